@@ -1,0 +1,204 @@
+//! Study files: TOML documents that say what to compute.
+//!
+//! A study file has a `[study]` table (name, description, seed, threads) and
+//! one table per kind of work it asks for (`[panels]`, `[problem]`,
+//! `[multistart]`, ...). Each module reads its own section with
+//! [`Study::section`], so modules stay independent of one another; this module
+//! only owns the common part and the error mapping. Angles in study files are
+//! written in degrees and converted once, where a section is resolved.
+//!
+//! Every error names the file, the key, the value and what was expected.
+
+use crate::error::{Error, Result};
+use serde::de::DeserializeOwned;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// The common `[study]` table.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct StudyMeta {
+    /// Name of the study; results go to `results/<name>/`. Default: file stem.
+    pub name: Option<String>,
+    /// Free text shown in reports.
+    #[serde(default)]
+    pub description: String,
+    /// Seed of every random choice in the study. Default 0 (documented so a
+    /// run is reproducible even when the file gives none).
+    #[serde(default)]
+    pub seed: u64,
+    /// Worker threads for drivers. Default: all cores.
+    pub threads: Option<usize>,
+}
+
+/// A parsed study file: its path, the raw TOML table and the common metadata.
+#[derive(Debug, Clone)]
+pub struct Study {
+    /// Where the study was read from (or a label for built-in studies).
+    pub path: PathBuf,
+    /// The original text (kept for the manifest).
+    pub text: String,
+    /// The whole document.
+    pub table: toml::Table,
+    /// The `[study]` table.
+    pub meta: StudyMeta,
+}
+
+impl Study {
+    /// Read and parse a study file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Study> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Study::parse(path, &text)
+    }
+
+    /// Parse study text; `path` is used in messages and for the default name.
+    pub fn parse(path: impl AsRef<Path>, text: &str) -> Result<Study> {
+        let path = path.as_ref().to_path_buf();
+        let table: toml::Table = toml::from_str(text).map_err(|e| Error::Input {
+            file: path.display().to_string(),
+            key: String::new(),
+            value: "(file)".into(),
+            expected: format!("valid TOML: {}", e.message().trim()),
+        })?;
+        let mut study = Study {
+            path,
+            text: text.to_string(),
+            table,
+            meta: StudyMeta::default(),
+        };
+        study.meta = study.section::<StudyMeta>("study")?.unwrap_or_default();
+        if study.meta.threads == Some(0) {
+            return Err(study.error("study.threads", 0, "a thread count >= 1"));
+        }
+        if let Some(name) = &study.meta.name {
+            if name.is_empty() || name.contains(['/', '\\']) || name == "." || name == ".." {
+                return Err(study.error(
+                    "study.name",
+                    name,
+                    "a non-empty name without path separators",
+                ));
+            }
+        }
+        Ok(study)
+    }
+
+    /// The study's name: `[study] name`, else the file stem.
+    pub fn name(&self) -> String {
+        self.meta.name.clone().unwrap_or_else(|| {
+            self.path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "study".into())
+        })
+    }
+
+    /// Does the study have a top-level table `key`?
+    pub fn has(&self, key: &str) -> bool {
+        self.table.contains_key(key)
+    }
+
+    /// Deserialize the top-level section `key` into `T`, or `None` if absent.
+    /// Serde errors (missing field, unknown field, wrong type) become input
+    /// errors naming this file and the section.
+    pub fn section<T: DeserializeOwned>(&self, key: &str) -> Result<Option<T>> {
+        match self.table.get(key) {
+            None => Ok(None),
+            Some(v) => v.clone().try_into::<T>().map(Some).map_err(|e| {
+                let msg = e.to_string();
+                Error::Input {
+                    file: self.path.display().to_string(),
+                    key: key.to_string(),
+                    value: summarize(v),
+                    expected: msg.trim().replace('\n', " "),
+                }
+            }),
+        }
+    }
+
+    /// Like [`Study::section`] but the section must be present.
+    pub fn require_section<T: DeserializeOwned>(&self, key: &str, what: &str) -> Result<T> {
+        self.section(key)?
+            .ok_or_else(|| self.error(key, "(missing)", format!("a [{key}] table: {what}")))
+    }
+
+    /// An input error in this file.
+    pub fn error(
+        &self,
+        key: impl Into<String>,
+        value: impl std::fmt::Display,
+        expected: impl Into<String>,
+    ) -> Error {
+        Error::input(key, value, expected).in_file(&self.path, "")
+    }
+
+    /// Attach this file (and a key prefix) to a library-level input error.
+    pub fn locate(&self, key_prefix: &str) -> impl Fn(Error) -> Error + '_ {
+        let prefix = key_prefix.to_string();
+        move |e| e.in_file(&self.path, &prefix)
+    }
+
+    /// The output directory `root/<name>`, created if needed.
+    pub fn output_dir(&self, root: &Path) -> Result<PathBuf> {
+        let dir = root.join(self.name());
+        std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+        Ok(dir)
+    }
+}
+
+/// Short one-line rendering of a TOML value for messages.
+fn summarize(v: &toml::Value) -> String {
+    let s = match v {
+        toml::Value::Table(_) => "(table)".to_string(),
+        toml::Value::Array(a) => format!("(array of {})", a.len()),
+        other => other.to_string(),
+    };
+    if s.len() > 60 {
+        format!("{}...", &s[..57])
+    } else {
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Demo {
+        #[allow(dead_code)]
+        starts: usize,
+    }
+
+    #[test]
+    fn name_defaults_to_stem_and_sections_map_errors() {
+        let s = Study::parse(
+            "studies/demo.toml",
+            "[study]\nseed = 3\n[demo]\nstarts = -1\n",
+        )
+        .unwrap();
+        assert_eq!(s.name(), "demo");
+        assert_eq!(s.meta.seed, 3);
+        let e = s.section::<Demo>("demo").unwrap_err().to_string();
+        assert!(e.starts_with("studies/demo.toml: `demo`"), "{e}");
+        assert!(s.section::<Demo>("absent").unwrap().is_none());
+    }
+
+    #[test]
+    fn zero_threads_rejected() {
+        let e = Study::parse("a.toml", "[study]\nthreads = 0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("study.threads") && e.contains("thread count"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn bad_toml_names_file() {
+        let e = Study::parse("b.toml", "[study\n").unwrap_err().to_string();
+        assert!(e.starts_with("b.toml"), "{e}");
+    }
+}
