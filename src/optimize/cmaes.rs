@@ -355,17 +355,14 @@ impl Cmaes {
                 evaluate_batch(c, &xs).map_err(argmin::core::Error::from)
             })
             .map_err(driver::from_argmin)?;
+        let m = problem
+            .problem
+            .as_ref()
+            .map(|c| c.n_constraints())
+            .unwrap_or(0);
         let mut samples: Vec<Sample> = Vec::with_capacity(lambda);
         for (k, ev) in evals.into_iter().enumerate() {
-            if !ev.f.is_finite() || ev.g.iter().any(|v| !v.is_finite()) {
-                return Err(Error::numerical(
-                    "optimize::cmaes",
-                    format!(
-                        "non-finite f = {} or g = {:?} at x = {:?}",
-                        ev.f, ev.g, xs[k]
-                    ),
-                ));
-            }
+            driver::check_evaluation(&ev, &xs[k], m, false, "optimize::cmaes")?;
             let violation = designs[k].1 + ev.g.iter().map(|g| g.max(0.0)).sum::<f64>();
             samples.push(Sample {
                 y: ys[k].as_slice().to_vec(),
