@@ -16,7 +16,9 @@ use plyscape::optimize::{History, LocalOutcome, Problem, Termination};
 fn solve(p: &Analytic, x0: &[f64], options: &MmfdOptions) -> LocalOutcome {
     let mut h = History::default();
     let out = mmfd::minimize(p, x0, options, &mut h).expect("mmfd runs");
-    let rel = (out.f - p.f_opt).abs() / p.f_opt.abs().max(1.0);
+    // Relative to |f*| (absolute when f* = 0).
+    let scale = if p.f_opt == 0.0 { 1.0 } else { p.f_opt.abs() };
+    let rel = (out.f - p.f_opt).abs() / scale;
     assert!(
         rel <= 1e-4,
         "{} from {x0:?}: f = {} vs published {} (rel {rel:.2e}), {out:?}",
