@@ -264,3 +264,31 @@ fn argmin_executor_runs_the_mmfd_solver() {
     assert_eq!(x, &direct.x);
     assert!((res.state().get_cost() - 1.0 / 9.0).abs() < 1e-4);
 }
+
+/// g = 1 − x <= 0 cannot hold for x in [−2, 0]: the restoration moves reach
+/// the least-violating design x = 0 (closed form) and MMFD reports
+/// `Infeasible` instead of looping.
+#[test]
+fn infeasible_problem_is_reported() {
+    fn k(x: &[f64]) -> (f64, Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+        (
+            x[0] * x[0],
+            vec![1.0 - x[0]],
+            vec![2.0 * x[0]],
+            vec![vec![-1.0]],
+        )
+    }
+    let p = Analytic {
+        name: "empty".into(),
+        variables: vec![plyscape::optimize::Variable::bounded("x", -2.0, 0.0).unwrap()],
+        n_constraints: 1,
+        kernel: k,
+        x0: vec![-1.5],
+        optima: vec![],
+        f_opt: f64::NAN,
+    };
+    let o = mmfd::minimize(&p, &p.x0, &MmfdOptions::default(), &mut History::default()).unwrap();
+    assert_eq!(o.termination, Termination::Infeasible);
+    assert!(o.x[0].abs() < 1e-9, "{o:?}");
+    assert!(o.function_calls < 20);
+}

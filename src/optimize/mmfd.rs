@@ -679,6 +679,9 @@ impl Mmfd {
             b.push(y);
         }
         let sol = qp::solve(&vec![0.0; n], &rows, &b)?;
+        if sol.s.iter().all(|&v| v == 0.0) {
+            return Ok(None);
+        }
         let v0 = base.max_g();
         let mut alpha = 1.0;
         for _ in 0..6 {
