@@ -1,1 +1,51 @@
-//! (module under construction; see lib.rs)
+//! Panel finite elements: mesh, laminated shell triangle, sparse assembly,
+//! supports (paper §2.2, §3.2 Eq. 20, §6.2).
+//!
+//! # API (what the modal analysis takes from here)
+//!
+//! ```text
+//! let panel  = PanelSpec { .. }.resolve()?;            // from a study file, or build by hand:
+//! let mesh   = Mesh::structured(&MeshParams { length, width, divisions, points })?;
+//! let model  = PanelModel::new(mesh, Support::CentreClamp)?;   // pattern + scatter map, once
+//! let sys    = model.assemble(&laminate, &design_map, Derivatives::Second)?;
+//! // or in one shot: fe::assemble(&mesh, &laminate, support, &design_map, Derivatives::First)?
+//!
+//! sys.k        : SparseColMat<usize, f64>       reduced K_ff (supports applied), n × n,
+//!                                               both triangles stored, symmetric
+//! sys.m_diag   : Vec<f64>                       lumped diagonal M (HRZ), same DOF order;
+//!                                               independent of the ply angles
+//! sys.dk[v]    : SparseColMat (same pattern)    dK/dθ_v, v = design variable   (First, Second)
+//! sys.d2k[v]   : SparseColMat (same pattern)    d²K/dθ_v²                      (Second)
+//! sys.d2k_mixed(v, w)                           Some(&d2k[v]) if v == w, None (= exactly 0) otherwise
+//! sys.dof_map  : Vec<(node, component)>         free DOF → node, 0..6 = u, v, w, θx, θy, θz
+//! sys.nodes    : Vec<[x, y]>                    panel coordinates, origin at the centre [m]
+//! sys.rigid_modes : Vec<Vec<f64>>               FreeFree only: 6 M-orthonormal rigid-body modes
+//! ```
+//!
+//! Angles in radians; a design variable ties one or more plies
+//! ([`crate::laminate::DesignMap`]; the paper's [θ1/θ2/θ2/θ1] is
+//! `DesignMap::symmetric(4)`). Derivatives are assembled only when asked
+//! for. K depends on the ply angles only through A, B, D, S, so
+//! `dK/dθ_v = Σ_e A_e Gᵀ (∂C/∂θ_v) G` with the element operators unchanged
+//! (Eq. 20); M does not depend on them.
+//!
+//! # Method
+//! - [`mesh`]: structured triangle grid with lines through every attachment
+//!   point, patch corner and the centre.
+//! - [`element`]: stabilised DSG3 Mindlin–Reissner triangle with CST
+//!   membrane + Hughes–Brezzi drilling, full A–B–D coupling, HRZ mass; the
+//!   module doc says why this element.
+//! - [`assembly`]: supports by elimination; the sparsity pattern and the
+//!   position of every element entry are computed once per model, each
+//!   assembly fills values in a fixed order (bit-for-bit deterministic).
+//! - [`spec`]: the `[[panels]]` study-file section.
+
+pub mod assembly;
+pub mod element;
+pub mod mesh;
+pub mod spec;
+
+pub use assembly::{assemble, Derivatives, PanelModel, PanelSystem, Support, NODE_DOF};
+pub use element::{section_matrix, Triangle};
+pub use mesh::{Mesh, MeshParams};
+pub use spec::{Panel, PanelSpec};

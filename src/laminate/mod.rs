@@ -266,6 +266,21 @@ impl Laminate {
         r
     }
 
+    /// Angle-independent mean membrane stiffness
+    /// `Ā = (A11 + A22 + 2A66)/4 = Σ tₖ (U1 + U5)ₖ / 2` \[N/m\] (the sum
+    /// `Q̄11 + Q̄22 + 2Q̄66 = 2(U1 + U5)` is a rotation invariant). Used to
+    /// scale the shell's drilling penalty so that it does not depend on the
+    /// design.
+    pub fn membrane_mean(&self) -> f64 {
+        self.plies
+            .iter()
+            .map(|p| {
+                let u = p.material.invariants();
+                p.thickness * (u[0] + u[4]) / 2.0
+            })
+            .sum()
+    }
+
     /// Ply angles \[rad\].
     pub fn angles(&self) -> Vec<f64> {
         self.plies.iter().map(|p| p.angle).collect()
