@@ -234,8 +234,14 @@ fn element_derivatives_match_central_differences() {
     let map = DesignMap::symmetric(4);
     let x0 = [20f64.to_radians(), -50f64.to_radians()];
     let el = 7;
-    let (t, g) = model.element(el);
+    let (t, gd) = model.element(el);
+    let g = model.element_ops(el);
     let h = lam.thickness();
+    // The compact block product equals the dense GᵀCG (up to rounding).
+    let c0 = section_matrix(&lam.stiffness());
+    let dense = t.section_stiffness_dense(&gd, &c0, h);
+    let fast = t.section_stiffness(g, &c0, h);
+    assert!((dense - fast).amax() <= 1e-13 * dense.amax());
     let scale = model.element_stiffness(el, &lam).amax();
     let d1 = |l: &Laminate, v: usize| -> Mat18 {
         t.section_stiffness(g, &section_matrix(&l.design_derivative(&map, v)), h)

@@ -5,7 +5,9 @@
 //! [`PanelModel::new`]; each assembly then only fills a value array
 //! (deterministic: fixed element order, fixed summation order).
 
-use super::element::{section_matrix, Mat18, Mat8, Mat8x18, Triangle, DRILLING_PENALTY};
+use super::element::{
+    section_matrix, CompactOps, Mat18, Mat8, Mat8x18, Triangle, DRILLING_PENALTY,
+};
 use super::mesh::Mesh;
 use crate::error::{require_positive, Error, Result};
 use crate::laminate::{DesignMap, Laminate};
@@ -14,6 +16,8 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 /// DOF per node: u, v, w, θx, θy, θz.
 pub const NODE_DOF: usize = 6;
 const NONE: usize = usize::MAX;
+/// Marker of a constrained entry in the scatter map.
+const SKIP: u32 = u32::MAX;
 
 /// Reference (boundary) condition of a panel for its modes (paper §6.2).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -188,11 +192,14 @@ pub struct PanelModel {
     mesh: Mesh,
     support: Support,
     tris: Vec<Triangle>,
-    ops: Vec<Mat8x18>,
+    ops: Vec<CompactOps>,
     free: Vec<usize>,
     dof_map: Vec<(usize, usize)>,
     symbolic: SymbolicSparseColMat<usize>,
-    scatter: Vec<usize>,
+    /// Position in the value array of every element entry (324 per
+    /// element), `SKIP` where a DOF is constrained. u32 halves the memory
+    /// traffic of assembly.
+    scatter: Vec<u32>,
 }
 
 impl PanelModel {
@@ -203,7 +210,7 @@ impl PanelModel {
             .iter()
             .map(|t| Triangle::new(t.map(|i| mesh.nodes[i])))
             .collect::<Result<Vec<_>>>()?;
-        let ops = tris.iter().map(Triangle::strain_operator).collect();
+        let ops = tris.iter().map(Triangle::compact_operator).collect();
         let fixed = support.constrained(&mesh)?;
         let mut free = vec![NONE; fixed.len()];
         let mut dof_map = Vec::new();
@@ -243,19 +250,28 @@ impl PanelModel {
             col_ptr[j + 1] += col_ptr[j];
         }
         let row_idx: Vec<usize> = pairs.iter().map(|&(_, r)| r).collect();
+        if row_idx.len() >= SKIP as usize {
+            return Err(Error::numerical(
+                "fe::PanelModel::new",
+                format!(
+                    "{} stored entries exceed the u32 scatter map",
+                    row_idx.len()
+                ),
+            ));
+        }
         let mut scatter = Vec::with_capacity(mesh.triangles.len() * 324);
         for t in &mesh.triangles {
             let d = edofs(t);
             for &c in &d {
                 for &r in &d {
                     scatter.push(if c == NONE || r == NONE {
-                        NONE
+                        SKIP
                     } else {
                         let col = &row_idx[col_ptr[c]..col_ptr[c + 1]];
-                        col_ptr[c]
-                            + col
-                                .binary_search(&r)
-                                .expect("pattern contains every element pair")
+                        let k = col
+                            .binary_search(&r)
+                            .expect("pattern contains every element pair");
+                        (col_ptr[c] + k) as u32
                     });
                 }
             }
@@ -296,22 +312,27 @@ impl PanelModel {
             .filter(|&f| f != NONE)
     }
 
-    /// Element `e`'s geometry and strain operator G.
-    pub fn element(&self, e: usize) -> (&Triangle, &Mat8x18) {
-        (&self.tris[e], &self.ops[e])
+    /// Element `e`'s geometry and strain operator G (8×18).
+    pub fn element(&self, e: usize) -> (&Triangle, Mat8x18) {
+        (&self.tris[e], self.tris[e].strain_operator())
+    }
+
+    /// Element `e`'s compact operator blocks (as used in assembly).
+    pub fn element_ops(&self, e: usize) -> &CompactOps {
+        &self.ops[e]
     }
 
     /// Element stiffness (18×18, element DOF order) for a laminate:
     /// `A·GᵀC_eG + K_drill`.
     pub fn element_stiffness(&self, e: usize, lam: &Laminate) -> Mat18 {
         let c = section_matrix(&lam.stiffness());
-        let (t, g) = self.element(e);
+        let (t, g) = (&self.tris[e], &self.ops[e]);
         t.section_stiffness(g, &c, lam.thickness())
             + t.drilling_stiffness(DRILLING_PENALTY * lam.membrane_mean())
     }
 
     /// Scatter element matrices into a value array of the pattern.
-    fn fill(&self, mut elem: impl FnMut(&Triangle, &Mat8x18) -> Mat18) -> Vec<f64> {
+    fn fill(&self, mut elem: impl FnMut(&Triangle, &CompactOps) -> Mat18) -> Vec<f64> {
         let mut val = vec![0.0; self.symbolic.row_idx().len()];
         for (e, (t, g)) in self.tris.iter().zip(&self.ops).enumerate() {
             let ke = elem(t, g);
@@ -320,9 +341,9 @@ impl PanelModel {
             // the lower triangle of K_e is read, so K is exactly symmetric
             // (GᵀCG is symmetric only up to rounding).
             for (i, &p) in map.iter().enumerate() {
-                if p != NONE {
+                if p != SKIP {
                     let (a, b) = (i / 18, i % 18);
-                    val[p] += ke[(a.max(b), a.min(b))];
+                    val[p as usize] += ke[(a.max(b), a.min(b))];
                 }
             }
         }

@@ -68,6 +68,23 @@ pub type Mat18 = SMatrix<f64, 18, 18>;
 /// Element vector, 18.
 pub type Vec18 = SVector<f64, 18>;
 
+/// Element DOF of the membrane block: (u, v) of nodes 0, 1, 2.
+pub const MEMBRANE_DOF: [usize; 6] = [0, 1, 6, 7, 12, 13];
+/// Element DOF of the bending block: (θx, θy) of nodes 0, 1, 2.
+pub const BENDING_DOF: [usize; 6] = [3, 4, 9, 10, 15, 16];
+/// Element DOF of the shear block: (w, θx, θy) of nodes 0, 1, 2.
+pub const SHEAR_DOF: [usize; 9] = [2, 3, 4, 8, 9, 10, 14, 15, 16];
+
+/// The non-zero blocks of the strain operator G: membrane `gm` (3×6 on
+/// [`MEMBRANE_DOF`]), bending `gb` (3×6 on [`BENDING_DOF`]), shear `gs`
+/// (2×9 on [`SHEAR_DOF`]). Every other entry of G is zero.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CompactOps {
+    pub gm: SMatrix<f64, 3, 6>,
+    pub gb: SMatrix<f64, 3, 6>,
+    pub gs: SMatrix<f64, 2, 9>,
+}
+
 /// α of the shear stabilisation `h²/(h² + α ℓ²)`: 0.1 is the value
 /// recommended by Lyly, Stenberg & Vihinen (1993) and used for DSG3 by
 /// Nguyen-Thoi et al. (CS-DSG3, 2012).
@@ -183,9 +200,10 @@ impl Triangle {
     }
 
     /// `A · Gᵀ C_e G` with C_e = C whose shear block is scaled by the
-    /// stabilisation factor for thickness h. Used both for K (C = section
-    /// matrix) and its ply-angle derivatives (C = C', C'': paper Eq. 20).
-    pub fn section_stiffness(&self, g: &Mat8x18, c: &Mat8, h: f64) -> Mat18 {
+    /// stabilisation factor for thickness h, by dense 8×18 products. Used
+    /// both for K (C = section matrix) and its ply-angle derivatives
+    /// (C = C', C'': paper Eq. 20). Reference for [`Triangle::section_stiffness`].
+    pub fn section_stiffness_dense(&self, g: &Mat8x18, c: &Mat8, h: f64) -> Mat18 {
         let mut ce = *c;
         let f = self.shear_factor(h);
         for i in 6..8 {
@@ -195,6 +213,47 @@ impl Triangle {
         }
         let cg = ce * g;
         g.transpose() * cg * self.area
+    }
+
+    /// The same product as [`Triangle::section_stiffness_dense`] from the
+    /// compact blocks of G (about 10× fewer operations): membrane rows act
+    /// on (u, v), bending rows on (θx, θy), shear rows on (w, θx, θy), and C
+    /// has the block form `[[A, B, 0], [B, D, 0], [0, 0, S]]` (entries
+    /// outside these blocks are ignored).
+    pub fn section_stiffness(&self, g: &CompactOps, c: &Mat8, h: f64) -> Mat18 {
+        let a = c.fixed_view::<3, 3>(0, 0);
+        let b = c.fixed_view::<3, 3>(0, 3);
+        let d = c.fixed_view::<3, 3>(3, 3);
+        let s = c.fixed_view::<2, 2>(6, 6) * self.shear_factor(h);
+        let kmm = g.gm.transpose() * (a * g.gm);
+        let kmb = g.gm.transpose() * (b * g.gb);
+        let kbb = g.gb.transpose() * (d * g.gb);
+        let kss = g.gs.transpose() * (s * g.gs);
+        let mut k = Mat18::zeros();
+        for i in 0..6 {
+            for j in 0..6 {
+                k[(MEMBRANE_DOF[i], MEMBRANE_DOF[j])] = kmm[(i, j)];
+                k[(MEMBRANE_DOF[i], BENDING_DOF[j])] = kmb[(i, j)];
+                k[(BENDING_DOF[j], MEMBRANE_DOF[i])] = kmb[(i, j)];
+                k[(BENDING_DOF[i], BENDING_DOF[j])] = kbb[(i, j)];
+            }
+        }
+        for i in 0..9 {
+            for j in 0..9 {
+                k[(SHEAR_DOF[i], SHEAR_DOF[j])] += kss[(i, j)];
+            }
+        }
+        k * self.area
+    }
+
+    /// Compact blocks of the strain operator (see [`CompactOps`]).
+    pub fn compact_operator(&self) -> CompactOps {
+        let g = self.strain_operator();
+        CompactOps {
+            gm: SMatrix::from_fn(|r, j| g[(r, MEMBRANE_DOF[j])]),
+            gb: SMatrix::from_fn(|r, j| g[(3 + r, BENDING_DOF[j])]),
+            gs: SMatrix::from_fn(|r, j| g[(6 + r, SHEAR_DOF[j])]),
+        }
     }
 
     /// Drilling penalty matrix `γ_d ∫ (Nθz − Ω q)ᵀ (Nθz − Ω q) dA`, with

@@ -198,16 +198,6 @@ impl Stiffness {
         self.d += p.q * ((z1 * z1 * z1 - z0 * z0 * z0) / 3.0);
         self.s += p.g * (SHEAR_CORRECTION * (z1 - z0));
     }
-
-    /// Largest absolute entry over A, B·(1/h), D·(12/h²), S (for scaled
-    /// comparisons in tests and checks).
-    pub fn max_abs(&self) -> f64 {
-        self.a
-            .amax()
-            .max(self.b.amax())
-            .max(self.d.amax())
-            .max(self.s.amax())
-    }
 }
 
 /// A stack of plies, listed bottom (z = −h/2) to top.
