@@ -225,6 +225,33 @@ fn rigid_body_modes_have_zero_energy_and_mass_is_exact() {
 }
 
 #[test]
+fn drilling_penalty_energy_matches_closed_form() {
+    // Closed form derived in this test from ½γ∫(θz − ω)² dA on one triangle:
+    // (i) θz = 1 at node 0 only, u = v = 0: qᵀKq = γ ∫N₀² dA = γ A/6;
+    // (ii) u = −c·y, v = c·x at the nodes (ω = c), θz = 0: qᵀKq = γ A c²;
+    // (iii) the same with θz = c at every node: 0.
+    let t = plyscape::fe::Triangle::new([[0.1, 0.0], [0.9, 0.2], [0.3, 0.7]]).unwrap();
+    let gamma = 3.7e6;
+    let k = t.drilling_stiffness(gamma);
+    let mut q = nalgebra::SVector::<f64, 18>::zeros();
+    q[5] = 1.0;
+    let e = (q.transpose() * k * q)[0];
+    assert!((e - gamma * t.area / 6.0).abs() < 1e-12 * gamma);
+    let c = 0.013;
+    let mut q = nalgebra::SVector::<f64, 18>::zeros();
+    for i in 0..3 {
+        q[6 * i] = -c * t.x[i][1];
+        q[6 * i + 1] = c * t.x[i][0];
+    }
+    let e = (q.transpose() * k * q)[0];
+    assert!((e - gamma * t.area * c * c).abs() < 1e-12 * gamma * c * c);
+    for i in 0..3 {
+        q[6 * i + 5] = c;
+    }
+    assert!((q.transpose() * k * q)[0].abs() < 1e-12 * gamma * c * c);
+}
+
+#[test]
 fn element_derivatives_match_central_differences() {
     // Reference: central finite differences of the element stiffness in the
     // ply angles (step 1e-4 rad); second derivative: central differences of
@@ -338,8 +365,11 @@ fn assembled_derivatives_match_central_differences_and_are_deterministic() {
             / scale;
         assert!(e12 < 1e-7, "mixed: {e12:e}");
     }
-    // Deterministic to the bit.
-    let again = model.assemble(&lam, &map, Derivatives::Second).unwrap();
+    // Deterministic to the bit, also when re-assembling into used buffers.
+    let mut again = model.assemble(&lam, &map, Derivatives::Second).unwrap();
+    let other = lam.with_design(&map, &[1.0, 2.0]).unwrap();
+    model.assemble_into(&other, &map, &mut again).unwrap();
+    model.assemble_into(&lam, &map, &mut again).unwrap();
     assert!(sys
         .k
         .val()

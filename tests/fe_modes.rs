@@ -207,6 +207,16 @@ fn sar_panel_mode_convergence() {
     }
 }
 
+/// CPU time of this thread \[ms\] from /proc/thread-self/schedstat (Linux;
+/// immune to other processes on a loaded machine), or wall time elsewhere.
+fn cpu_ms(wall0: std::time::Instant) -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map(|ns| ns * 1e-6)
+        .unwrap_or_else(|| wall0.elapsed().as_secs_f64() * 1e3)
+}
+
 /// Measurement, not a check: assembly time (median and min of 21) of the
 /// SAR panel (the minimum is the better estimate on a loaded machine).
 /// `cargo test --release --test fe_modes assembly_time -- --ignored --nocapture`
@@ -219,21 +229,63 @@ fn sar_panel_assembly_time() {
         let model = sar_panel3(div, Support::CentreClamp);
         for want in [Derivatives::None, Derivatives::Second] {
             let mut t = Vec::new();
+            // Wall time per run (median, min) and CPU time averaged over the
+            // batch (schedstat is updated at scheduler ticks: per-run CPU
+            // deltas would be quantised).
+            let w0 = std::time::Instant::now();
+            let c0 = cpu_ms(w0);
             for _ in 0..21 {
                 let t0 = std::time::Instant::now();
                 let sys = model.assemble(&lam, &map, want).unwrap();
                 t.push(t0.elapsed().as_secs_f64() * 1e3);
                 std::hint::black_box(sys);
             }
+            let cpu = (cpu_ms(w0) - c0) / 21.0;
             t.sort_by(f64::total_cmp);
             eprintln!(
-                "assembly div {div} ({} DOF, {} elements) {want:?}: median {:.3} ms, min {:.3} ms",
+                "assembly div {div} ({} DOF, {} elements) {want:?}: wall median {:.3} ms, min {:.3} ms; CPU mean {cpu:.3} ms",
                 model.n_dof(),
                 model.mesh().triangles.len(),
                 t[10],
                 t[0]
             );
         }
+        let mut sys = model.assemble(&lam, &map, Derivatives::Second).unwrap();
+        let mut t = Vec::new();
+        for _ in 0..21 {
+            let t0 = std::time::Instant::now();
+            model.assemble_into(&lam, &map, &mut sys).unwrap();
+            t.push(t0.elapsed().as_secs_f64() * 1e3);
+        }
+        t.sort_by(f64::total_cmp);
+        eprintln!(
+            "  assemble_into (buffers reused) Second: wall median {:.3} ms, min {:.3} ms",
+            t[10], t[0]
+        );
+        let mut sys = model.assemble(&lam, &map, Derivatives::None).unwrap();
+        let mut t = Vec::new();
+        for _ in 0..21 {
+            let t0 = std::time::Instant::now();
+            model.assemble_into(&lam, &map, &mut sys).unwrap();
+            t.push(t0.elapsed().as_secs_f64() * 1e3);
+        }
+        t.sort_by(f64::total_cmp);
+        eprintln!(
+            "  assemble_into (buffers reused) None: wall median {:.3} ms, min {:.3} ms",
+            t[10], t[0]
+        );
+        let mut t = Vec::new();
+        for _ in 0..21 {
+            let t0 = std::time::Instant::now();
+            std::hint::black_box(sys.k.clone());
+            t.push(t0.elapsed().as_secs_f64() * 1e3);
+        }
+        t.sort_by(f64::total_cmp);
+        eprintln!(
+            "  nnz {}: copying K alone takes min {:.3} ms",
+            sys.k.val().len(),
+            t[0]
+        );
         let t0 = std::time::Instant::now();
         let _ = sar_panel3(div, Support::CentreClamp);
         eprintln!(

@@ -327,15 +327,23 @@ impl PanelModel {
     pub fn element_stiffness(&self, e: usize, lam: &Laminate) -> Mat18 {
         let c = section_matrix(&lam.stiffness());
         let (t, g) = (&self.tris[e], &self.ops[e]);
-        t.section_stiffness(g, &c, lam.thickness())
-            + t.drilling_stiffness(DRILLING_PENALTY * lam.membrane_mean())
+        let mut k = t.section_stiffness(g, &c, lam.thickness());
+        t.add_drilling(DRILLING_PENALTY * lam.membrane_mean(), &mut k);
+        k
     }
 
-    /// Scatter element matrices into a value array of the pattern.
-    fn fill(&self, mut elem: impl FnMut(&Triangle, &CompactOps) -> Mat18) -> Vec<f64> {
-        let mut val = vec![0.0; self.symbolic.row_idx().len()];
+    /// Scatter element matrices into `val` (zeroed first). `elem` writes
+    /// the element matrix into the buffer it is given.
+    fn fill(
+        &self,
+        val: &mut [f64],
+        what: &str,
+        mut elem: impl FnMut(&Triangle, &CompactOps, &mut Mat18),
+    ) -> Result<()> {
+        val.fill(0.0);
+        let mut ke = Mat18::zeros();
         for (e, (t, g)) in self.tris.iter().zip(&self.ops).enumerate() {
-            let ke = elem(t, g);
+            elem(t, g, &mut ke);
             let map = &self.scatter[324 * e..324 * (e + 1)];
             // map index a·18 + b holds entry (row d[b], column d[a]). Only
             // the lower triangle of K_e is read, so K is exactly symmetric
@@ -347,17 +355,13 @@ impl PanelModel {
                 }
             }
         }
-        val
-    }
-
-    fn matrix(&self, val: Vec<f64>, what: &str) -> Result<SparseColMat<usize, f64>> {
         if let Some(i) = val.iter().position(|v| !v.is_finite()) {
             return Err(Error::numerical(
                 "fe::PanelModel::assemble",
                 format!("non-finite {what} entry {i}: {}", val[i]),
             ));
         }
-        Ok(SparseColMat::new(self.symbolic.clone(), val))
+        Ok(())
     }
 
     /// Assemble K, M and (as asked) dK/dθ_v, d²K/dθ_v² for `lam` with
@@ -368,6 +372,41 @@ impl PanelModel {
         design: &DesignMap,
         want: Derivatives,
     ) -> Result<PanelSystem> {
+        let nnz = self.symbolic.row_idx().len();
+        let mk = || SparseColMat::new(self.symbolic.clone(), vec![0.0; nnz]);
+        let n1 = if want >= Derivatives::First {
+            design.len()
+        } else {
+            0
+        };
+        let n2 = if want >= Derivatives::Second {
+            design.len()
+        } else {
+            0
+        };
+        let mut sys = PanelSystem {
+            k: mk(),
+            m_diag: vec![0.0; self.n_dof()],
+            dk: (0..n1).map(|_| mk()).collect(),
+            d2k: (0..n2).map(|_| mk()).collect(),
+            dof_map: self.dof_map.clone(),
+            nodes: self.mesh.nodes.clone(),
+            rigid_modes: Vec::new(),
+        };
+        self.assemble_into(lam, design, &mut sys)?;
+        Ok(sys)
+    }
+
+    /// Re-assemble into a system previously returned by
+    /// [`PanelModel::assemble`] on this model (same design-variable count and
+    /// derivative level: those of `sys`), reusing its buffers: the cheap path
+    /// inside an optimization loop.
+    pub fn assemble_into(
+        &self,
+        lam: &Laminate,
+        design: &DesignMap,
+        sys: &mut PanelSystem,
+    ) -> Result<()> {
         let n_plies = lam.plies().len();
         if let Some(k) = design.groups().iter().flatten().find(|&&k| k >= n_plies) {
             return Err(Error::input(
@@ -376,61 +415,59 @@ impl PanelModel {
                 format!("ply numbers within the lay-up (1..={n_plies})"),
             ));
         }
+        let nnz = self.symbolic.row_idx().len();
+        let same = |m: &SparseColMat<usize, f64>| m.val().len() == nnz && m.nrows() == self.n_dof();
+        let levels_ok = [sys.dk.len(), sys.d2k.len()]
+            .iter()
+            .all(|&l| l == 0 || l == design.len());
+        if !same(&sys.k)
+            || !sys.dk.iter().all(same)
+            || !sys.d2k.iter().all(same)
+            || !levels_ok
+            || sys.m_diag.len() != self.n_dof()
+        {
+            return Err(Error::input(
+                "system",
+                "(buffers of another model)",
+                "a PanelSystem assembled by this PanelModel with this design map",
+            ));
+        }
         let h = lam.thickness();
         let c = section_matrix(&lam.stiffness());
         let gamma = DRILLING_PENALTY * lam.membrane_mean();
-        let k = self.matrix(
-            self.fill(|t, g| t.section_stiffness(g, &c, h) + t.drilling_stiffness(gamma)),
-            "K",
-        )?;
-        let deriv = |order: u8| -> Result<Vec<SparseColMat<usize, f64>>> {
-            (0..design.len())
-                .map(|v| {
-                    let st = if order == 1 {
-                        lam.design_derivative(design, v)
-                    } else {
-                        lam.design_second_derivative(design, v, v)
-                    };
-                    let dc: Mat8 = section_matrix(&st);
-                    self.matrix(self.fill(|t, g| t.section_stiffness(g, &dc, h)), "dK")
-                })
-                .collect()
-        };
-        let dk = if want >= Derivatives::First {
-            deriv(1)?
-        } else {
-            Vec::new()
-        };
-        let d2k = if want >= Derivatives::Second {
-            deriv(2)?
-        } else {
-            Vec::new()
-        };
+        self.fill(sys.k.val_mut(), "K", |t, g, ke| {
+            t.section_stiffness_into(g, &c, h, ke);
+            t.add_drilling(gamma, ke);
+        })?;
+        for (v, m) in sys.dk.iter_mut().enumerate() {
+            let dc: Mat8 = section_matrix(&lam.design_derivative(design, v));
+            self.fill(m.val_mut(), "dK", |t, g, ke| {
+                t.section_stiffness_into(g, &dc, h, ke)
+            })?;
+        }
+        for (v, m) in sys.d2k.iter_mut().enumerate() {
+            let dc: Mat8 = section_matrix(&lam.design_second_derivative(design, v, v));
+            self.fill(m.val_mut(), "d2K", |t, g, ke| {
+                t.section_stiffness_into(g, &dc, h, ke)
+            })?;
+        }
         let (mu, ir) = (lam.mass_per_area(), lam.rotary_inertia_per_area());
-        let mut m_diag = vec![0.0; self.n_dof()];
+        sys.m_diag.fill(0.0);
         for (t, tri) in self.mesh.triangles.iter().zip(&self.tris) {
             let me = tri.lumped_mass(mu, ir);
             for (a, &m) in me.iter().enumerate() {
                 let f = self.free[NODE_DOF * t[a / NODE_DOF] + a % NODE_DOF];
                 if f != NONE {
-                    m_diag[f] += m;
+                    sys.m_diag[f] += m;
                 }
             }
         }
-        let rigid_modes = if self.support == Support::FreeFree {
-            self.rigid_modes(&m_diag)?
+        sys.rigid_modes = if self.support == Support::FreeFree {
+            self.rigid_modes(&sys.m_diag)?
         } else {
             Vec::new()
         };
-        Ok(PanelSystem {
-            k,
-            m_diag,
-            dk,
-            d2k,
-            dof_map: self.dof_map.clone(),
-            nodes: self.mesh.nodes.clone(),
-            rigid_modes,
-        })
+        Ok(())
     }
 
     /// The six rigid-body displacement fields about the panel centre (free

@@ -221,15 +221,24 @@ impl Triangle {
     /// has the block form `[[A, B, 0], [B, D, 0], [0, 0, S]]` (entries
     /// outside these blocks are ignored).
     pub fn section_stiffness(&self, g: &CompactOps, c: &Mat8, h: f64) -> Mat18 {
-        let a = c.fixed_view::<3, 3>(0, 0);
-        let b = c.fixed_view::<3, 3>(0, 3);
-        let d = c.fixed_view::<3, 3>(3, 3);
-        let s = c.fixed_view::<2, 2>(6, 6) * self.shear_factor(h);
+        let mut k = Mat18::zeros();
+        self.section_stiffness_into(g, c, h, &mut k);
+        k
+    }
+
+    /// [`Triangle::section_stiffness`] written into `k` (overwritten), for
+    /// assembly loops that reuse one buffer.
+    pub fn section_stiffness_into(&self, g: &CompactOps, c: &Mat8, h: f64, k: &mut Mat18) {
+        let ar = self.area;
+        let a = c.fixed_view::<3, 3>(0, 0) * ar;
+        let b = c.fixed_view::<3, 3>(0, 3) * ar;
+        let d = c.fixed_view::<3, 3>(3, 3) * ar;
+        let s = c.fixed_view::<2, 2>(6, 6) * (self.shear_factor(h) * ar);
         let kmm = g.gm.transpose() * (a * g.gm);
         let kmb = g.gm.transpose() * (b * g.gb);
         let kbb = g.gb.transpose() * (d * g.gb);
         let kss = g.gs.transpose() * (s * g.gs);
-        let mut k = Mat18::zeros();
+        k.fill(0.0);
         for i in 0..6 {
             for j in 0..6 {
                 k[(MEMBRANE_DOF[i], MEMBRANE_DOF[j])] = kmm[(i, j)];
@@ -243,7 +252,6 @@ impl Triangle {
                 k[(SHEAR_DOF[i], SHEAR_DOF[j])] += kss[(i, j)];
             }
         }
-        k * self.area
     }
 
     /// Compact blocks of the strain operator (see [`CompactOps`]).
@@ -260,27 +268,41 @@ impl Triangle {
     /// `∫ N_i N_j dA = A (1 + δ_ij)/12` and `Ω q = ω = ½(v,x − u,y)`.
     /// `gamma` in N/m (N·m per radian² per m²).
     pub fn drilling_stiffness(&self, gamma: f64) -> Mat18 {
-        let mut om = Vec18::zeros();
-        for i in 0..3 {
-            om[6 * i] = -0.5 * self.grad[i][1];
-            om[6 * i + 1] = 0.5 * self.grad[i][0];
+        let mut k = Mat18::zeros();
+        self.add_drilling(gamma, &mut k);
+        k
+    }
+
+    /// Add [`Triangle::drilling_stiffness`] to `k` (touches only the u, v
+    /// and θz rows and columns).
+    pub fn add_drilling(&self, gamma: f64, k: &mut Mat18) {
+        // Ω on (u_i, v_i) in MEMBRANE_DOF order: ω = Σ ½(N_i,x v_i − N_i,y u_i).
+        let om: [f64; 6] = std::array::from_fn(|j| {
+            let g = self.grad[j / 2];
+            if j % 2 == 0 {
+                -0.5 * g[1]
+            } else {
+                0.5 * g[0]
+            }
+        });
+        let ga = gamma * self.area;
+        for p in 0..6 {
+            for q in 0..6 {
+                k[(MEMBRANE_DOF[p], MEMBRANE_DOF[q])] += ga * om[p] * om[q];
+            }
         }
-        let a = self.area;
-        let mut k = om * om.transpose() * (gamma * a);
         for i in 0..3 {
             let ti = 6 * i + 5;
             for j in 0..3 {
-                let tj = 6 * j + 5;
-                k[(ti, tj)] += gamma * a * if i == j { 2.0 } else { 1.0 } / 12.0;
+                k[(ti, 6 * j + 5)] += ga * if i == j { 2.0 } else { 1.0 } / 12.0;
             }
             // cross terms −γ ∫ N_i dA Ω = −γ (A/3) Ω
-            for q in 0..18 {
-                let v = -gamma * a / 3.0 * om[q];
-                k[(ti, q)] += v;
-                k[(q, ti)] += v;
+            for q in 0..6 {
+                let v = -ga / 3.0 * om[q];
+                k[(ti, MEMBRANE_DOF[q])] += v;
+                k[(MEMBRANE_DOF[q], ti)] += v;
             }
         }
-        k
     }
 
     /// HRZ lumped mass (module doc): `mass_area` = Σρt \[kg/m²\],
