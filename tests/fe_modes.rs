@@ -146,6 +146,30 @@ fn sar_laminate(angles_deg: [f64; 4]) -> Laminate {
     .unwrap()
 }
 
+#[test]
+fn free_free_panel_has_exactly_six_zero_energy_modes() {
+    // Identity: an unsupported body has exactly 6 rigid-body modes; a 7th
+    // near-zero eigenvalue would be a spurious (hourglass or drilling) mode.
+    // Shift σ = −1 makes K − σM definite.
+    let lam = sar_laminate([30.0, -60.0, -60.0, 30.0]);
+    let model = sar_panel3(12, Support::FreeFree);
+    let sys = model
+        .assemble(&lam, &DesignMap::symmetric(4), Derivatives::None)
+        .unwrap();
+    let l = lowest_eigenvalues(&sys, -1.0, 8);
+    eprintln!("free-free eigenvalues [rad²/s²]: {l:?}");
+    for (i, li) in l[..6].iter().enumerate() {
+        assert!(
+            li.abs() < 1e-6 * l[6],
+            "mode {i}: {li:e} vs λ7 = {:e}",
+            l[6]
+        );
+    }
+    // First elastic mode: a few rad/s (the panel is soft), clearly non-zero.
+    assert!(l[6].sqrt() > 1.0, "{}", l[6]);
+    assert_eq!(sys.rigid_modes.len(), 6);
+}
+
 fn sar_panel3(divisions: usize, support: Support) -> PanelModel {
     let mut points = vec![
         [0.797, 0.45],

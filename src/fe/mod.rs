@@ -9,6 +9,7 @@
 //! let model  = PanelModel::new(mesh, Support::CentreClamp)?;   // pattern + scatter map, once
 //! let sys    = model.assemble(&laminate, &design_map, Derivatives::Second)?;
 //! // or in one shot: fe::assemble(&mesh, &laminate, support, &design_map, Derivatives::First)?
+//! model.assemble_into(&new_laminate, &design_map, &mut sys)?;   // reuse buffers in a loop
 //!
 //! sys.k        : SparseColMat<usize, f64>       reduced K_ff (supports applied), n × n,
 //!                                               both triangles stored, symmetric
@@ -39,6 +40,24 @@
 //!   position of every element entry are computed once per model, each
 //!   assembly fills values in a fixed order (bit-for-bit deterministic).
 //! - [`spec`]: the `[[panels]]` study-file section.
+//!
+//! # Measured (tests/fe_*.rs; 2-core x86_64 VM)
+//! - SS square plate, uniform load, 32×32 cells: centre deflection within
+//!   0.24 % of the Kirchhoff series at a/h = 1000 and 0.19 % of the FSDT
+//!   Navier series at a/h = 10 (no shear locking; second-order convergence).
+//! - SS square plate, 24×24 cells: lowest four frequencies within 0.34 % of
+//!   the closed form.
+//! - Assembly of K for SAR panel 3 at 40 divisions (6 636 DOF): ≈ 3 ms; at 64
+//!   divisions (15 984 DOF): ≈ 8–11 ms; each derivative matrix costs about
+//!   as much as K. The cost is dominated by the scatter into the value
+//!   array (memory bound).
+//!
+//! # Limitations
+//! - Flat panels only (the element is a flat facet; no curvature).
+//! - CST membrane: stiff in in-plane bending; irrelevant for the flexural
+//!   modes of symmetric lay-ups, coarse for in-plane dominated ones.
+//! - Lumped mass ignores the first-moment coupling inertia of unsymmetric
+//!   lay-ups.
 
 pub mod assembly;
 pub mod element;
