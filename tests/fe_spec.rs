@@ -77,6 +77,27 @@ fn sar_panel_resolves_with_nodes_at_support_points_and_centre() {
 }
 
 #[test]
+fn panels_from_study_reads_all_and_rejects_duplicate_names() {
+    let study = Study::parse(
+        "two.toml",
+        &format!("{PANEL2}\n{}", PANEL2.replace("panel2", "panel3")),
+    )
+    .unwrap();
+    let panels = plyscape::fe::panels_from_study(&study).unwrap();
+    assert_eq!(panels.len(), 2);
+    assert_eq!(panels[1].name, "panel3");
+    let dup = Study::parse("dup.toml", &format!("{PANEL2}\n{PANEL2}")).unwrap();
+    let e = plyscape::fe::panels_from_study(&dup).unwrap_err();
+    assert_eq!(key_of(&e), "panels[1].name");
+    assert!(e.to_string().starts_with("dup.toml:"), "{e}");
+    let bad = Study::parse("bad.toml", &PANEL2.replace("e1 = 177e9", "e1 = -177e9")).unwrap();
+    let e = plyscape::fe::panels_from_study(&bad).unwrap_err();
+    assert_eq!(key_of(&e), "panels[0].material.e1");
+    let none = Study::parse("none.toml", "[study]\nname = \"x\"\n").unwrap();
+    assert!(plyscape::fe::panels_from_study(&none).unwrap().is_empty());
+}
+
+#[test]
 fn central_patch_clamps_the_patch_nodes() {
     let text = PANEL2.replace(
         "support = \"centre_clamp\"",

@@ -4,7 +4,7 @@
 //! # API (what the modal analysis takes from here)
 //!
 //! ```text
-//! let panel  = PanelSpec { .. }.resolve()?;            // from a study file, or build by hand:
+//! let panels = fe::panels_from_study(&study)?;         // [[panels]] of a study file, or by hand:
 //! let mesh   = Mesh::structured(&MeshParams { length, width, divisions, points })?;
 //! let model  = PanelModel::new(mesh, Support::CentreClamp)?;   // pattern + scatter map, once
 //! let sys    = model.assemble(&laminate, &design_map, Derivatives::Second)?;
@@ -67,4 +67,4 @@ pub mod spec;
 pub use assembly::{assemble, Derivatives, PanelModel, PanelSystem, Support, NODE_DOF};
 pub use element::{section_matrix, Triangle};
 pub use mesh::{Mesh, MeshParams};
-pub use spec::{Panel, PanelSpec};
+pub use spec::{panels_from_study, Panel, PanelSpec};

@@ -164,3 +164,24 @@ impl Panel {
         PanelModel::new(self.mesh.clone(), self.support)
     }
 }
+
+/// Read and resolve every `[[panels]]` entry of a study. Errors name the
+/// file and `panels[i].key`; panel names must be unique. An absent section
+/// gives an empty list.
+pub fn panels_from_study(study: &crate::study::Study) -> Result<Vec<Panel>> {
+    let specs: Vec<PanelSpec> = study.section("panels")?.unwrap_or_default();
+    let mut out: Vec<Panel> = Vec::with_capacity(specs.len());
+    for (i, spec) in specs.iter().enumerate() {
+        let prefix = format!("panels[{i}]");
+        let panel = spec.resolve().map_err(study.locate(&prefix))?;
+        if out.iter().any(|p| p.name == panel.name) {
+            return Err(study.error(
+                format!("{prefix}.name"),
+                format!("\"{}\"", panel.name),
+                "a panel name not used by another panel",
+            ));
+        }
+        out.push(panel);
+    }
+    Ok(out)
+}
