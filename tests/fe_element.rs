@@ -255,45 +255,58 @@ fn drilling_penalty_energy_matches_closed_form() {
 fn element_derivatives_match_central_differences() {
     // Reference: central finite differences of the element stiffness in the
     // ply angles (step 1e-4 rad); second derivative: central differences of
-    // the exact first derivative.
+    // the exact first derivative. Two cases: the paper's symmetric tying
+    // [θ1/θ2/θ2/θ1], and an unsymmetric stack with one variable per ply
+    // (so dB/dθ ≠ 0 is exercised).
     let model = PanelModel::new(distorted_mesh(), Support::FreeFree).unwrap();
-    let lam = laminate(&[20.0, -50.0, -50.0, 20.0], 0.5e-3);
-    let map = DesignMap::symmetric(4);
-    let x0 = [20f64.to_radians(), -50f64.to_radians()];
-    let el = 7;
-    let (t, gd) = model.element(el);
-    let g = model.element_ops(el);
-    let h = lam.thickness();
-    // The compact block product equals the dense GᵀCG (up to rounding).
-    let c0 = section_matrix(&lam.stiffness());
-    let dense = t.section_stiffness_dense(&gd, &c0, h);
-    let fast = t.section_stiffness(g, &c0, h);
-    assert!((dense - fast).amax() <= 1e-13 * dense.amax());
-    let scale = model.element_stiffness(el, &lam).amax();
-    let d1 = |l: &Laminate, v: usize| -> Mat18 {
-        t.section_stiffness(g, &section_matrix(&l.design_derivative(&map, v)), h)
-    };
-    let step = 1e-4;
-    for v in 0..2 {
-        let mut xp = x0;
-        let mut xm = x0;
-        xp[v] += step;
-        xm[v] -= step;
-        let lp = lam.with_design(&map, &xp).unwrap();
-        let lm = lam.with_design(&map, &xm).unwrap();
-        let fd =
-            (model.element_stiffness(el, &lp) - model.element_stiffness(el, &lm)) / (2.0 * step);
-        let err = (d1(&lam, v) - fd).amax() / scale;
-        assert!(err < 1e-7, "dK/dθ{v}: {err:e}");
-        for w in 0..2 {
-            let fd2 = (d1(&lp, w) - d1(&lm, w)) / (2.0 * step);
-            let an = t.section_stiffness(
-                g,
-                &section_matrix(&lam.design_second_derivative(&map, w, v)),
-                h,
-            );
-            let err = (an - fd2).amax() / scale;
-            assert!(err < 1e-7, "d²K/dθ{w}dθ{v}: {err:e}");
+    let cases = [
+        (
+            laminate(&[20.0, -50.0, -50.0, 20.0], 0.5e-3),
+            DesignMap::symmetric(4),
+        ),
+        (
+            laminate(&[10.0, 75.0, -40.0], 0.5e-3),
+            DesignMap::per_ply(3),
+        ),
+    ];
+    for (lam, map) in &cases {
+        let x0: Vec<f64> = map.groups().iter().map(|g| lam.angles()[g[0]]).collect();
+        for el in [0, 7, 33] {
+            let (t, gd) = model.element(el);
+            let g = model.element_ops(el);
+            let h = lam.thickness();
+            // The compact block product equals the dense GᵀCG (up to rounding).
+            let c0 = section_matrix(&lam.stiffness());
+            let dense = t.section_stiffness_dense(&gd, &c0, h);
+            let fast = t.section_stiffness(g, &c0, h);
+            assert!((dense - fast).amax() <= 1e-13 * dense.amax());
+            let scale = model.element_stiffness(el, lam).amax();
+            let d1 = |l: &Laminate, v: usize| -> Mat18 {
+                t.section_stiffness(g, &section_matrix(&l.design_derivative(map, v)), h)
+            };
+            let step = 1e-4;
+            for v in 0..map.len() {
+                let mut xp = x0.clone();
+                let mut xm = x0.clone();
+                xp[v] += step;
+                xm[v] -= step;
+                let lp = lam.with_design(map, &xp).unwrap();
+                let lm = lam.with_design(map, &xm).unwrap();
+                let fd = (model.element_stiffness(el, &lp) - model.element_stiffness(el, &lm))
+                    / (2.0 * step);
+                let err = (d1(lam, v) - fd).amax() / scale;
+                assert!(err < 1e-7, "element {el} dK/dθ{v}: {err:e}");
+                for w in 0..map.len() {
+                    let fd2 = (d1(&lp, w) - d1(&lm, w)) / (2.0 * step);
+                    let an = t.section_stiffness(
+                        g,
+                        &section_matrix(&lam.design_second_derivative(map, w, v)),
+                        h,
+                    );
+                    let err = (an - fd2).amax() / scale;
+                    assert!(err < 1e-7, "element {el} d²K/dθ{w}dθ{v}: {err:e}");
+                }
+            }
         }
     }
 }
