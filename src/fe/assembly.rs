@@ -16,8 +16,8 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 /// DOF per node: u, v, w, θx, θy, θz.
 pub const NODE_DOF: usize = 6;
 const NONE: usize = usize::MAX;
-/// Marker of a constrained entry in the scatter map.
-const SKIP: u32 = u32::MAX;
+/// Positions in the scatter map are u32 (half the memory traffic of usize).
+const MAX_STORED: usize = u32::MAX as usize;
 
 /// Reference (boundary) condition of a panel for its modes (paper §6.2).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -205,10 +205,15 @@ pub struct PanelModel {
     free: Vec<usize>,
     dof_map: Vec<(usize, usize)>,
     symbolic: SymbolicSparseColMat<usize>,
-    /// Position in the value array of every element entry (324 per
-    /// element), `SKIP` where a DOF is constrained. u32 halves the memory
-    /// traffic of assembly.
+    /// For each element, the stored entries it contributes to: position in
+    /// the value array (sorted, for locality) ...
     scatter: Vec<u32>,
+    /// ... and the index of the contribution in the column-major 18×18
+    /// element matrix (always a lower-triangle entry, so K is exactly
+    /// symmetric although GᵀCG is symmetric only up to rounding).
+    local: Vec<u16>,
+    /// Element e's entries are `offsets[e]..offsets[e + 1]`.
+    offsets: Vec<usize>,
 }
 
 impl PanelModel {
@@ -261,7 +266,7 @@ impl PanelModel {
             col_ptr[j + 1] += col_ptr[j];
         }
         let row_idx: Vec<usize> = pairs.iter().map(|&(_, r)| r).collect();
-        if row_idx.len() >= SKIP as usize {
+        if row_idx.len() >= MAX_STORED {
             return Err(Error::numerical(
                 "fe::PanelModel::new",
                 format!(
@@ -270,22 +275,32 @@ impl PanelModel {
                 ),
             ));
         }
-        let mut scatter = Vec::with_capacity(mesh.triangles.len() * 324);
+        let mut scatter = Vec::with_capacity(mesh.triangles.len() * 270);
+        let mut local = Vec::with_capacity(mesh.triangles.len() * 270);
+        let mut offsets = Vec::with_capacity(mesh.triangles.len() + 1);
+        offsets.push(0);
+        let mut entries: Vec<(u32, u16)> = Vec::with_capacity(324);
         for t in &mesh.triangles {
             let d = edofs(t);
+            entries.clear();
             for (a, &c) in d.iter().enumerate() {
                 for (b, &r) in d.iter().enumerate() {
-                    scatter.push(if c == NONE || r == NONE || structural_zero(a, b) {
-                        SKIP
-                    } else {
-                        let col = &row_idx[col_ptr[c]..col_ptr[c + 1]];
-                        let k = col
-                            .binary_search(&r)
-                            .expect("pattern contains every element pair");
-                        (col_ptr[c] + k) as u32
-                    });
+                    if c == NONE || r == NONE || structural_zero(a, b) {
+                        continue;
+                    }
+                    let col = &row_idx[col_ptr[c]..col_ptr[c + 1]];
+                    let k = col
+                        .binary_search(&r)
+                        .expect("pattern contains every element pair");
+                    // lower-triangle entry (max(a,b), min(a,b)), column-major
+                    let l = 18 * a.min(b) + a.max(b);
+                    entries.push(((col_ptr[c] + k) as u32, l as u16));
                 }
             }
+            entries.sort_unstable();
+            scatter.extend(entries.iter().map(|e| e.0));
+            local.extend(entries.iter().map(|e| e.1));
+            offsets.push(scatter.len());
         }
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         Ok(PanelModel {
@@ -297,6 +312,8 @@ impl PanelModel {
             dof_map,
             symbolic,
             scatter,
+            local,
+            offsets,
         })
     }
 
@@ -355,15 +372,10 @@ impl PanelModel {
         let mut ke = Mat18::zeros();
         for (e, (t, g)) in self.tris.iter().zip(&self.ops).enumerate() {
             elem(t, g, &mut ke);
-            let map = &self.scatter[324 * e..324 * (e + 1)];
-            // map index a·18 + b holds entry (row d[b], column d[a]). Only
-            // the lower triangle of K_e is read, so K is exactly symmetric
-            // (GᵀCG is symmetric only up to rounding).
-            for (i, &p) in map.iter().enumerate() {
-                if p != SKIP {
-                    let (a, b) = (i / 18, i % 18);
-                    val[p as usize] += ke[(a.max(b), a.min(b))];
-                }
+            let ks = ke.as_slice();
+            let range = self.offsets[e]..self.offsets[e + 1];
+            for (&p, &l) in self.scatter[range.clone()].iter().zip(&self.local[range]) {
+                val[p as usize] += ks[l as usize];
             }
         }
         if let Some(i) = val.iter().position(|v| !v.is_finite()) {
