@@ -360,29 +360,40 @@ impl PanelModel {
         k
     }
 
-    /// Scatter element matrices into `val` (zeroed first). `elem` writes
-    /// the element matrix into the buffer it is given.
-    fn fill(
-        &self,
-        val: &mut [f64],
-        what: &str,
-        mut elem: impl FnMut(&Triangle, &CompactOps, &mut Mat18),
-    ) -> Result<()> {
-        val.fill(0.0);
+    /// One pass over the elements filling every requested matrix:
+    /// `vals[0]` gets K (section matrix `cs[0]` plus drilling with penalty
+    /// `gamma`), `vals[m]` for m ≥ 1 gets the section term with `cs[m]`
+    /// (the derivatives; no drilling). Each element's entry list is read
+    /// once for all matrices. Values are zeroed first.
+    fn fill_all(&self, vals: &mut [&mut [f64]], cs: &[Mat8], h: f64, gamma: f64) -> Result<()> {
+        for v in vals.iter_mut() {
+            v.fill(0.0);
+        }
         let mut ke = Mat18::zeros();
         for (e, (t, g)) in self.tris.iter().zip(&self.ops).enumerate() {
-            elem(t, g, &mut ke);
-            let ks = ke.as_slice();
             let range = self.offsets[e]..self.offsets[e + 1];
-            for (&p, &l) in self.scatter[range.clone()].iter().zip(&self.local[range]) {
-                val[p as usize] += ks[l as usize];
+            let (pos, loc) = (&self.scatter[range.clone()], &self.local[range]);
+            for (m, (val, c)) in vals.iter_mut().zip(cs).enumerate() {
+                t.section_stiffness_into(g, c, h, &mut ke);
+                if m == 0 {
+                    t.add_drilling(gamma, &mut ke);
+                }
+                let ks = ke.as_slice();
+                for (&p, &l) in pos.iter().zip(loc) {
+                    val[p as usize] += ks[l as usize];
+                }
             }
         }
-        if let Some(i) = val.iter().position(|v| !v.is_finite()) {
-            return Err(Error::numerical(
-                "fe::PanelModel::assemble",
-                format!("non-finite {what} entry {i}: {}", val[i]),
-            ));
+        for (m, val) in vals.iter().enumerate() {
+            if let Some(i) = val.iter().position(|v| !v.is_finite()) {
+                return Err(Error::numerical(
+                    "fe::PanelModel::assemble",
+                    format!(
+                        "non-finite entry {i} of matrix {m} (0 = K, then dK, d2K): {}",
+                        val[i]
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -456,24 +467,17 @@ impl PanelModel {
             ));
         }
         let h = lam.thickness();
-        let c = section_matrix(&lam.stiffness());
         let gamma = DRILLING_PENALTY * lam.membrane_mean();
-        self.fill(sys.k.val_mut(), "K", |t, g, ke| {
-            t.section_stiffness_into(g, &c, h, ke);
-            t.add_drilling(gamma, ke);
-        })?;
-        for (v, m) in sys.dk.iter_mut().enumerate() {
-            let dc: Mat8 = section_matrix(&lam.design_derivative(design, v));
-            self.fill(m.val_mut(), "dK", |t, g, ke| {
-                t.section_stiffness_into(g, &dc, h, ke)
-            })?;
-        }
-        for (v, m) in sys.d2k.iter_mut().enumerate() {
-            let dc: Mat8 = section_matrix(&lam.design_second_derivative(design, v, v));
-            self.fill(m.val_mut(), "d2K", |t, g, ke| {
-                t.section_stiffness_into(g, &dc, h, ke)
-            })?;
-        }
+        let mut cs = vec![section_matrix(&lam.stiffness())];
+        cs.extend((0..sys.dk.len()).map(|v| section_matrix(&lam.design_derivative(design, v))));
+        cs.extend(
+            (0..sys.d2k.len()).map(|v| section_matrix(&lam.design_second_derivative(design, v, v))),
+        );
+        let mut vals: Vec<&mut [f64]> = std::iter::once(sys.k.val_mut())
+            .chain(sys.dk.iter_mut().map(|m| m.val_mut()))
+            .chain(sys.d2k.iter_mut().map(|m| m.val_mut()))
+            .collect();
+        self.fill_all(&mut vals, &cs, h, gamma)?;
         let (mu, ir) = (lam.mass_per_area(), lam.rotary_inertia_per_area());
         sys.m_diag.fill(0.0);
         for (t, tri) in self.mesh.triangles.iter().zip(&self.tris) {
