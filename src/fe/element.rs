@@ -26,10 +26,11 @@
 //! of DSG3 on coarse meshes of very thin plates and tends to 1 as ℓ → 0, so
 //! the FSDT solution is recovered at convergence.
 //!
-//! Why not MITC3: on the panel's span-to-thickness ratio of ~1000 MITC3
-//! still locks noticeably on coarse unstructured meshes, and MITC3+ needs a
-//! cubic bubble for the rotations (extra internal DOF to condense). DSG3
-//! plus stabilisation is a constant-B element: all its operators are
+//! Why not MITC3: Lee & Bathe (2004) and Lee, Lee & Bathe (2014, the MITC3+
+//! paper) report that MITC3 is still noticeably stiff for thin plates on
+//! coarse and distorted meshes, and MITC3+ needs a cubic bubble for the
+//! rotations (internal DOF to condense). DSG3 plus stabilisation is a
+//! constant-B element: all its operators are
 //! constant, so K = A·GᵀCG exactly with one evaluation, and the ply-angle
 //! derivative (paper Eq. 20) is the same product with C' (no quadrature).
 //!
