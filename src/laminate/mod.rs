@@ -1,1 +1,557 @@
-//! (module under construction; see lib.rs)
+//! Laminate mechanics: orthotropic plies, ABD and transverse shear stiffness,
+//! and their exact first and second derivatives with respect to ply angles
+//! (paper §3.2, Eqs. 20–22).
+//!
+//! # Method
+//! A ply's reduced plane-stress stiffness `Q` (material axes 1 = fibre,
+//! 2 = transverse) is rotated to the laminate axes by the ply angle θ
+//! (counter-clockwise from x to the fibre). The rotated stiffness is written
+//! with the Tsai–Pagano invariants U1..U5,
+//!
+//! ```text
+//! Q̄11 = U1 + U2 cos2θ + U3 cos4θ      Q̄16 = U2/2 sin2θ + U3 sin4θ
+//! Q̄22 = U1 − U2 cos2θ + U3 cos4θ      Q̄26 = U2/2 sin2θ − U3 sin4θ
+//! Q̄12 = U4 − U3 cos4θ                 Q̄66 = U5 − U3 cos4θ
+//! ```
+//!
+//! so that its first and second θ-derivatives are closed forms (the content
+//! of the paper's Eq. 22, `∂Q̄/∂θ = ∂(T⁻¹ Q T⁻ᵀ)/∂θ`). Transverse shear
+//! (order γxz, γyz) rotates as a second-order tensor:
+//! `C̄ = [[G13 c² + G23 s², (G13−G23) c s], [.., G13 s² + G23 c²]]`.
+//!
+//! Through the thickness (plies listed bottom to top, z from −h/2):
+//! `A = Σ Q̄ₖ (zₖ − zₖ₋₁)`, `B = ½ Σ Q̄ₖ (zₖ² − zₖ₋₁²)`,
+//! `D = ⅓ Σ Q̄ₖ (zₖ³ − zₖ₋₁³)`, `S = κ Σ C̄ₖ (zₖ − zₖ₋₁)` with the shear
+//! correction factor κ = 5/6 ([`SHEAR_CORRECTION`], Reissner's value for a
+//! homogeneous section; first-order shear deformation theory has no better
+//! universal choice, and for the thin panels of the paper (a/h ≈ 1000) the
+//! shear energy is negligible anyway).
+//!
+//! Each ply's stiffness depends on its own angle only, so
+//! `∂X/∂θₖ = Q̄ₖ'·(z-moment of ply k)` and mixed second derivatives between
+//! different plies vanish. A design variable ([`DesignMap`]) ties a group of
+//! plies (the paper's [θ1/θ2/θ2/θ1] ties plies 1 & 4 and 2 & 3); its
+//! derivative is the sum over the group.
+//!
+//! [`ply_stiffness_generic`] and [`stiffness_generic`] are a twin of the same
+//! mechanics written generic over the scalar with the explicit `c⁴, s²c², …`
+//! transformation polynomials (an independent route); tests drive them with
+//! hyper-dual numbers to check the closed-form derivatives.
+//!
+//! Units: SI throughout (Pa, m, kg/m³, rad). A, S in N/m; B in N; D in N·m.
+
+use crate::error::{require_positive, Error, Result};
+use nalgebra::{Matrix2, Matrix3};
+use num_dual::DualNum;
+
+/// Shear correction factor κ applied to the transverse shear stiffness.
+pub const SHEAR_CORRECTION: f64 = 5.0 / 6.0;
+
+/// An orthotropic ply material (SI units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Orthotropic {
+    /// Fibre-direction Young's modulus E1 \[Pa\].
+    pub e1: f64,
+    /// Transverse Young's modulus E2 \[Pa\].
+    pub e2: f64,
+    /// In-plane shear modulus G12 \[Pa\].
+    pub g12: f64,
+    /// Transverse shear modulus G13 \[Pa\].
+    pub g13: f64,
+    /// Transverse shear modulus G23 \[Pa\].
+    pub g23: f64,
+    /// Major Poisson's ratio ν12 \[-\].
+    pub nu12: f64,
+    /// Density ρ \[kg/m³\].
+    pub rho: f64,
+}
+
+impl Orthotropic {
+    /// Validate: moduli and density finite and > 0; ν12 finite with
+    /// ν12² < E1/E2 (the plane-stress stiffness is positive definite only
+    /// then, since ν12·ν21 = ν12²·E2/E1 must be < 1).
+    pub fn validate(&self) -> Result<()> {
+        require_positive("e1", self.e1)?;
+        require_positive("e2", self.e2)?;
+        require_positive("g12", self.g12)?;
+        require_positive("g13", self.g13)?;
+        require_positive("g23", self.g23)?;
+        require_positive("rho", self.rho)?;
+        if !self.nu12.is_finite() || self.nu12 * self.nu12 >= self.e1 / self.e2 {
+            return Err(Error::input(
+                "nu12",
+                self.nu12,
+                format!(
+                    "a finite value with nu12² < e1/e2 = {:.6e} (positive definite ply)",
+                    self.e1 / self.e2
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Reduced plane-stress stiffness in material axes: (Q11, Q22, Q12, Q66)
+    /// with `Q11 = E1/(1−ν12ν21)`, `Q22 = E2/(1−ν12ν21)`,
+    /// `Q12 = ν12 E2/(1−ν12ν21)`, `Q66 = G12`, `ν21 = ν12 E2/E1`.
+    pub fn reduced(&self) -> [f64; 4] {
+        let nu21 = self.nu12 * self.e2 / self.e1;
+        let den = 1.0 - self.nu12 * nu21;
+        [
+            self.e1 / den,
+            self.e2 / den,
+            self.nu12 * self.e2 / den,
+            self.g12,
+        ]
+    }
+
+    /// Tsai–Pagano invariants [U1, U2, U3, U4, U5] \[Pa\].
+    pub fn invariants(&self) -> [f64; 5] {
+        let [q11, q22, q12, q66] = self.reduced();
+        [
+            (3.0 * q11 + 3.0 * q22 + 2.0 * q12 + 4.0 * q66) / 8.0,
+            (q11 - q22) / 2.0,
+            (q11 + q22 - 2.0 * q12 - 4.0 * q66) / 8.0,
+            (q11 + q22 + 6.0 * q12 - 4.0 * q66) / 8.0,
+            (q11 + q22 - 2.0 * q12 + 4.0 * q66) / 8.0,
+        ]
+    }
+}
+
+/// One ply: material, thickness \[m\] and angle \[rad\].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ply {
+    pub material: Orthotropic,
+    /// Thickness \[m\].
+    pub thickness: f64,
+    /// Angle from the laminate x axis to the fibre, counter-clockwise \[rad\].
+    pub angle: f64,
+}
+
+/// Rotated ply stiffness and its θ-derivatives of order 0, 1 or 2:
+/// in-plane Q̄ (3×3, Voigt order xx, yy, xy with engineering shear) and
+/// transverse shear C̄ (2×2, order γxz, γyz), unscaled by κ.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlyStiffness {
+    pub q: Matrix3<f64>,
+    pub g: Matrix2<f64>,
+}
+
+impl Ply {
+    /// `order`-th derivative (0, 1 or 2) of the rotated stiffness with
+    /// respect to the ply angle, from the invariant form (module doc).
+    pub fn stiffness_derivative(&self, order: u8) -> PlyStiffness {
+        let [u1, u2, u3, u4, u5] = self.material.invariants();
+        let t = self.angle;
+        let (s2, c2) = (2.0 * t).sin_cos();
+        let (s4, c4) = (4.0 * t).sin_cos();
+        let (s1, c1) = t.sin_cos();
+        let (g13, g23) = (self.material.g13, self.material.g23);
+        // f(θ) and its derivatives: cos2θ, sin2θ, cos4θ, sin4θ, c², s², cs.
+        // d/dθ cos2θ = −2 sin2θ etc.; c² = (1+cos2θ)/2, s² = (1−cos2θ)/2,
+        // cs = sin2θ/2.
+        let (cc2, ss2, cc4, ss4, u0) = match order {
+            0 => (c2, s2, c4, s4, 1.0),
+            1 => (-2.0 * s2, 2.0 * c2, -4.0 * s4, 4.0 * c4, 0.0),
+            _ => (-4.0 * c2, -4.0 * s2, -16.0 * c4, -16.0 * s4, 0.0),
+        };
+        let q11 = u0 * u1 + u2 * cc2 + u3 * cc4;
+        let q22 = u0 * u1 - u2 * cc2 + u3 * cc4;
+        let q12 = u0 * u4 - u3 * cc4;
+        let q66 = u0 * u5 - u3 * cc4;
+        let q16 = 0.5 * u2 * ss2 + u3 * ss4;
+        let q26 = 0.5 * u2 * ss2 - u3 * ss4;
+        let q = Matrix3::new(q11, q12, q16, q12, q22, q26, q16, q26, q66);
+        let (cc, ss, cs) = if order == 0 {
+            (c1 * c1, s1 * s1, c1 * s1)
+        } else {
+            (0.5 * cc2, -0.5 * cc2, 0.5 * ss2)
+        };
+        let g = Matrix2::new(
+            g13 * cc + g23 * ss,
+            (g13 - g23) * cs,
+            (g13 - g23) * cs,
+            g13 * ss + g23 * cc,
+        );
+        PlyStiffness { q, g }
+    }
+}
+
+/// Laminate stiffness: membrane A, coupling B, bending D, transverse shear S
+/// (S includes κ). Generalized stress–strain law
+/// `[N; M] = [[A, B], [B, D]] [ε; κ]`, `Q = S γ`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Stiffness {
+    /// Membrane stiffness A \[N/m\].
+    pub a: Matrix3<f64>,
+    /// Membrane–bending coupling B \[N\].
+    pub b: Matrix3<f64>,
+    /// Bending stiffness D \[N·m\].
+    pub d: Matrix3<f64>,
+    /// Transverse shear stiffness S = κ Σ C̄ₖ tₖ \[N/m\], order (γxz, γyz).
+    pub s: Matrix2<f64>,
+}
+
+impl Stiffness {
+    fn add_ply(&mut self, p: &PlyStiffness, z0: f64, z1: f64) {
+        self.a += p.q * (z1 - z0);
+        self.b += p.q * (0.5 * (z1 * z1 - z0 * z0));
+        self.d += p.q * ((z1 * z1 * z1 - z0 * z0 * z0) / 3.0);
+        self.s += p.g * (SHEAR_CORRECTION * (z1 - z0));
+    }
+}
+
+/// A stack of plies, listed bottom (z = −h/2) to top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Laminate {
+    plies: Vec<Ply>,
+}
+
+impl Laminate {
+    /// Build and validate: at least one ply, every material valid, every
+    /// thickness finite and > 0, every angle finite. Keys of errors are
+    /// `plies[k].…` (0-based).
+    pub fn new(plies: Vec<Ply>) -> Result<Laminate> {
+        if plies.is_empty() {
+            return Err(Error::input("plies", "[]", "at least one ply"));
+        }
+        for (k, p) in plies.iter().enumerate() {
+            let at = |e: Error| e.in_file("", &format!("plies[{k}]"));
+            p.material
+                .validate()
+                .map_err(|e| e.in_file("", &format!("plies[{k}].material")))?;
+            require_positive("thickness", p.thickness).map_err(at)?;
+            crate::error::require_finite("angle", p.angle).map_err(at)?;
+        }
+        Ok(Laminate { plies })
+    }
+
+    /// The plies, bottom to top.
+    pub fn plies(&self) -> &[Ply] {
+        &self.plies
+    }
+
+    /// Total thickness h \[m\].
+    pub fn thickness(&self) -> f64 {
+        self.plies.iter().map(|p| p.thickness).sum()
+    }
+
+    /// Mass per unit area `Σ ρₖ tₖ` \[kg/m²\].
+    pub fn mass_per_area(&self) -> f64 {
+        self.plies
+            .iter()
+            .map(|p| p.material.rho * p.thickness)
+            .sum()
+    }
+
+    /// Rotary inertia per unit area about the mid-surface `Σ ρₖ ∫ z² dz`
+    /// \[kg\].
+    pub fn rotary_inertia_per_area(&self) -> f64 {
+        let mut z0 = -0.5 * self.thickness();
+        let mut r = 0.0;
+        for p in &self.plies {
+            let z1 = z0 + p.thickness;
+            r += p.material.rho * (z1 * z1 * z1 - z0 * z0 * z0) / 3.0;
+            z0 = z1;
+        }
+        r
+    }
+
+    /// Angle-independent mean membrane stiffness
+    /// `Ā = (A11 + A22 + 2A66)/4 = Σ tₖ (U1 + U5)ₖ / 2` \[N/m\] (the sum
+    /// `Q̄11 + Q̄22 + 2Q̄66 = 2(U1 + U5)` is a rotation invariant). Used to
+    /// scale the shell's drilling penalty so that it does not depend on the
+    /// design.
+    pub fn membrane_mean(&self) -> f64 {
+        self.plies
+            .iter()
+            .map(|p| {
+                let u = p.material.invariants();
+                p.thickness * (u[0] + u[4]) / 2.0
+            })
+            .sum()
+    }
+
+    /// Ply angles \[rad\].
+    pub fn angles(&self) -> Vec<f64> {
+        self.plies.iter().map(|p| p.angle).collect()
+    }
+
+    /// The same stack with new angles (one per ply, \[rad\]).
+    pub fn with_angles(&self, angles: &[f64]) -> Result<Laminate> {
+        if angles.len() != self.plies.len() {
+            return Err(Error::input(
+                "angles",
+                angles.len(),
+                format!("one angle per ply ({})", self.plies.len()),
+            ));
+        }
+        let mut plies = self.plies.clone();
+        for (k, (p, &a)) in plies.iter_mut().zip(angles).enumerate() {
+            crate::error::require_finite(&format!("angles[{k}]"), a)?;
+            p.angle = a;
+        }
+        Ok(Laminate { plies })
+    }
+
+    /// Ply interface coordinates z₀ = −h/2 < z₁ < … < z_n = h/2.
+    fn interfaces(&self) -> Vec<f64> {
+        let mut z = Vec::with_capacity(self.plies.len() + 1);
+        let mut acc = -0.5 * self.thickness();
+        z.push(acc);
+        for p in &self.plies {
+            acc += p.thickness;
+            z.push(acc);
+        }
+        z
+    }
+
+    /// A, B, D, S (module doc).
+    pub fn stiffness(&self) -> Stiffness {
+        let z = self.interfaces();
+        let mut st = Stiffness::default();
+        for (k, p) in self.plies.iter().enumerate() {
+            st.add_ply(&p.stiffness_derivative(0), z[k], z[k + 1]);
+        }
+        st
+    }
+
+    /// `order`-th derivative (1 or 2) of A, B, D, S with respect to the
+    /// angle of ply `k` alone (paper Eq. 21 with Eq. 22). Order 0 gives ply
+    /// k's contribution.
+    pub fn ply_derivative(&self, k: usize, order: u8) -> Stiffness {
+        let z = self.interfaces();
+        let mut st = Stiffness::default();
+        if let Some(p) = self.plies.get(k) {
+            st.add_ply(&p.stiffness_derivative(order), z[k], z[k + 1]);
+        }
+        st
+    }
+
+    /// First derivative of A, B, D, S with respect to design variable `v`
+    /// of `map` (sum over its plies).
+    pub fn design_derivative(&self, map: &DesignMap, v: usize) -> Stiffness {
+        self.group_derivative(&map.groups[v], 1)
+    }
+
+    /// Second derivative ∂²/∂θ_v∂θ_w. Zero unless v == w (groups are
+    /// disjoint and each ply depends on its own angle only); then the sum of
+    /// the group's plies' second derivatives.
+    pub fn design_second_derivative(&self, map: &DesignMap, v: usize, w: usize) -> Stiffness {
+        if v != w {
+            return Stiffness::default();
+        }
+        self.group_derivative(&map.groups[v], 2)
+    }
+
+    fn group_derivative(&self, group: &[usize], order: u8) -> Stiffness {
+        let z = self.interfaces();
+        let mut st = Stiffness::default();
+        for &k in group {
+            st.add_ply(&self.plies[k].stiffness_derivative(order), z[k], z[k + 1]);
+        }
+        st
+    }
+
+    /// Apply design-variable values (radians) through `map`: each variable
+    /// sets the angle of every ply in its group; other plies keep theirs.
+    pub fn with_design(&self, map: &DesignMap, values: &[f64]) -> Result<Laminate> {
+        if values.len() != map.len() {
+            return Err(Error::input(
+                "design",
+                values.len(),
+                format!("one value per design variable ({})", map.len()),
+            ));
+        }
+        let mut angles = self.angles();
+        for (g, &v) in map.groups.iter().zip(values) {
+            for &k in g {
+                angles[k] = v;
+            }
+        }
+        self.with_angles(&angles)
+    }
+}
+
+/// Design variables: variable v sets the angle of every ply in `groups[v]`
+/// (0-based ply indices). Groups are non-empty and disjoint.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DesignMap {
+    groups: Vec<Vec<usize>>,
+}
+
+impl DesignMap {
+    /// Validate against a laminate of `n_plies` plies.
+    pub fn new(groups: Vec<Vec<usize>>, n_plies: usize) -> Result<DesignMap> {
+        let mut seen = vec![false; n_plies];
+        for (v, g) in groups.iter().enumerate() {
+            if g.is_empty() {
+                return Err(Error::input(
+                    format!("design[{v}]"),
+                    "[]",
+                    "a non-empty list of plies",
+                ));
+            }
+            for &k in g {
+                if k >= n_plies || seen[k] {
+                    return Err(Error::input(
+                        format!("design[{v}]"),
+                        k + 1,
+                        format!("a ply number in 1..={n_plies} used by one variable only"),
+                    ));
+                }
+                seen[k] = true;
+            }
+        }
+        Ok(DesignMap { groups })
+    }
+
+    /// One variable per ply.
+    pub fn per_ply(n_plies: usize) -> DesignMap {
+        DesignMap {
+            groups: (0..n_plies).map(|k| vec![k]).collect(),
+        }
+    }
+
+    /// Symmetric tying: ply k and ply n−1−k share a variable
+    /// (the paper's [θ1/θ2/θ2/θ1] for n = 4).
+    pub fn symmetric(n_plies: usize) -> DesignMap {
+        DesignMap {
+            groups: (0..n_plies.div_ceil(2))
+                .map(|k| {
+                    let j = n_plies - 1 - k;
+                    if j == k {
+                        vec![k]
+                    } else {
+                        vec![k, j]
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    /// Number of design variables.
+    pub fn len(&self) -> usize {
+        self.groups.len()
+    }
+
+    /// No design variables?
+    pub fn is_empty(&self) -> bool {
+        self.groups.is_empty()
+    }
+
+    /// The ply groups (0-based).
+    pub fn groups(&self) -> &[Vec<usize>] {
+        &self.groups
+    }
+}
+
+/// Rotated ply stiffness, generic over the scalar (twin of
+/// [`Ply::stiffness_derivative`] by the explicit transformation
+/// polynomials). Returns (Q̄ as rows, C̄ as rows).
+pub fn ply_stiffness_generic<T: DualNum<Primitive = f64> + Copy>(
+    m: &Orthotropic,
+    theta: T,
+) -> ([[T; 3]; 3], [[T; 2]; 2]) {
+    let [q11, q22, q12, q66] = m.reduced();
+    let (s, c) = theta.sin_cos();
+    let (c2, s2) = (c * c, s * s);
+    let (c4, s4, s2c2) = (c2 * c2, s2 * s2, s2 * c2);
+    let b11 = c4 * q11 + s2c2 * (2.0 * (q12 + 2.0 * q66)) + s4 * q22;
+    let b22 = s4 * q11 + s2c2 * (2.0 * (q12 + 2.0 * q66)) + c4 * q22;
+    let b12 = s2c2 * (q11 + q22 - 4.0 * q66) + (s4 + c4) * q12;
+    let b66 = s2c2 * (q11 + q22 - 2.0 * q12 - 2.0 * q66) + (s4 + c4) * q66;
+    let b16 = s * c2 * c * (q11 - q12 - 2.0 * q66) + s2 * s * c * (q12 - q22 + 2.0 * q66);
+    let b26 = s2 * s * c * (q11 - q12 - 2.0 * q66) + s * c2 * c * (q12 - q22 + 2.0 * q66);
+    let g11 = c2 * m.g13 + s2 * m.g23;
+    let g22 = s2 * m.g13 + c2 * m.g23;
+    let g12 = s * c * (m.g13 - m.g23);
+    (
+        [[b11, b12, b16], [b12, b22, b26], [b16, b26, b66]],
+        [[g11, g12], [g12, g22]],
+    )
+}
+
+/// Generic laminate stiffness (A, B, D, S as row arrays) for plies of the
+/// given materials and thicknesses at angles `angles` (same order).
+pub type GenericAbd<T> = ([[T; 3]; 3], [[T; 3]; 3], [[T; 3]; 3], [[T; 2]; 2]);
+
+/// A, B, D, S generic over the scalar (twin of [`Laminate::stiffness`]).
+pub fn stiffness_generic<T: DualNum<Primitive = f64> + Copy>(
+    lam: &Laminate,
+    angles: &[T],
+) -> GenericAbd<T> {
+    let zero = T::from(0.0);
+    let mut a = [[zero; 3]; 3];
+    let mut b = [[zero; 3]; 3];
+    let mut d = [[zero; 3]; 3];
+    let mut s = [[zero; 2]; 2];
+    let z = lam.interfaces();
+    for (k, p) in lam.plies.iter().enumerate() {
+        let (q, g) = ply_stiffness_generic(&p.material, angles[k]);
+        let (z0, z1) = (z[k], z[k + 1]);
+        let (m1, m2, m3) = (
+            z1 - z0,
+            0.5 * (z1 * z1 - z0 * z0),
+            (z1 * z1 * z1 - z0 * z0 * z0) / 3.0,
+        );
+        for i in 0..3 {
+            for j in 0..3 {
+                a[i][j] += q[i][j] * m1;
+                b[i][j] += q[i][j] * m2;
+                d[i][j] += q[i][j] * m3;
+            }
+        }
+        for i in 0..2 {
+            for j in 0..2 {
+                s[i][j] += g[i][j] * (SHEAR_CORRECTION * m1);
+            }
+        }
+    }
+    (a, b, d, s)
+}
+
+pub mod spec;
+pub use spec::{MaterialSpec, PlySpec};
+
+#[cfg(test)]
+#[allow(clippy::needless_range_loop)]
+mod tests {
+    use super::*;
+
+    fn im6() -> Orthotropic {
+        Orthotropic {
+            e1: 177e9,
+            e2: 10.8e9,
+            g12: 7.6e9,
+            g13: 7.6e9,
+            g23: 8.504e9,
+            nu12: 0.27,
+            rho: 1600.0,
+        }
+    }
+
+    #[test]
+    fn invariant_and_polynomial_forms_agree() {
+        // Two independent routes to Q̄(θ) (module doc): must agree to rounding.
+        let m = im6();
+        for &t in &[0.0, 0.3, 1.1, -2.0, 3.0] {
+            let p = Ply {
+                material: m,
+                thickness: 1e-3,
+                angle: t,
+            };
+            let a = p.stiffness_derivative(0);
+            let (q, g) = ply_stiffness_generic(&m, t);
+            for i in 0..3 {
+                for j in 0..3 {
+                    assert!((a.q[(i, j)] - q[i][j]).abs() < 1e-12 * m.e1, "{i}{j}");
+                }
+            }
+            for i in 0..2 {
+                for j in 0..2 {
+                    assert!((a.g[(i, j)] - g[i][j]).abs() < 1e-12 * m.g23);
+                }
+            }
+        }
+    }
+}
