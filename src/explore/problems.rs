@@ -33,6 +33,9 @@ pub struct ProblemSpec {
     /// CPU time burnt per evaluation \[ms\] (default 0).
     #[serde(default)]
     pub cost_ms: f64,
+    /// Replacement box `[[lower, upper], ...]`, one pair per variable
+    /// (non-periodic variables only; periodic ones must repeat their box).
+    pub bounds: Option<Vec<[f64; 2]>>,
 }
 
 /// Names accepted by [`ProblemSpec::build`].
@@ -75,6 +78,10 @@ impl ProblemSpec {
                 ))
             }
         };
+        let inner = match &self.bounds {
+            None => inner,
+            Some(b) => Box::new(Rebounded::new(inner, b)?),
+        };
         if self.cost_ms > 0.0 {
             Ok(Box::new(Costly {
                 inner,
@@ -83,6 +90,73 @@ impl ProblemSpec {
         } else {
             Ok(inner)
         }
+    }
+}
+
+/// A problem with a user-given box (`[problem] bounds`).
+pub struct Rebounded {
+    inner: Box<dyn Problem>,
+    vars: Vec<Variable>,
+}
+
+impl Rebounded {
+    /// Replace the box of `inner`; errors name `bounds[i]`.
+    pub fn new(inner: Box<dyn Problem>, bounds: &[[f64; 2]]) -> Result<Self> {
+        let old = inner.variables();
+        if bounds.len() != old.len() {
+            return Err(Error::input(
+                "bounds",
+                format!("(array of {})", bounds.len()),
+                format!("{} pairs [lower, upper]", old.len()),
+            ));
+        }
+        let mut vars = Vec::with_capacity(old.len());
+        for (i, (v, &[lo, hi])) in old.iter().zip(bounds).enumerate() {
+            let key = format!("bounds[{i}]");
+            if v.period.is_some() {
+                if lo != v.lower || hi != v.upper {
+                    return Err(Error::input(
+                        key,
+                        format!("[{lo}, {hi}]"),
+                        format!("[{}, {}]: {} is periodic", v.lower, v.upper, v.name),
+                    ));
+                }
+                vars.push(v.clone());
+            } else {
+                vars.push(
+                    Variable::bounded(v.name.clone(), lo, hi).map_err(|e| match e {
+                        Error::Input {
+                            file,
+                            value,
+                            expected,
+                            ..
+                        } => Error::Input {
+                            file,
+                            key: key.clone(),
+                            value,
+                            expected,
+                        },
+                        e => e,
+                    })?,
+                );
+            }
+        }
+        Ok(Rebounded { inner, vars })
+    }
+}
+
+impl Problem for Rebounded {
+    fn variables(&self) -> &[Variable] {
+        &self.vars
+    }
+    fn n_constraints(&self) -> usize {
+        self.inner.n_constraints()
+    }
+    fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
+        self.inner.evaluate(x, gradients)
+    }
+    fn name(&self) -> &str {
+        self.inner.name()
     }
 }
 
@@ -419,10 +493,18 @@ mod tests {
             name: name.into(),
             dimension: None,
             cost_ms,
+            bounds: None,
         };
         let e = spec("himmelbau", 0.0).build().err().unwrap().to_string();
         assert!(e.contains("himmelbau") && e.contains("himmelblau"), "{e}");
         assert!(spec("himmelblau", -1.0).build().is_err());
         assert!(spec("himmelblau", 1.0).build().is_ok());
+        let mut s = spec("himmelblau", 0.0);
+        s.bounds = Some(vec![[-1.0, 1.0], [2.0, -2.0]]);
+        let e = s.build().err().unwrap().to_string();
+        assert!(
+            e.contains("bounds[1]") && e.contains("lower < upper"),
+            "{e}"
+        );
     }
 }
