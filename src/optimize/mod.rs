@@ -13,6 +13,11 @@
 use crate::error::{Error, Result};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+pub mod driver;
+pub mod mmfd;
+pub mod qp;
+pub mod testproblems;
+
 /// One design variable: bounds and optional period.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variable {

@@ -1,0 +1,59 @@
+//! The loop that runs an argmin [`Solver`] and hands its per-iteration
+//! records to an [`Observer`].
+//!
+//! argmin's `Executor` wants `'static` observers; ours are borrowed
+//! (`&mut dyn Observer`: CSV writers, progress bars, a test's `History`),
+//! so the `minimize` functions run the same protocol themselves: `init`,
+//! then `next_iter` until `terminate_internal` says stop, incrementing the
+//! iteration counter like the executor does. The solvers hold the last
+//! [`IterRecord`]; only this loop passes it on.
+
+use super::{Counted, IterRecord, Observer};
+use crate::error::{Error, Result};
+use argmin::core::{IterState, Problem as ArgminProblem, Solver, State};
+
+/// The argmin state both solvers use: parameters and cost are `Vec<f64>`
+/// and `f64`; gradients and Hessians live inside the solvers.
+pub type OptState = IterState<Vec<f64>, (), (), (), (), f64>;
+
+/// A solver that exposes the record of its last iteration.
+pub trait Recorded {
+    /// The record of the iteration just completed (taken once).
+    fn take_record(&mut self) -> Option<IterRecord>;
+}
+
+/// Map an argmin error back to the crate error it wraps.
+pub fn from_argmin(e: argmin::core::Error) -> Error {
+    match e.downcast::<Error>() {
+        Ok(err) => err,
+        Err(other) => Error::numerical("optimize (argmin)", other.to_string()),
+    }
+}
+
+/// Run `solver` from `state` to termination, feeding `observer`.
+pub fn run<'a, S>(
+    solver: &mut S,
+    problem: &mut ArgminProblem<Counted<'a>>,
+    state: OptState,
+    observer: &mut dyn Observer,
+) -> Result<OptState>
+where
+    S: Solver<Counted<'a>, OptState> + Recorded,
+{
+    let (mut state, _) = solver.init(problem, state).map_err(from_argmin)?;
+    if let Some(r) = solver.take_record() {
+        observer.observe(&r);
+    }
+    loop {
+        if solver.terminate_internal(&state).terminated() {
+            break;
+        }
+        let (next, _) = solver.next_iter(problem, state).map_err(from_argmin)?;
+        state = next;
+        state.increment_iter();
+        if let Some(r) = solver.take_record() {
+            observer.observe(&r);
+        }
+    }
+    Ok(state)
+}

@@ -1,0 +1,933 @@
+//! The modified method of feasible directions (MMFD), as in Vanderplaats'
+//! CONMIN/ADS/DOT, which the paper uses (§5, Table 5), as an argmin
+//! [`Solver`].
+//!
+//! Problem: minimize `f(x)` subject to `g_j(x) <= 0` and the bounds of the
+//! non-periodic variables (side constraints). Periodic variables are
+//! wrapped into their box and never stopped by a bound. Directions and
+//! steps live in range-scaled coordinates `y_i = x_i / (upper_i − lower_i)`
+//! (the period for periodic variables), so a unit step spans a variable's
+//! whole range and variables in degrees and metres are treated alike.
+//!
+//! One iteration (one gradient evaluation at the current design):
+//! 1. Sets: active `g_j >= CT`, violated `g_j > CTMIN`, active side
+//!    constraints (a non-periodic variable on its bound). CT starts at the
+//!    option `ct` (< 0) and shrinks by `ct_reduction` each iteration towards
+//!    `−ctmin`, as CONMIN does, so the active set sharpens near the optimum.
+//! 2. Infeasible design → feasibility-restoration move: the shortest step
+//!    `S` with `g_j + ∇g_jᵀS <= −ctmin/2` for the active and violated
+//!    constraints and inside the bounds (push-off past the limit by half the
+//!    tolerance), solved exactly by [`super::qp`], then halved until the
+//!    largest violation decreases.
+//! 3. Feasible, nothing active → steepest descent, conjugated by
+//!    Fletcher–Reeves (`β = |∇f_k|²/|∇f_{k−1}|²`) while consecutive
+//!    iterations stay unconstrained, restarted every n iterations.
+//! 4. Feasible, something active → the MMFD direction: `min ½|S|² + ∇fᵀS`
+//!    s.t. `∇g_jᵀS <= 0` (active) and `S_i >= 0` / `<= 0` (at a lower /
+//!    upper bound), i.e. `−∇f` projected onto the cone of non-increasing
+//!    directions, solved exactly. Multipliers `λ_j > 0` mark the binding
+//!    constraints B; `|S| = 0` with B on its limits is the Kuhn–Tucker
+//!    condition.
+//! 5. Line search along `x(α) = x + c₀ + αS` by polynomial interpolation:
+//!    `c₀ = −N_B(N_BᵀN_B)⁻¹ g_B` first moves onto the binding constraints'
+//!    linearised limits; every trial point is pulled back onto them by
+//!    Newton corrections with the frozen gradients N_B (constraint
+//!    following; one function call each, at most `max_corrections`). The
+//!    first trial length is the smallest of: the one that changes f by
+//!    `dobj1`·|f| (first iteration) / `dobj2`·|f| later on the linear model,
+//!    the one that moves a variable by `dx2` of its range, and the distance
+//!    to the nearest bound. A quadratic through `f(0)`, `f'(0)` and the
+//!    trial gives the next length (extrapolating up to 4×, interpolating
+//!    down to 0.1×); a constraint that becomes violated is interpolated to
+//!    its zero crossing (quadratic in α from `g(0)`, `∇gᵀS` and the trial).
+//! 6. Convergence: `|Δf| < DABOBJ` or `|Δf|/|f| < DELOBJ` for ITRMOP
+//!    consecutive feasible iterations, or the Kuhn–Tucker test
+//!    `|S| <= kt_tolerance · max(|f|, 1)` with the binding constraints within
+//!    CTMIN of their limits.
+//!
+//! Counting follows DOT (and the paper's Table 5): an evaluation with
+//! gradients counts one function call and one gradient call.
+
+use super::driver::{self, OptState, Recorded};
+use super::{qp, Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination};
+use crate::error::{Error, Result};
+use argmin::core::{
+    Problem as ArgminProblem, Solver, State, TerminationReason, TerminationStatus, KV,
+};
+use nalgebra::{DMatrix, DVector};
+
+/// MMFD parameters. Defaults are DOT's where DOT has the parameter
+/// (Vanderplaats R&D, *DOT Users Manual*, parameters RPRM/IPRM).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MmfdOptions {
+    /// Initial constraint thickness CT (< 0): `g_j >= CT` is active.
+    /// DOT: −0.03 (3 % from a normalised limit).
+    pub ct: f64,
+    /// CTMIN (> 0): `g_j > CTMIN` is violated; also the final CT magnitude.
+    /// DOT: 0.003.
+    pub ctmin: f64,
+    /// Factor applied to CT after each iteration (CONMIN-style sharpening of
+    /// the active set): 0.5, so CT reaches −CTMIN in about 4 iterations.
+    pub ct_reduction: f64,
+    /// Relative convergence DELOBJ on |Δf|/|f|. DOT: 0.001.
+    pub delobj: f64,
+    /// Absolute convergence DABOBJ on |Δf|; `None`: DOT's
+    /// `max(1e-4 |f(x0)|, 1e-10)`.
+    pub dabobj: Option<f64>,
+    /// ITRMOP: consecutive iterations the change must stay below DELOBJ or
+    /// DABOBJ. DOT: 2.
+    pub itrmop: usize,
+    /// Iteration limit (ITMAX). DOT: 100.
+    pub max_iterations: usize,
+    /// DOBJ1: relative change of f sought by the first step. DOT: 0.1.
+    pub dobj1: f64,
+    /// DOBJ2: largest relative change of f sought by later first trials.
+    /// DOT: 0.2.
+    pub dobj2: f64,
+    /// DX2: largest move of any variable per first trial, as a fraction of
+    /// its range. DOT: 0.2 (relative to the variable's value there; here to
+    /// its range, since the variables are range-scaled).
+    pub dx2: f64,
+    /// Kuhn–Tucker tolerance on the projected gradient in scaled variables,
+    /// relative to `max(|f|, 1)`: 1e-4 (a full-range move then changes f by
+    /// less than 0.01 % to first order).
+    pub kt_tolerance: f64,
+    /// Function calls allowed per line search (excluding corrections): 6.
+    pub max_line_evaluations: usize,
+    /// Newton pull-backs onto the binding constraints per trial point: 3.
+    pub max_corrections: usize,
+    /// Constraint following stops when every binding |g_j| is below this:
+    /// 3e-5 (CTMIN/100, so the final f is not biased by a violation).
+    pub follow_tolerance: f64,
+}
+
+impl Default for MmfdOptions {
+    fn default() -> Self {
+        MmfdOptions {
+            ct: -0.03,
+            ctmin: 0.003,
+            ct_reduction: 0.5,
+            delobj: 0.001,
+            dabobj: None,
+            itrmop: 2,
+            max_iterations: 100,
+            dobj1: 0.1,
+            dobj2: 0.2,
+            dx2: 0.2,
+            kt_tolerance: 1e-4,
+            max_line_evaluations: 6,
+            max_corrections: 3,
+            follow_tolerance: 3e-5,
+        }
+    }
+}
+
+impl MmfdOptions {
+    fn validate(&self) -> Result<()> {
+        let bad = |k: &str, v: f64, e: &str| Err(Error::input(format!("mmfd.{k}"), v, e));
+        if !(self.ct < 0.0 && self.ct.is_finite()) {
+            return bad("ct", self.ct, "a finite constraint thickness < 0");
+        }
+        if !(self.ctmin > 0.0 && self.ctmin.is_finite()) {
+            return bad("ctmin", self.ctmin, "a finite tolerance > 0");
+        }
+        if !(self.ct_reduction > 0.0 && self.ct_reduction <= 1.0) {
+            return bad("ct_reduction", self.ct_reduction, "a factor in (0, 1]");
+        }
+        for (k, v) in [
+            ("delobj", self.delobj),
+            ("dobj1", self.dobj1),
+            ("dobj2", self.dobj2),
+            ("dx2", self.dx2),
+            ("kt_tolerance", self.kt_tolerance),
+            ("follow_tolerance", self.follow_tolerance),
+        ] {
+            if !(v > 0.0 && v.is_finite()) {
+                return bad(k, v, "a finite value > 0");
+            }
+        }
+        if let Some(d) = self.dabobj {
+            if !(d > 0.0 && d.is_finite()) {
+                return bad("dabobj", d, "a finite value > 0");
+            }
+        }
+        if self.itrmop == 0 || self.max_line_evaluations < 2 {
+            return Err(Error::input(
+                "mmfd.itrmop/max_line_evaluations",
+                format!("{}/{}", self.itrmop, self.max_line_evaluations),
+                "itrmop >= 1 and max_line_evaluations >= 2",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A design with its (function-only or full) evaluation.
+#[derive(Debug, Clone)]
+struct Point {
+    x: Vec<f64>,
+    f: f64,
+    g: Vec<f64>,
+}
+
+impl Point {
+    fn max_g(&self) -> f64 {
+        self.g.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// The MMFD engine as an argmin solver on a [`Counted`] problem; the state's
+/// parameter is the current design.
+pub struct Mmfd {
+    options: MmfdOptions,
+    x0: Vec<f64>,
+    /// Range (or period) of each variable: the scaling of directions.
+    range: Vec<f64>,
+    current: Option<Point>,
+    ct_now: f64,
+    dabobj: f64,
+    /// Previous unconstrained scaled gradient and direction (Fletcher–Reeves).
+    fr_prev: Option<(Vec<f64>, Vec<f64>)>,
+    fr_count: usize,
+    /// Previous accepted step length and its slope, for the next first trial.
+    prev_step: Option<(f64, f64)>,
+    /// |Δf| of the last iteration (quadratic first-trial estimate
+    /// `α = 2|Δf|/|f'(0)|`, Nocedal & Wright eq. 3.60).
+    last_change: f64,
+    abs_count: usize,
+    rel_count: usize,
+    failed_searches: usize,
+    iteration: usize,
+    termination: Option<Termination>,
+    record: Option<IterRecord>,
+}
+
+type Ap<'a> = ArgminProblem<Counted<'a>>;
+
+fn evaluate(problem: &mut Ap<'_>, x: &[f64], gradients: bool) -> Result<Evaluation> {
+    let key = if gradients {
+        "gradient_count"
+    } else {
+        "cost_count"
+    };
+    let ev = problem
+        .problem(key, |c| {
+            c.evaluate(x, gradients).map_err(argmin::core::Error::from)
+        })
+        .map_err(driver::from_argmin)?;
+    if !ev.f.is_finite() || ev.g.iter().any(|v| !v.is_finite()) {
+        return Err(Error::numerical(
+            "optimize::mmfd",
+            format!("non-finite f = {} or g = {:?} at x = {x:?}", ev.f, ev.g),
+        ));
+    }
+    Ok(ev)
+}
+
+fn counts(problem: &Ap<'_>) -> (usize, usize) {
+    problem
+        .problem
+        .as_ref()
+        .map(|c| (c.function_calls(), c.gradient_calls()))
+        .unwrap_or((0, 0))
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn norm(a: &[f64]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Least-norm `c` with `Nᵀc = −r` for the columns `cols` (scaled
+/// gradients): `c = −N (NᵀN)⁻¹ r`. None if the Gram matrix is singular.
+fn least_norm(cols: &[&[f64]], r: &[f64]) -> Option<Vec<f64>> {
+    let k = cols.len();
+    let n = cols.first()?.len();
+    let gram = DMatrix::from_fn(k, k, |i, j| dot(cols[i], cols[j]));
+    let ridge = 1e-12 * (1.0 + gram.diagonal().max());
+    let gram = gram + DMatrix::identity(k, k) * ridge;
+    let w = gram.cholesky()?.solve(&DVector::from_column_slice(r));
+    let mut c = vec![0.0; n];
+    for (col, wi) in cols.iter().zip(w.iter()) {
+        for i in 0..n {
+            c[i] -= wi * col[i];
+        }
+    }
+    Some(c)
+}
+
+/// Smallest positive root of `a α² + b α + c = 0`, if any.
+fn first_root(a: f64, b: f64, c: f64) -> Option<f64> {
+    if a.abs() < 1e-14 * (b.abs() + c.abs()) {
+        let r = -c / b;
+        return (r > 0.0 && r.is_finite()).then_some(r);
+    }
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    let sq = disc.sqrt();
+    let q = -0.5 * (b + b.signum() * sq);
+    let mut roots = [q / a, c / q];
+    roots.sort_by(f64::total_cmp);
+    roots.into_iter().find(|r| *r > 0.0 && r.is_finite())
+}
+
+/// What the line search works with in one iteration.
+struct Search<'s> {
+    base: &'s Point,
+    /// Scaled gradients of f and of all constraints at the base.
+    gf: &'s [f64],
+    gg: &'s [Vec<f64>],
+    s: &'s [f64],
+    c0: &'s [f64],
+    binding: &'s [usize],
+}
+
+impl Mmfd {
+    /// A solver starting from `x0` (wrapped/clamped into the box).
+    pub fn new(problem: &dyn Problem, x0: &[f64], options: MmfdOptions) -> Result<Self> {
+        options.validate()?;
+        let vars = problem.variables();
+        if x0.len() != vars.len() {
+            return Err(Error::input(
+                "mmfd.x0",
+                x0.len(),
+                format!("{} values", vars.len()),
+            ));
+        }
+        let mut x = Vec::with_capacity(x0.len());
+        for (i, (v, &xi)) in vars.iter().zip(x0).enumerate() {
+            if !xi.is_finite() {
+                return Err(Error::input(format!("mmfd.x0[{i}]"), xi, "a finite value"));
+            }
+            x.push(v.wrap(xi));
+        }
+        let range = vars
+            .iter()
+            .map(|v| v.period.unwrap_or(v.upper - v.lower))
+            .collect();
+        Ok(Mmfd {
+            ct_now: options.ct,
+            options,
+            x0: x,
+            range,
+            current: None,
+            dabobj: 0.0,
+            fr_prev: None,
+            fr_count: 0,
+            prev_step: None,
+            last_change: f64::INFINITY,
+            abs_count: 0,
+            rel_count: 0,
+            failed_searches: 0,
+            iteration: 0,
+            termination: None,
+            record: None,
+        })
+    }
+
+    /// Why the solver stopped (None while running).
+    pub fn termination(&self) -> Option<&Termination> {
+        self.termination.as_ref()
+    }
+
+    /// The current design with its f and g.
+    pub fn current(&self) -> Option<(&[f64], f64, &[f64])> {
+        self.current
+            .as_ref()
+            .map(|p| (p.x.as_slice(), p.f, p.g.as_slice()))
+    }
+
+    /// Design at scaled offset `z` from `x`: wrapped (periodic) or clamped.
+    fn moved(&self, problem: &Ap<'_>, x: &[f64], z: &[f64]) -> Vec<f64> {
+        let vars = problem
+            .problem
+            .as_ref()
+            .map(|c| c.variables())
+            .unwrap_or(&[]);
+        vars.iter()
+            .enumerate()
+            .map(|(i, v)| v.wrap(x[i] + z[i] * self.range[i]))
+            .collect()
+    }
+
+    /// Evaluate the trial `x + c₀ + αS` with constraint following.
+    fn trial(&self, problem: &mut Ap<'_>, sr: &Search<'_>, alpha: f64) -> Result<Point> {
+        let mut z: Vec<f64> = sr.c0.iter().zip(sr.s).map(|(c, s)| c + alpha * s).collect();
+        let mut x = self.moved(problem, &sr.base.x, &z);
+        let mut ev = evaluate(problem, &x, false)?;
+        let follow_tol = self.options.follow_tolerance;
+        for _ in 0..self.options.max_corrections {
+            if sr.binding.is_empty() {
+                break;
+            }
+            let r: Vec<f64> = sr.binding.iter().map(|&j| ev.g[j]).collect();
+            if r.iter().all(|v| v.abs() <= follow_tol) {
+                break;
+            }
+            let cols: Vec<&[f64]> = sr.binding.iter().map(|&j| sr.gg[j].as_slice()).collect();
+            let Some(dz) = least_norm(&cols, &r) else {
+                break;
+            };
+            for (zi, d) in z.iter_mut().zip(&dz) {
+                *zi += d;
+            }
+            x = self.moved(problem, &sr.base.x, &z);
+            ev = evaluate(problem, &x, false)?;
+        }
+        Ok(Point {
+            x,
+            f: ev.f,
+            g: ev.g,
+        })
+    }
+
+    /// Largest α keeping `y + c₀ + αS` inside the bounds of the non-periodic
+    /// variables.
+    fn alpha_max(&self, problem: &Ap<'_>, sr: &Search<'_>) -> f64 {
+        let vars = problem
+            .problem
+            .as_ref()
+            .map(|c| c.variables())
+            .unwrap_or(&[]);
+        let snorm = sr.s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let mut amax = f64::INFINITY;
+        for (i, v) in vars.iter().enumerate() {
+            if v.period.is_some() || sr.s[i].abs() <= 1e-9 * snorm {
+                continue;
+            }
+            let y = (sr.base.x[i] - v.lower) / self.range[i] + sr.c0[i];
+            let room = if sr.s[i] > 0.0 { 1.0 - y } else { y };
+            amax = amax.min(room.max(0.0) / sr.s[i].abs());
+        }
+        amax
+    }
+
+    /// Predicted α where a constraint not followed crosses zero, from
+    /// `g(0)`, `∇gᵀS` and the value at the trial `at`.
+    fn crossing(&self, sr: &Search<'_>, at: &Point, alpha: f64) -> f64 {
+        let mut best = f64::INFINITY;
+        for (j, gt) in at.g.iter().enumerate() {
+            if sr.binding.contains(&j) {
+                continue;
+            }
+            let g0 = sr.base.g[j] + dot(&sr.gg[j], sr.c0);
+            let s = dot(&sr.gg[j], sr.s);
+            if s <= 0.0 && *gt <= 0.0 {
+                continue;
+            }
+            let a = (gt - g0 - s * alpha) / (alpha * alpha);
+            if let Some(r) = first_root(a, s, g0) {
+                best = best.min(r);
+            } else if *gt > 0.0 {
+                // Linear interpolation between the base and the trial.
+                let r = alpha * (0.0 - g0) / (gt - g0);
+                if r > 0.0 {
+                    best = best.min(r);
+                }
+            }
+        }
+        best
+    }
+
+    /// The line search of step 5. Returns the accepted point and α, or None
+    /// when no feasible point with a decrease of f was found.
+    fn line_search(&self, problem: &mut Ap<'_>, sr: &Search<'_>) -> Result<Option<(Point, f64)>> {
+        let o = &self.options;
+        let ok = |p: &Point| p.max_g() <= o.ctmin;
+        let phi0 = sr.base.f + dot(sr.gf, sr.c0);
+        let d0 = dot(sr.gf, sr.s);
+        let snorm = sr.s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        // Pure pull onto the binding limits (S = 0).
+        if snorm == 0.0 || d0 >= 0.0 {
+            if norm(sr.c0) == 0.0 {
+                return Ok(None);
+            }
+            let t = self.trial(problem, sr, 0.0)?;
+            return Ok((ok(&t) && t.f < sr.base.f.max(phi0)).then_some((t, 0.0)));
+        }
+        let amax = self.alpha_max(problem, sr);
+        let fscale = sr.base.f.abs().max(self.dabobj);
+        let mut alpha = match self.prev_step {
+            None => o.dobj1 * fscale / d0.abs(),
+            Some((a, dprev)) => (a * dprev / d0)
+                .min(o.dobj2 * fscale / d0.abs())
+                .min(2.02 * self.last_change.max(1e-300) / d0.abs()),
+        };
+        alpha = alpha.min(o.dx2 / snorm).min(amax);
+        if !(alpha > 0.0 && alpha.is_finite()) {
+            return Ok(None);
+        }
+        // Reference for a decrease: f at the base, or the predicted f on the
+        // binding limits when reaching them costs (base slightly violated).
+        let f_ref = sr.base.f.max(phi0);
+        let mut best: Option<(Point, f64)> = None;
+        let mut evals = 0;
+        // Phase A: a feasible trial with a decrease.
+        while evals < o.max_line_evaluations {
+            let t = self.trial(problem, sr, alpha)?;
+            evals += 1;
+            if !ok(&t) {
+                let r = self.crossing(sr, &t, alpha);
+                // A followed constraint the corrections could not reach
+                // (r infinite): the step was too long for the curvature.
+                alpha = if r.is_finite() {
+                    r.clamp(0.05 * alpha, 0.9 * alpha)
+                } else {
+                    0.25 * alpha
+                };
+                continue;
+            }
+            if t.f < f_ref + 1e-4 * alpha * d0 {
+                best = Some((t, alpha));
+                break;
+            }
+            let c = (t.f - phi0 - d0 * alpha) / (alpha * alpha);
+            let a_q = if c > 0.0 {
+                -d0 / (2.0 * c)
+            } else {
+                0.1 * alpha
+            };
+            alpha = a_q.clamp(0.01 * alpha, 0.5 * alpha);
+        }
+        let Some((mut bp, mut ba)) = best else {
+            return Ok(None);
+        };
+        // Phase B: interpolate / extrapolate from the accepted trial.
+        let mut lo: Option<(f64, f64)> = None; // a second point for 3-point fits
+        while evals < o.max_line_evaluations {
+            let (a_star, capped) = match lo {
+                Some((a2, f2)) => {
+                    // Quadratic through (0, φ0), (ba, f_b), (a2, f2).
+                    let (x1, y1, x2, y2) = (ba, bp.f - phi0, a2, f2 - phi0);
+                    let den = x1 * x2 * (x1 - x2);
+                    let c = (y1 * x2 - y2 * x1) / den;
+                    let b = (y2 * x1 * x1 - y1 * x2 * x2) / den;
+                    if c > 0.0 {
+                        (-b / (2.0 * c), false)
+                    } else {
+                        break;
+                    }
+                }
+                None => {
+                    let c = (bp.f - phi0 - d0 * ba) / (ba * ba);
+                    if c > 0.0 {
+                        let a = -d0 / (2.0 * c);
+                        if a > 4.0 * ba {
+                            (4.0 * ba, true)
+                        } else {
+                            (a, false)
+                        }
+                    } else {
+                        (4.0 * ba, true)
+                    }
+                }
+            };
+            let limit = amax.min(self.crossing(sr, &bp, ba));
+            let a_new = a_star.min(limit);
+            if a_new.is_nan() || a_new <= 0.0 || (a_new - ba).abs() <= 0.05 * ba {
+                break;
+            }
+            let t = self.trial(problem, sr, a_new)?;
+            evals += 1;
+            if ok(&t) && t.f < bp.f {
+                let prev = (ba, bp.f);
+                bp = t;
+                ba = a_new;
+                if capped && a_new < limit {
+                    lo = None;
+                    continue;
+                }
+                lo = Some(prev);
+                if a_new >= limit {
+                    break;
+                }
+            } else {
+                if lo.is_some() || !ok(&t) {
+                    break;
+                }
+                lo = Some((a_new, t.f));
+            }
+        }
+        Ok(Some((bp, ba)))
+    }
+
+    /// Record the iteration and update the convergence counters.
+    fn finish_iteration(&mut self, problem: &Ap<'_>, old: &Point, new: Point, step: f64) {
+        let o = &self.options;
+        let feasible = old.max_g() <= o.ctmin && new.max_g() <= o.ctmin;
+        let df = (new.f - old.f).abs();
+        if df > 0.0 {
+            self.last_change = df;
+        }
+        if feasible && df < self.dabobj {
+            self.abs_count += 1;
+        } else {
+            self.abs_count = 0;
+        }
+        if feasible && df < o.delobj * old.f.abs().max(1e-300) {
+            self.rel_count += 1;
+        } else {
+            self.rel_count = 0;
+        }
+        let (fc, gc) = counts(problem);
+        self.record = Some(IterRecord {
+            iteration: self.iteration,
+            x: new.x.clone(),
+            f: new.f,
+            max_g: new.max_g(),
+            step,
+            function_calls: fc,
+            gradient_calls: gc,
+        });
+        self.current = Some(new);
+        self.iteration += 1;
+        self.ct_now = (self.ct_now * o.ct_reduction).min(-o.ctmin);
+        if self.abs_count >= o.itrmop {
+            self.termination = Some(Termination::AbsoluteChange);
+        } else if self.rel_count >= o.itrmop {
+            self.termination = Some(Termination::RelativeChange);
+        } else if self.iteration >= o.max_iterations {
+            self.termination = Some(Termination::MaxIterations);
+        }
+    }
+
+    /// Scaled step length `|Δy|` between two designs.
+    fn scaled_distance(&self, problem: &Ap<'_>, a: &[f64], b: &[f64]) -> f64 {
+        let vars = problem
+            .problem
+            .as_ref()
+            .map(|c| c.variables())
+            .unwrap_or(&[]);
+        vars.iter()
+            .enumerate()
+            .map(|(i, v)| (v.difference(a[i], b[i]) / self.range[i]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    }
+
+    /// Step 2: a feasibility-restoration move.
+    fn restore(
+        &mut self,
+        problem: &mut Ap<'_>,
+        base: &Point,
+        gg: &[Vec<f64>],
+    ) -> Result<Option<Point>> {
+        let o = self.options.clone();
+        let vars: Vec<_> = problem
+            .problem
+            .as_ref()
+            .map(|c| c.variables().to_vec())
+            .unwrap_or_default();
+        let n = vars.len();
+        let mut rows = Vec::new();
+        let mut b = Vec::new();
+        for (j, gj) in base.g.iter().enumerate() {
+            if *gj >= self.ct_now {
+                rows.push(gg[j].clone());
+                b.push(-gj - 0.5 * o.ctmin);
+            }
+        }
+        for (i, v) in vars.iter().enumerate() {
+            if v.period.is_some() {
+                continue;
+            }
+            let y = (base.x[i] - v.lower) / self.range[i];
+            let mut e = vec![0.0; n];
+            e[i] = 1.0;
+            rows.push(e.clone());
+            b.push(1.0 - y);
+            e[i] = -1.0;
+            rows.push(e);
+            b.push(y);
+        }
+        let sol = qp::solve(&vec![0.0; n], &rows, &b)?;
+        let v0 = base.max_g();
+        let mut alpha = 1.0;
+        for _ in 0..6 {
+            let z: Vec<f64> = sol.s.iter().map(|s| alpha * s).collect();
+            let x = self.moved(problem, &base.x, &z);
+            let ev = evaluate(problem, &x, false)?;
+            let p = Point {
+                x,
+                f: ev.f,
+                g: ev.g,
+            };
+            if p.max_g() < v0 {
+                return Ok(Some(p));
+            }
+            alpha *= 0.5;
+        }
+        Ok(None)
+    }
+
+    /// One MMFD iteration (steps 1–6 of the module doc).
+    fn iterate(&mut self, problem: &mut Ap<'_>) -> Result<()> {
+        let o = self.options.clone();
+        let vars: Vec<_> = problem
+            .problem
+            .as_ref()
+            .map(|c| c.variables().to_vec())
+            .unwrap_or_default();
+        let n = vars.len();
+        let x = match &self.current {
+            Some(p) => p.x.clone(),
+            None => self.x0.clone(),
+        };
+        let ev = evaluate(problem, &x, true)?;
+        let base = Point {
+            x,
+            f: ev.f,
+            g: ev.g.clone(),
+        };
+        if self.iteration == 0 && self.current.is_none() {
+            self.dabobj = o.dabobj.unwrap_or((1e-4 * base.f.abs()).max(1e-10));
+            self.current = Some(base.clone());
+        }
+        let missing = || Error::numerical("optimize::mmfd", "problem returned no gradients");
+        let gf: Vec<f64> = ev
+            .grad_f
+            .as_ref()
+            .ok_or_else(missing)?
+            .iter()
+            .zip(&self.range)
+            .map(|(g, r)| g * r)
+            .collect();
+        let gg: Vec<Vec<f64>> = match &ev.grad_g {
+            Some(rows) => rows
+                .iter()
+                .map(|row| row.iter().zip(&self.range).map(|(g, r)| g * r).collect())
+                .collect(),
+            None if base.g.is_empty() => vec![],
+            None => return Err(missing()),
+        };
+        if gf.iter().chain(gg.iter().flatten()).any(|v| !v.is_finite()) {
+            return Err(Error::numerical(
+                "optimize::mmfd",
+                format!("non-finite gradient at x = {:?}", base.x),
+            ));
+        }
+        // Step 2: restoration.
+        if base.max_g() > o.ctmin {
+            self.fr_prev = None;
+            self.prev_step = None;
+            match self.restore(problem, &base, &gg)? {
+                Some(p) => {
+                    let step = self.scaled_distance(problem, &p.x, &base.x);
+                    self.finish_iteration(problem, &base, p, step);
+                }
+                None => {
+                    self.current = Some(base.clone());
+                    self.termination = Some(Termination::Infeasible);
+                    self.record_stay(problem, &base);
+                }
+            }
+            return Ok(());
+        }
+        // Step 1: active sets.
+        let active: Vec<usize> = (0..base.g.len())
+            .filter(|&j| base.g[j] >= self.ct_now)
+            .collect();
+        let eps = 1e-9;
+        let mut side_rows = Vec::new();
+        let mut side_vars = Vec::new();
+        for (i, v) in vars.iter().enumerate() {
+            if v.period.is_some() {
+                continue;
+            }
+            let y = (base.x[i] - v.lower) / self.range[i];
+            let mut e = vec![0.0; n];
+            if y <= eps {
+                e[i] = -1.0;
+                side_rows.push(e);
+                side_vars.push((i, 1.0));
+            } else if y >= 1.0 - eps {
+                e[i] = 1.0;
+                side_rows.push(e);
+                side_vars.push((i, -1.0));
+            }
+        }
+        // Steps 3–4: direction.
+        let (s, binding) = if active.is_empty() && side_rows.is_empty() {
+            let mut s: Vec<f64> = gf.iter().map(|v| -v).collect();
+            if let Some((gprev, sprev)) = &self.fr_prev {
+                if self.fr_count < n {
+                    let beta = dot(&gf, &gf) / dot(gprev, gprev).max(1e-300);
+                    let cand: Vec<f64> = s.iter().zip(sprev).map(|(a, b)| a + beta * b).collect();
+                    if dot(&cand, &gf) < -1e-3 * norm(&cand) * norm(&gf) {
+                        s = cand;
+                        self.fr_count += 1;
+                    } else {
+                        self.fr_count = 0;
+                    }
+                } else {
+                    self.fr_count = 0;
+                }
+            }
+            self.fr_prev = Some((gf.clone(), s.clone()));
+            (s, vec![])
+        } else {
+            self.fr_prev = None;
+            self.fr_count = 0;
+            let mut rows: Vec<Vec<f64>> = active.iter().map(|&j| gg[j].clone()).collect();
+            rows.extend(side_rows.iter().cloned());
+            let b = vec![0.0; rows.len()];
+            let sol = qp::solve(&gf, &rows, &b)?;
+            let lmax = sol.lambda.iter().copied().fold(0.0, f64::max);
+            // Binding: positive multiplier and S tangent to the constraint
+            // (complementarity); constraints S moves away from are free.
+            let sn = norm(&sol.s);
+            let binding: Vec<usize> = active
+                .iter()
+                .enumerate()
+                .filter(|(k, &j)| {
+                    sol.lambda[*k] > 1e-8 * lmax.max(1e-300)
+                        && dot(&gg[j], &sol.s) >= -1e-6 * norm(&gg[j]) * sn
+                })
+                .map(|(_, &j)| j)
+                .collect();
+            let mut s = sol.s;
+            // Remove round-off components pointing out of an active bound.
+            for &(i, sign) in &side_vars {
+                if s[i] * sign < 0.0 {
+                    s[i] = 0.0;
+                }
+            }
+            (s, binding)
+        };
+        // Kuhn–Tucker test.
+        let on_limits = binding.iter().all(|&j| base.g[j].abs() <= o.ctmin);
+        if norm(&s) <= o.kt_tolerance * base.f.abs().max(1.0) && on_limits {
+            self.current = Some(base.clone());
+            self.termination = Some(Termination::KuhnTucker);
+            self.record_stay(problem, &base);
+            return Ok(());
+        }
+        let c0 = if binding.is_empty() {
+            vec![0.0; n]
+        } else {
+            let cols: Vec<&[f64]> = binding.iter().map(|&j| gg[j].as_slice()).collect();
+            let r: Vec<f64> = binding.iter().map(|&j| base.g[j]).collect();
+            least_norm(&cols, &r).unwrap_or_else(|| vec![0.0; n])
+        };
+        let d0 = dot(&gf, &s);
+        let sr = Search {
+            base: &base,
+            gf: &gf,
+            gg: &gg,
+            s: &s,
+            c0: &c0,
+            binding: &binding,
+        };
+        match self.line_search(problem, &sr)? {
+            Some((p, alpha)) => {
+                self.failed_searches = 0;
+                if alpha > 0.0 {
+                    self.prev_step = Some((alpha, d0));
+                }
+                let step = self.scaled_distance(problem, &p.x, &base.x);
+                self.finish_iteration(problem, &base, p, step);
+            }
+            None => {
+                self.failed_searches += 1;
+                self.fr_prev = None;
+                self.prev_step = None;
+                if self.failed_searches >= 2 {
+                    self.current = Some(base.clone());
+                    self.termination = Some(Termination::NoFeasibleDirection);
+                    self.record_stay(problem, &base);
+                } else {
+                    self.finish_iteration(problem, &base, base.clone(), 0.0);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Record a final iteration that did not move.
+    fn record_stay(&mut self, problem: &Ap<'_>, p: &Point) {
+        let (fc, gc) = counts(problem);
+        self.record = Some(IterRecord {
+            iteration: self.iteration,
+            x: p.x.clone(),
+            f: p.f,
+            max_g: p.max_g(),
+            step: 0.0,
+            function_calls: fc,
+            gradient_calls: gc,
+        });
+    }
+}
+
+impl Recorded for Mmfd {
+    fn take_record(&mut self) -> Option<IterRecord> {
+        self.record.take()
+    }
+}
+
+impl<'a> Solver<Counted<'a>, OptState> for Mmfd {
+    fn name(&self) -> &str {
+        "MMFD"
+    }
+
+    fn next_iter(
+        &mut self,
+        problem: &mut ArgminProblem<Counted<'a>>,
+        state: OptState,
+    ) -> std::result::Result<(OptState, Option<KV>), argmin::core::Error> {
+        self.iterate(problem).map_err(argmin::core::Error::from)?;
+        let (x, f) = match &self.current {
+            Some(p) => (p.x.clone(), p.f),
+            None => (self.x0.clone(), f64::NAN),
+        };
+        Ok((state.param(x).cost(f), None))
+    }
+
+    fn terminate(&mut self, _state: &OptState) -> TerminationStatus {
+        match &self.termination {
+            Some(t) => TerminationStatus::Terminated(TerminationReason::SolverExit(t.to_string())),
+            None => TerminationStatus::NotTerminated,
+        }
+    }
+}
+
+/// Minimize `problem` from `x0` with MMFD; records go to `observer`, one
+/// per iteration. The outcome carries Table 5's counts: iterations,
+/// function and gradient calls, active constraints (`g >= CT` with the
+/// final CT) and active side constraints, plus why it stopped.
+pub fn minimize(
+    problem: &dyn Problem,
+    x0: &[f64],
+    options: &MmfdOptions,
+    observer: &mut dyn Observer,
+) -> Result<LocalOutcome> {
+    let mut solver = Mmfd::new(problem, x0, options.clone())?;
+    let mut ap = ArgminProblem::new(Counted::new(problem));
+    driver::run(&mut solver, &mut ap, OptState::new(), observer)?;
+    let (fc, gc) = counts(&ap);
+    let p = solver
+        .current
+        .clone()
+        .ok_or_else(|| Error::numerical("optimize::mmfd", "no iteration was run"))?;
+    let vars = problem.variables();
+    let active_side = vars
+        .iter()
+        .zip(&p.x)
+        .filter(|(v, &x)| v.period.is_none() && (x <= v.lower || x >= v.upper))
+        .count();
+    let active = p.g.iter().filter(|&&g| g >= solver.ct_now).count();
+    Ok(LocalOutcome {
+        x: p.x,
+        f: p.f,
+        g: p.g,
+        iterations: solver.iteration,
+        function_calls: fc,
+        gradient_calls: gc,
+        active_constraints: active,
+        active_side_constraints: active_side,
+        termination: solver.termination.unwrap_or(Termination::MaxIterations),
+    })
+}
