@@ -8,12 +8,15 @@ use plyscape::explore::multistart::Shard;
 use plyscape::explore::{self, DriveFlags};
 
 /// Local method used by these tests.
-const METHOD: &str = "steepest";
+const METHOD: &str = "mmfd";
+/// MMFD converged far tighter than DOT's defaults (DELOBJ = 1e-3), so the
+/// optima can be compared with the published minima to 1e-5.
+const TIGHT: &str = "[multistart.mmfd]\ndelobj = 1e-12\ndabobj = 1e-14\nkt_tolerance = 1e-10\nmax_iterations = 500\n";
 
 fn himmelblau(starts: usize, extra: &str) -> String {
     format!(
         "[study]\nname = \"h\"\nseed = 11\n[problem]\nname = \"himmelblau\"\n\
-         [multistart]\nmethod = \"{METHOD}\"\nsampler = \"lhs\"\nstarts = {starts}\n{extra}"
+         [multistart]\nmethod = \"{METHOD}\"\nsampler = \"lhs\"\nstarts = {starts}\n{extra}{TIGHT}"
     )
 }
 
@@ -86,7 +89,7 @@ fn periodic_optima_merge_across_the_seam() {
     let text = format!(
         "[study]\nname = \"p\"\nseed = 5\n[problem]\nname = \"periodic2\"\n\
          [multistart]\nmethod = \"{METHOD}\"\nsampler = \"sobol\"\nstarts = 64\n\
-         points = [[89.0, -30.0], [-89.0, -30.0]]\n"
+         points = [[89.0, -30.0], [-89.0, -30.0]]\n{TIGHT}"
     );
     let s = study("p", &text);
     let r = explore::run_multistart(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();

@@ -62,16 +62,21 @@ pub struct MultistartSection {
     /// Stop launching runs after this wall time \[s\].
     pub max_wall_seconds: Option<f64>,
     /// Same optimum: coordinates within this fraction of each range
-    /// (default 1e-3: 0.18° on a 180° ply angle).
+    /// (default 1e-2: 1.8° on a 180° ply angle; MMFD with DOT's default
+    /// DELOBJ = 1e-3 stops that far from the exact optimum on flat valleys).
     #[serde(default = "default_x_tol")]
     pub x_tolerance: f64,
-    /// Same optimum: `|Δf| <= f_tolerance · max(1, |f|)` (default 1e-6).
+    /// Same optimum: `|Δf| <= f_tolerance · max(1, |f|)` (default 1e-3,
+    /// DOT's DELOBJ).
     #[serde(default = "default_f_tol")]
     pub f_tolerance: f64,
     /// Feasible: `max g <= feasibility_tolerance` (default 1e-4, the order of
     /// MMFD's final constraint tolerance).
     #[serde(default = "default_feas_tol")]
     pub feasibility_tolerance: f64,
+    /// MMFD convergence settings (`[multistart.mmfd]`; DOT defaults).
+    #[serde(default)]
+    pub mmfd: solvers::MmfdSettings,
 }
 
 fn default_method() -> String {
@@ -81,10 +86,10 @@ fn default_sampler() -> String {
     "lhs".into()
 }
 fn default_x_tol() -> f64 {
-    1e-3
+    1e-2
 }
 fn default_f_tol() -> f64 {
-    1e-6
+    1e-3
 }
 fn default_feas_tol() -> f64 {
     1e-4
@@ -204,6 +209,7 @@ pub fn multistart_plan(study: &Study, problem: &dyn Problem) -> Result<Multistar
         study.require_section("multistart", "starts = ..., sampler = ...")?;
     let loc = study.locate("multistart");
     solvers::check_local(&s.method).map_err(&loc)?;
+    s.mmfd.check().map_err(study.locate("multistart.mmfd"))?;
     for (key, v) in [
         ("x_tolerance", s.x_tolerance),
         ("f_tolerance", s.f_tolerance),
@@ -275,7 +281,7 @@ fn multistart_with(
 ) -> Result<multistart::Report> {
     let dir = ctx.dir()?;
     ctx.manifest(&dir, "multistart", json!({"complete": false}))?;
-    let solver = solvers::local(&plan.section.method)?;
+    let solver = solvers::local(&plan.section.method, &plan.section.mmfd)?;
     let settings = multistart::Settings {
         threads: ctx.threads,
         max_evaluations: plan.section.max_evaluations,

@@ -2,22 +2,23 @@
 //! wrapper that gives any of them a fixed CPU cost per evaluation.
 //!
 //! These problems have known landscapes, so the exploration drivers can be
-//! checked against closed-form answers:
-//! - `himmelblau`: four global minima with `f = 0` (Himmelblau, *Applied
-//!   Nonlinear Programming*, 1972, p. 428), box `[-5, 5]²`.
+//! checked against closed-form answers. From `optimize::testproblems`
+//! (sources cited there): `himmelblau` (four global minima, `f = 0`),
+//! `rosenbrock` and `rastrigin` (`dimension` variables), `hs21`, `hs35`,
+//! `hs43`, `hs76`, `hs100`, `disc` and `seam`. Defined here:
 //! - `hs22`: Hock–Schittkowski problem 22 (Hock & Schittkowski, *Test
 //!   Examples for Nonlinear Programming Codes*, 1981), minimum `f = 1` at
 //!   `(1, 1)` with both constraints active; box `[-5, 5]²` added (inactive at
 //!   the optimum) so that samplers have a design box.
 //! - `periodic2`: two periodic angles (degrees, period 180°) with four minima,
 //!   one of them on the seam `θ₁ = ±90°`; see [`Periodic2`].
-//! - `rosenbrock`: `n`-variable Rosenbrock valley, minimum 0 at `(1, …, 1)`.
 //!
 //! [`Costly`] burns a fixed CPU time per evaluation (a busy wait, so it
 //! occupies a core like a real simulation would) for performance
 //! measurements of the drivers.
 
 use crate::error::{Error, Result};
+use crate::optimize::testproblems as tp;
 use crate::optimize::{Evaluation, Problem, Variable};
 use serde::Deserialize;
 use std::time::{Duration, Instant};
@@ -26,9 +27,9 @@ use std::time::{Duration, Instant};
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProblemSpec {
-    /// One of `himmelblau`, `hs22`, `periodic2`, `rosenbrock`.
+    /// A name from [`PROBLEM_NAMES`].
     pub name: String,
-    /// Number of variables (only `rosenbrock`; default 2).
+    /// Number of variables (only `rosenbrock`, `rastrigin`; default 2).
     pub dimension: Option<usize>,
     /// CPU time burnt per evaluation \[ms\] (default 0).
     #[serde(default)]
@@ -39,7 +40,8 @@ pub struct ProblemSpec {
 }
 
 /// Names accepted by [`ProblemSpec::build`].
-pub const PROBLEM_NAMES: &str = "himmelblau, hs22, periodic2, rosenbrock";
+pub const PROBLEM_NAMES: &str =
+    "himmelblau, rosenbrock, rastrigin, hs21, hs22, hs35, hs43, hs76, hs100, disc, seam, periodic2";
 
 impl ProblemSpec {
     /// Build the named problem (wrapped in [`Costly`] when `cost_ms > 0`).
@@ -52,24 +54,31 @@ impl ProblemSpec {
                 "a finite time >= 0 ms",
             ));
         }
-        if self.dimension.is_some() && self.name != "rosenbrock" {
+        let sized = matches!(self.name.as_str(), "rosenbrock" | "rastrigin");
+        if self.dimension.is_some() && !sized {
             return Err(Error::input(
                 "dimension",
                 self.dimension.unwrap_or(0),
-                "no `dimension` (only rosenbrock takes one)",
+                "no `dimension` (only rosenbrock and rastrigin take one)",
             ));
         }
+        let n = self.dimension.unwrap_or(2);
+        if sized && !(2..=64).contains(&n) {
+            return Err(Error::input("dimension", n, "2 <= dimension <= 64"));
+        }
         let inner: Box<dyn Problem> = match self.name.as_str() {
-            "himmelblau" => Box::new(Himmelblau::new()),
+            "himmelblau" => Box::new(tp::himmelblau()),
+            "rosenbrock" => Box::new(tp::rosenbrock(n)),
+            "rastrigin" => Box::new(tp::rastrigin(n)),
+            "hs21" => Box::new(tp::hs21()),
+            "hs35" => Box::new(tp::hs35()),
+            "hs43" => Box::new(tp::hs43()),
+            "hs76" => Box::new(tp::hs76()),
+            "hs100" => Box::new(tp::hs100()),
+            "disc" => Box::new(tp::disc()),
+            "seam" => Box::new(tp::seam()),
             "hs22" => Box::new(Hs22::new()),
             "periodic2" => Box::new(Periodic2::new()),
-            "rosenbrock" => {
-                let n = self.dimension.unwrap_or(2);
-                if !(2..=64).contains(&n) {
-                    return Err(Error::input("dimension", n, "2 <= dimension <= 64"));
-                }
-                Box::new(Rosenbrock::new(n))
-            }
             other => {
                 return Err(Error::input(
                     "name",
@@ -171,57 +180,12 @@ fn check_len(place: &str, x: &[f64], n: usize) -> Result<()> {
     Ok(())
 }
 
-/// Himmelblau's function `f = (x² + y − 11)² + (x + y² − 7)²` on `[-5, 5]²`.
-/// Minima (all `f = 0`): `(3, 2)`, `(−2.805118, 3.131312)`,
-/// `(−3.779310, −3.283186)`, `(3.584428, −1.848126)`.
-pub struct Himmelblau {
-    vars: Vec<Variable>,
-}
-
-impl Himmelblau {
-    /// The problem on its usual box `[-5, 5]²`.
-    pub fn new() -> Self {
-        Himmelblau {
-            vars: vec![bounded("x", -5.0, 5.0), bounded("y", -5.0, 5.0)],
-        }
-    }
-}
-
-impl Default for Himmelblau {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
 fn bounded(name: &str, lo: f64, hi: f64) -> Variable {
     Variable {
         name: name.into(),
         lower: lo,
         upper: hi,
         period: None,
-    }
-}
-
-impl Problem for Himmelblau {
-    fn variables(&self) -> &[Variable] {
-        &self.vars
-    }
-    fn n_constraints(&self) -> usize {
-        0
-    }
-    fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
-        check_len("himmelblau", x, 2)?;
-        let (a, b) = (x[0] * x[0] + x[1] - 11.0, x[0] + x[1] * x[1] - 7.0);
-        let grad = gradients.then(|| vec![4.0 * a * x[0] + 2.0 * b, 2.0 * a + 4.0 * b * x[1]]);
-        Ok(Evaluation {
-            f: a * a + b * b,
-            g: vec![],
-            grad_f: grad,
-            grad_g: gradients.then(Vec::new),
-        })
-    }
-    fn name(&self) -> &str {
-        "himmelblau"
     }
 }
 
@@ -344,54 +308,6 @@ impl Problem for Periodic2 {
     }
 }
 
-/// Rosenbrock's function `Σ 100 (x_{i+1} − x_i²)² + (1 − x_i)²` on
-/// `[-2, 2]ⁿ`; minimum 0 at `(1, …, 1)`.
-pub struct Rosenbrock {
-    vars: Vec<Variable>,
-}
-
-impl Rosenbrock {
-    /// `n` variables (`n >= 2`).
-    pub fn new(n: usize) -> Self {
-        Rosenbrock {
-            vars: (0..n)
-                .map(|i| bounded(&format!("x{i}"), -2.0, 2.0))
-                .collect(),
-        }
-    }
-}
-
-impl Problem for Rosenbrock {
-    fn variables(&self) -> &[Variable] {
-        &self.vars
-    }
-    fn n_constraints(&self) -> usize {
-        0
-    }
-    fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
-        let n = self.vars.len();
-        check_len("rosenbrock", x, n)?;
-        let mut f = 0.0;
-        let mut grad = vec![0.0; n];
-        for i in 0..n - 1 {
-            let a = x[i + 1] - x[i] * x[i];
-            let b = 1.0 - x[i];
-            f += 100.0 * a * a + b * b;
-            grad[i] += -400.0 * a * x[i] - 2.0 * b;
-            grad[i + 1] += 200.0 * a;
-        }
-        Ok(Evaluation {
-            f,
-            g: vec![],
-            grad_f: gradients.then_some(grad),
-            grad_g: gradients.then(Vec::new),
-        })
-    }
-    fn name(&self) -> &str {
-        "rosenbrock"
-    }
-}
-
 /// Any problem plus a fixed CPU cost per evaluation (busy wait on the
 /// monotonic clock, so the thread really occupies a core).
 pub struct Costly {
@@ -454,24 +370,12 @@ mod tests {
 
     #[test]
     fn gradients_match_central_differences() {
-        check_gradients(&Himmelblau::new(), &[0.3, -1.7]);
         check_gradients(&Hs22::new(), &[0.3, -1.7]);
         check_gradients(&Periodic2::new(), &[37.0, -71.0]);
-        check_gradients(&Rosenbrock::new(4), &[0.3, -1.7, 0.9, 1.1]);
     }
 
     #[test]
     fn known_minima() {
-        // Himmelblau (1972): f = 0 at (3, 2); the other three to 6 digits.
-        let h = Himmelblau::new();
-        assert_eq!(h.evaluate(&[3.0, 2.0], false).unwrap().f, 0.0);
-        for m in [
-            [-2.805118, 3.131312],
-            [-3.779310, -3.283186],
-            [3.584428, -1.848126],
-        ] {
-            assert!(h.evaluate(&m, false).unwrap().f < 1e-9);
-        }
         // HS 22 (Hock & Schittkowski 1981): f* = 1 at (1, 1), both active.
         let e = Hs22::new().evaluate(&[1.0, 1.0], false).unwrap();
         assert_eq!((e.f, e.g[0], e.g[1]), (1.0, 0.0, 0.0));

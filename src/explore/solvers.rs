@@ -33,14 +33,68 @@ pub fn check_local(method: &str) -> Result<()> {
     }
 }
 
-/// The local solver called `method`.
-pub fn local(method: &str) -> Result<Box<LocalSolver<'static>>> {
+/// MMFD settings a study may change (`[multistart.mmfd]`); absent keys
+/// keep DOT's defaults (`optimize::mmfd::MmfdOptions::default()`).
+#[derive(Debug, Clone, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MmfdSettings {
+    /// Relative convergence DELOBJ on |Δf|/|f|.
+    pub delobj: Option<f64>,
+    /// Absolute convergence DABOBJ on |Δf|.
+    pub dabobj: Option<f64>,
+    /// Consecutive converged iterations ITRMOP.
+    pub itrmop: Option<usize>,
+    /// Iteration limit ITMAX.
+    pub max_iterations: Option<usize>,
+    /// Kuhn–Tucker tolerance.
+    pub kt_tolerance: Option<f64>,
+}
+
+impl MmfdSettings {
+    /// Check the given values (error keys inside `[multistart.mmfd]`).
+    pub fn check(&self) -> Result<()> {
+        for (k, v) in [
+            ("delobj", self.delobj),
+            ("dabobj", self.dabobj),
+            ("kt_tolerance", self.kt_tolerance),
+        ] {
+            if let Some(v) = v {
+                crate::error::require_positive(k, v)?;
+            }
+        }
+        for (k, v) in [
+            ("itrmop", self.itrmop),
+            ("max_iterations", self.max_iterations),
+        ] {
+            if v == Some(0) {
+                return Err(Error::input(k, 0, "a count >= 1"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The full option set.
+    pub fn options(&self) -> crate::optimize::mmfd::MmfdOptions {
+        let d = crate::optimize::mmfd::MmfdOptions::default();
+        crate::optimize::mmfd::MmfdOptions {
+            delobj: self.delobj.unwrap_or(d.delobj),
+            dabobj: self.dabobj.or(d.dabobj),
+            itrmop: self.itrmop.unwrap_or(d.itrmop),
+            max_iterations: self.max_iterations.unwrap_or(d.max_iterations),
+            kt_tolerance: self.kt_tolerance.unwrap_or(d.kt_tolerance),
+            ..d
+        }
+    }
+}
+
+/// The local solver called `method` (MMFD with `mmfd`'s settings).
+pub fn local(method: &str, mmfd: &MmfdSettings) -> Result<Box<LocalSolver<'static>>> {
     check_local(method)?;
+    let options = mmfd.options();
     Ok(match method {
         "steepest" => Box::new(|p: &dyn Problem, x0: &[f64]| steepest(p, x0)),
-        _ => Box::new(|p: &dyn Problem, x0: &[f64]| {
-            let _ = (p, x0, NoObserver);
-            Err(Error::input("method", "\"mmfd\"", "PENDING-MERGE"))
+        _ => Box::new(move |p: &dyn Problem, x0: &[f64]| {
+            crate::optimize::mmfd::minimize(p, x0, &options, &mut NoObserver)
         }),
     })
 }
