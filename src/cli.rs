@@ -195,9 +195,10 @@ fn explore_context(
 }
 
 /// `plyscape run` handlers of the exploration drivers. Under `[compare]`
-/// the multistart and evolution run as part of the comparison.
+/// the multistart and evolution run as part of the comparison (and under
+/// `[scaling]` the multistart runs once per thread count).
 fn run_multistart_handler(cfg: &RunConfig) -> Result<()> {
-    if cfg.study.has("compare") {
+    if cfg.study.has("compare") || cfg.study.has("scaling") {
         return Ok(());
     }
     crate::explore::run_multistart(&explore_context(cfg, Default::default())).map(|_| ())
@@ -210,6 +211,9 @@ fn run_evolve_handler(cfg: &RunConfig) -> Result<()> {
 }
 fn run_compare_handler(cfg: &RunConfig) -> Result<()> {
     crate::explore::run_compare(&explore_context(cfg, Default::default())).map(|_| ())
+}
+fn run_scaling_handler(cfg: &RunConfig) -> Result<()> {
+    crate::explore::scaling::run_scaling(&explore_context(cfg, Default::default())).map(|_| ())
 }
 fn run_map_handler(cfg: &RunConfig) -> Result<()> {
     crate::explore::run_map(&explore_context(cfg, Default::default())).map(|_| ())
@@ -228,6 +232,7 @@ fn handlers() -> Vec<(&'static str, Handler)> {
         ("multistart", run_multistart_handler),
         ("evolve", run_evolve_handler),
         ("compare", run_compare_handler),
+        ("scaling", run_scaling_handler),
         ("map", run_map_handler),
     ]
 }

@@ -18,7 +18,8 @@
 //!
 //! Study sections read here: `[problem]` ([`problems::ProblemSpec`]),
 //! `[multistart]` ([`MultistartSection`]), `[evolve]` ([`EvolveSection`]),
-//! `[compare]` (no keys) and `[map]` ([`MapSection`]).
+//! `[compare]` (no keys), `[map]` ([`MapSection`]) and `[scaling]`
+//! ([`scaling::ScalingSection`]).
 
 pub mod cluster;
 pub mod evolve;
@@ -26,6 +27,7 @@ pub mod map;
 pub mod multistart;
 pub mod problems;
 pub mod sampling;
+pub mod scaling;
 pub mod solvers;
 pub mod tables;
 
@@ -66,12 +68,14 @@ pub struct MultistartSection {
     /// DELOBJ = 1e-3 stops that far from the exact optimum on flat valleys).
     #[serde(default = "default_x_tol")]
     pub x_tolerance: f64,
-    /// Same optimum: `|Δf| <= f_tolerance · max(1, |f|)` (default 1e-3,
-    /// DOT's DELOBJ).
+    /// Same optimum: `|Δf| <= f_tolerance · max(1, |f|)` (default 1e-2:
+    /// ten times DOT's DELOBJ, since runs that end on active constraints
+    /// within CTMIN differ in f by that much; distinct optima are told apart
+    /// by `x_tolerance`).
     #[serde(default = "default_f_tol")]
     pub f_tolerance: f64,
-    /// Feasible: `max g <= feasibility_tolerance` (default 1e-4, the order of
-    /// MMFD's final constraint tolerance).
+    /// Feasible: `max g <= feasibility_tolerance` (default 3e-3, DOT's
+    /// CTMIN, the violation MMFD accepts at its optimum).
     #[serde(default = "default_feas_tol")]
     pub feasibility_tolerance: f64,
     /// MMFD convergence settings (`[multistart.mmfd]`; DOT defaults).
@@ -89,10 +93,10 @@ fn default_x_tol() -> f64 {
     1e-2
 }
 fn default_f_tol() -> f64 {
-    1e-3
+    1e-2
 }
 fn default_feas_tol() -> f64 {
-    1e-4
+    3e-3
 }
 
 /// The `[evolve]` section.
