@@ -47,7 +47,7 @@ fn killed_multistart_resumes_to_the_same_tables() {
     child.wait().unwrap();
     let rows_at_kill = std::fs::read_to_string(&runs).unwrap().lines().count() - 1;
     assert!(
-        rows_at_kill >= 3 && rows_at_kill < 24,
+        (3..24).contains(&rows_at_kill),
         "{rows_at_kill} rows at kill"
     );
 
