@@ -198,3 +198,67 @@ fn bad_input_is_an_input_error() {
     let e = mmfd::minimize(&p, &[f64::NAN, 0.0, 0.0], &d, &mut History::default()).unwrap_err();
     assert_eq!(e.exit_code(), 2);
 }
+
+/// A problem that returns NaN beyond x > 1 and too few constraint values
+/// on request: the solver reports a numerical error instead of panicking.
+struct Broken {
+    vars: Vec<plyscape::optimize::Variable>,
+    short_g: bool,
+}
+
+impl Problem for Broken {
+    fn variables(&self) -> &[plyscape::optimize::Variable] {
+        &self.vars
+    }
+    fn n_constraints(&self) -> usize {
+        1
+    }
+    fn evaluate(
+        &self,
+        x: &[f64],
+        gradients: bool,
+    ) -> plyscape::Result<plyscape::optimize::Evaluation> {
+        let f = if x[0] > 1.0 { f64::NAN } else { -x[0] };
+        let g = if self.short_g { vec![] } else { vec![-1.0] };
+        Ok(plyscape::optimize::Evaluation {
+            f,
+            g,
+            grad_f: gradients.then(|| vec![-1.0]),
+            grad_g: gradients.then(|| vec![vec![0.0]]),
+        })
+    }
+}
+
+#[test]
+fn broken_problems_give_numerical_errors() {
+    let vars = vec![plyscape::optimize::Variable::bounded("x", 0.0, 3.0).unwrap()];
+    for short_g in [false, true] {
+        let p = Broken {
+            vars: vars.clone(),
+            short_g,
+        };
+        let e = mmfd::minimize(&p, &[0.5], &MmfdOptions::default(), &mut History::default())
+            .unwrap_err();
+        assert_eq!(e.exit_code(), 3, "{e}");
+    }
+}
+
+/// The engine is a genuine argmin solver: argmin's own Executor drives it
+/// to the same optimum as `minimize` (HS 35, f* = 1/9).
+#[test]
+fn argmin_executor_runs_the_mmfd_solver() {
+    use argmin::core::{Executor, State};
+    use plyscape::optimize::driver::OptState;
+    use plyscape::optimize::Counted;
+    let p = tp::hs35();
+    let d = MmfdOptions::default();
+    let solver = mmfd::Mmfd::new(&p, &p.x0, d.clone()).unwrap();
+    let res = Executor::new(Counted::new(&p), solver)
+        .configure(|s: OptState| s.max_iters(50))
+        .run()
+        .unwrap();
+    let direct = mmfd::minimize(&p, &p.x0, &d, &mut History::default()).unwrap();
+    let x = res.state().get_param().unwrap();
+    assert_eq!(x, &direct.x);
+    assert!((res.state().get_cost() - 1.0 / 9.0).abs() < 1e-4);
+}

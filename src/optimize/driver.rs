@@ -8,7 +8,7 @@
 //! iteration counter like the executor does. The solvers hold the last
 //! [`IterRecord`]; only this loop passes it on.
 
-use super::{Counted, IterRecord, Observer};
+use super::{Counted, Evaluation, IterRecord, Observer};
 use crate::error::{Error, Result};
 use argmin::core::{IterState, Problem as ArgminProblem, Solver, State};
 
@@ -28,6 +28,45 @@ pub fn from_argmin(e: argmin::core::Error) -> Error {
         Ok(err) => err,
         Err(other) => Error::numerical("optimize (argmin)", other.to_string()),
     }
+}
+
+/// Check that an evaluation has the sizes the problem declared and finite
+/// values: `g` of length m, `grad_f` of length n and `grad_g` m × n when
+/// gradients were asked for. Violations are numerical errors at `place`.
+pub fn check_evaluation(
+    ev: &Evaluation,
+    x: &[f64],
+    m: usize,
+    gradients: bool,
+    place: &str,
+) -> Result<()> {
+    let n = x.len();
+    let fail = |d: String| Err(Error::numerical(place, format!("{d} at x = {x:?}")));
+    if ev.g.len() != m {
+        return fail(format!("{} constraint values, expected {m}", ev.g.len()));
+    }
+    if !ev.f.is_finite() || ev.g.iter().any(|v| !v.is_finite()) {
+        return fail(format!("non-finite f = {} or g = {:?}", ev.f, ev.g));
+    }
+    if gradients {
+        match &ev.grad_f {
+            Some(gf) if gf.len() == n && gf.iter().all(|v| v.is_finite()) => {}
+            _ => return fail("missing, mis-sized or non-finite grad_f".into()),
+        }
+        let ok = match &ev.grad_g {
+            Some(gg) => {
+                gg.len() == m
+                    && gg
+                        .iter()
+                        .all(|r| r.len() == n && r.iter().all(|v| v.is_finite()))
+            }
+            None => m == 0,
+        };
+        if !ok {
+            return fail("missing, mis-sized or non-finite grad_g".into());
+        }
+    }
+    Ok(())
 }
 
 /// Run `solver` from `state` to termination, feeding `observer`.

@@ -215,12 +215,12 @@ fn evaluate(problem: &mut Ap<'_>, x: &[f64], gradients: bool) -> Result<Evaluati
             c.evaluate(x, gradients).map_err(argmin::core::Error::from)
         })
         .map_err(driver::from_argmin)?;
-    if !ev.f.is_finite() || ev.g.iter().any(|v| !v.is_finite()) {
-        return Err(Error::numerical(
-            "optimize::mmfd",
-            format!("non-finite f = {} or g = {:?} at x = {x:?}", ev.f, ev.g),
-        ));
-    }
+    let m = problem
+        .problem
+        .as_ref()
+        .map(|c| c.n_constraints())
+        .unwrap_or(0);
+    driver::check_evaluation(&ev, x, m, gradients, "optimize::mmfd")?;
     Ok(ev)
 }
 

@@ -13,6 +13,7 @@
 use crate::error::{Error, Result};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+pub mod cmaes;
 pub mod driver;
 pub mod mmfd;
 pub mod qp;
@@ -246,6 +247,8 @@ pub enum Termination {
     Stagnation,
     /// Could not reach the feasible region.
     Infeasible,
+    /// A feasible design reached the requested target objective.
+    TargetReached,
 }
 
 impl std::fmt::Display for Termination {
@@ -259,6 +262,7 @@ impl std::fmt::Display for Termination {
             Termination::MaxEvaluations => "max_evaluations",
             Termination::Stagnation => "stagnation",
             Termination::Infeasible => "infeasible",
+            Termination::TargetReached => "target_reached",
         };
         f.write_str(s)
     }

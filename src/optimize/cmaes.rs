@@ -1,0 +1,571 @@
+//! CMA-ES (covariance matrix adaptation evolution strategy) with IPOP
+//! restarts, as an argmin [`Solver`]: the global comparison method of the
+//! exploration (NUMERICS.md, "Responses and optimization").
+//!
+//! Method: N. Hansen, *The CMA Evolution Strategy: A Tutorial*
+//! (arXiv:1604.00772, 2016), with the default parameters of its Table 1
+//! (weights `ln((λ+1)/2) − ln i` on the best μ = ⌊λ/2⌋, cumulation `c_σ`,
+//! `c_c`, rank-one `c_1`, rank-μ `c_μ`, damping `d_σ`) and the `h_σ` stall
+//! of the evolution path; restarts with doubled population (IPOP-CMA-ES,
+//! Auger & Hansen, CEC 2005) from a uniformly random mean in the box.
+//!
+//! Search space: range-scaled `y = (x − lower)/range ∈ [0, 1]ⁿ`, so σ is a
+//! fraction of each variable's range (σ0 = 0.3 by default) and every
+//! generation's σ is what [`IterRecord::step`] reports. A periodic variable
+//! is simply wrapped when a sample is evaluated (the distribution lives on
+//! the line, the problem on the circle). A non-periodic sample outside its
+//! box is evaluated at its projection onto the box, and the distance to the
+//! box counts as a violation (below).
+//!
+//! Constraints by Deb's feasibility rules (K. Deb, *Comput. Methods Appl.
+//! Mech. Engrg.* 186 (2000) 311): the violation `v = Σ_j max(0, g_j) + Σ_i
+//! dist(y_i, [0, 1])` orders samples; any feasible sample (v = 0) beats any
+//! infeasible one, feasible samples compare by f, infeasible ones by v.
+//! No penalty constant is involved, and the reported best is the best
+//! feasible design seen (the least violating one if none was feasible).
+//!
+//! Parallelism: each generation is one batch call; the batch evaluator is
+//! the only place that uses rayon (`par_iter` then collect in index order),
+//! and everything random happens before it, so a seed gives the same run
+//! bit for bit on any number of threads.
+
+use super::driver::{self, OptState, Recorded};
+use super::{Counted, Evaluation, GlobalOutcome, IterRecord, Observer, Problem, Termination};
+use crate::error::{Error, Result};
+use argmin::core::{
+    Problem as ArgminProblem, Solver, State, TerminationReason, TerminationStatus, KV,
+};
+use nalgebra::{DMatrix, DVector};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+/// CMA-ES parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CmaesOptions {
+    /// Seed of the ChaCha8 generator: the same seed gives the same run.
+    pub seed: u64,
+    /// Evaluation budget over all restarts; a generation that would exceed
+    /// it is not started.
+    pub max_evaluations: usize,
+    /// Initial step size as a fraction of each variable's range: 0.3
+    /// (Hansen recommends about a quarter to a third of the search interval).
+    pub sigma0: f64,
+    /// Population of the first run; `None`: `4 + ⌊3 ln n⌋` (Hansen, Table 1).
+    pub popsize: Option<usize>,
+    /// IPOP restarts after the first run (each doubles the population): 9.
+    pub max_restarts: usize,
+    /// Population growth factor per restart: 2 (IPOP).
+    pub popsize_factor: f64,
+    /// Mean of the first run; `None`: uniformly random in the box. Restarts
+    /// always start from a uniformly random mean.
+    pub x0: Option<Vec<f64>>,
+    /// Restart when the best f of the last `10 + ⌈30 n/λ⌉` generations and
+    /// all f of the current one lie within this range (TolFun): 1e-12.
+    pub tol_fun: f64,
+    /// Restart when `σ · max(√C_ii, |p_c|)` falls below this (TolX, in
+    /// range units): 1e-12.
+    pub tol_x: f64,
+    /// Stop when a feasible design reaches this objective (`None`: never).
+    pub target: Option<f64>,
+}
+
+impl Default for CmaesOptions {
+    fn default() -> Self {
+        CmaesOptions {
+            seed: 1,
+            max_evaluations: 10_000,
+            sigma0: 0.3,
+            popsize: None,
+            max_restarts: 9,
+            popsize_factor: 2.0,
+            x0: None,
+            tol_fun: 1e-12,
+            tol_x: 1e-12,
+            target: None,
+        }
+    }
+}
+
+impl CmaesOptions {
+    fn validate(&self, n: usize) -> Result<()> {
+        let bad = |k: &str, v: String, e: &str| Err(Error::input(format!("cmaes.{k}"), v, e));
+        if !(self.sigma0 > 0.0 && self.sigma0.is_finite()) {
+            return bad("sigma0", self.sigma0.to_string(), "a finite value > 0");
+        }
+        if !(self.popsize_factor >= 1.0 && self.popsize_factor.is_finite()) {
+            return bad(
+                "popsize_factor",
+                self.popsize_factor.to_string(),
+                "a factor >= 1",
+            );
+        }
+        if let Some(p) = self.popsize {
+            if p < 2 {
+                return bad("popsize", p.to_string(), "at least 2");
+            }
+        }
+        if self.max_evaluations == 0 {
+            return bad("max_evaluations", "0".into(), "at least one evaluation");
+        }
+        for (k, v) in [("tol_fun", self.tol_fun), ("tol_x", self.tol_x)] {
+            if !(v >= 0.0 && v.is_finite()) {
+                return bad(k, v.to_string(), "a finite value >= 0");
+            }
+        }
+        if let Some(x0) = &self.x0 {
+            if x0.len() != n || x0.iter().any(|v| !v.is_finite()) {
+                return bad("x0", format!("{x0:?}"), &format!("{n} finite values"));
+            }
+        }
+        if n == 0 {
+            return bad("variables", "0".into(), "at least one design variable");
+        }
+        Ok(())
+    }
+}
+
+/// Evaluate a batch of designs, in parallel, results in input order. The
+/// only parallel code of the solver.
+pub fn evaluate_batch(problem: &dyn Problem, xs: &[Vec<f64>]) -> Result<Vec<Evaluation>> {
+    xs.par_iter().map(|x| problem.evaluate(x, false)).collect()
+}
+
+/// A ranked sample.
+#[derive(Debug, Clone)]
+struct Sample {
+    /// Scaled, unrepaired point (what the distribution produced).
+    y: Vec<f64>,
+    /// The design evaluated (wrapped / clamped).
+    x: Vec<f64>,
+    f: f64,
+    g: Vec<f64>,
+    violation: f64,
+}
+
+/// Deb's order: feasible by f before infeasible by violation.
+fn better(a: &Sample, b: &Sample) -> std::cmp::Ordering {
+    match (a.violation <= 0.0, b.violation <= 0.0) {
+        (true, true) => a.f.total_cmp(&b.f),
+        (true, false) => std::cmp::Ordering::Less,
+        (false, true) => std::cmp::Ordering::Greater,
+        (false, false) => a.violation.total_cmp(&b.violation),
+    }
+}
+
+/// Strategy parameters for one population size (Hansen 2016, Table 1).
+struct Params {
+    lambda: usize,
+    weights: Vec<f64>,
+    mueff: f64,
+    cs: f64,
+    ds: f64,
+    cc: f64,
+    c1: f64,
+    cmu: f64,
+    chi_n: f64,
+}
+
+impl Params {
+    fn new(n: usize, lambda: usize) -> Params {
+        let nf = n as f64;
+        let mu = lambda / 2;
+        let raw: Vec<f64> = (1..=mu)
+            .map(|i| ((lambda as f64 + 1.0) / 2.0).ln() - (i as f64).ln())
+            .collect();
+        let sum: f64 = raw.iter().sum();
+        let weights: Vec<f64> = raw.iter().map(|w| w / sum).collect();
+        let mueff = 1.0 / weights.iter().map(|w| w * w).sum::<f64>();
+        let cs = (mueff + 2.0) / (nf + mueff + 5.0);
+        let ds = 1.0 + 2.0 * (((mueff - 1.0) / (nf + 1.0)).sqrt() - 1.0).max(0.0) + cs;
+        let cc = (4.0 + mueff / nf) / (nf + 4.0 + 2.0 * mueff / nf);
+        let c1 = 2.0 / ((nf + 1.3).powi(2) + mueff);
+        let cmu = (1.0 - c1).min(2.0 * (mueff - 2.0 + 1.0 / mueff) / ((nf + 2.0).powi(2) + mueff));
+        let chi_n = nf.sqrt() * (1.0 - 1.0 / (4.0 * nf) + 1.0 / (21.0 * nf * nf));
+        Params {
+            lambda,
+            weights,
+            mueff,
+            cs,
+            ds,
+            cc,
+            c1,
+            cmu,
+            chi_n,
+        }
+    }
+}
+
+/// The state of one CMA-ES run (between restarts).
+struct Run {
+    p: Params,
+    mean: DVector<f64>,
+    sigma: f64,
+    cov: DMatrix<f64>,
+    /// Eigenvectors B and axis lengths D of C = B D² Bᵀ.
+    b: DMatrix<f64>,
+    d: DVector<f64>,
+    ps: DVector<f64>,
+    pc: DVector<f64>,
+    generation: usize,
+    best_history: Vec<f64>,
+}
+
+impl Run {
+    fn new(n: usize, lambda: usize, mean: Vec<f64>, sigma: f64) -> Run {
+        Run {
+            p: Params::new(n, lambda),
+            mean: DVector::from_vec(mean),
+            sigma,
+            cov: DMatrix::identity(n, n),
+            b: DMatrix::identity(n, n),
+            d: DVector::from_element(n, 1.0),
+            ps: DVector::zeros(n),
+            pc: DVector::zeros(n),
+            generation: 0,
+            best_history: Vec::new(),
+        }
+    }
+}
+
+/// CMA-ES engine; one `next_iter` is one generation.
+pub struct Cmaes {
+    options: CmaesOptions,
+    rng: ChaCha8Rng,
+    lower: Vec<f64>,
+    range: Vec<f64>,
+    periodic: Vec<bool>,
+    run: Option<Run>,
+    lambda0: usize,
+    restarts: usize,
+    generations: usize,
+    best: Option<Sample>,
+    termination: Option<Termination>,
+    record: Option<IterRecord>,
+}
+
+/// One standard normal number by the Box–Muller transform.
+fn normal(rng: &mut ChaCha8Rng) -> f64 {
+    let u1: f64 = 1.0 - rng.random::<f64>(); // (0, 1]
+    let u2: f64 = rng.random::<f64>();
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
+impl Cmaes {
+    /// A solver for `problem` (validates the options).
+    pub fn new(problem: &dyn Problem, options: CmaesOptions) -> Result<Cmaes> {
+        let vars = problem.variables();
+        let n = vars.len();
+        options.validate(n)?;
+        let lambda0 = options
+            .popsize
+            .unwrap_or(4 + (3.0 * (n as f64).ln()).floor() as usize);
+        Ok(Cmaes {
+            rng: ChaCha8Rng::seed_from_u64(options.seed),
+            lower: vars.iter().map(|v| v.lower).collect(),
+            range: vars.iter().map(|v| v.upper - v.lower).collect(),
+            periodic: vars.iter().map(|v| v.period.is_some()).collect(),
+            options,
+            run: None,
+            lambda0,
+            restarts: 0,
+            generations: 0,
+            best: None,
+            termination: None,
+            record: None,
+        })
+    }
+
+    fn n(&self) -> usize {
+        self.lower.len()
+    }
+
+    fn start_run(&mut self) {
+        let n = self.n();
+        let lambda = ((self.lambda0 as f64)
+            * self.options.popsize_factor.powi(self.restarts as i32))
+        .round() as usize;
+        let mean: Vec<f64> = match (&self.options.x0, self.run.is_none() && self.restarts == 0) {
+            (Some(x0), true) => (0..n)
+                .map(|i| (x0[i] - self.lower[i]) / self.range[i])
+                .collect(),
+            _ => (0..n).map(|_| self.rng.random::<f64>()).collect(),
+        };
+        self.run = Some(Run::new(n, lambda.max(2), mean, self.options.sigma0));
+    }
+
+    /// Map a scaled sample to the design evaluated and its box violation.
+    fn to_design(&self, y: &[f64]) -> (Vec<f64>, f64) {
+        let mut viol = 0.0;
+        let x = y
+            .iter()
+            .enumerate()
+            .map(|(i, &yi)| {
+                if self.periodic[i] {
+                    let p = self.range[i];
+                    let v = self.lower[i] + (yi * p).rem_euclid(p);
+                    if v >= self.lower[i] + p {
+                        self.lower[i]
+                    } else {
+                        v
+                    }
+                } else {
+                    let c = yi.clamp(0.0, 1.0);
+                    viol += (yi - c).abs();
+                    self.lower[i] + c * self.range[i]
+                }
+            })
+            .collect();
+        (x, viol)
+    }
+
+    /// One generation: sample, evaluate as a batch, rank, update.
+    fn generation(&mut self, problem: &mut ArgminProblem<Counted<'_>>) -> Result<()> {
+        let n = self.n();
+        if self.run.is_none() {
+            self.start_run();
+        }
+        let lambda = self.run.as_ref().map(|r| r.p.lambda).unwrap_or(2);
+        let used = problem
+            .problem
+            .as_ref()
+            .map(|c| c.function_calls())
+            .unwrap_or(0);
+        if used + lambda > self.options.max_evaluations {
+            self.termination = Some(Termination::MaxEvaluations);
+            return Ok(());
+        }
+        // Sample (sequential, seeded).
+        let mut zs = Vec::with_capacity(lambda);
+        let mut ys = Vec::with_capacity(lambda);
+        {
+            let run = self.run.as_ref().expect("run started");
+            for _ in 0..lambda {
+                let z = DVector::from_fn(n, |_, _| normal(&mut self.rng));
+                let y = &run.mean + run.sigma * (&run.b * run.d.component_mul(&z));
+                zs.push(z);
+                ys.push(y);
+            }
+        }
+        let designs: Vec<(Vec<f64>, f64)> =
+            ys.iter().map(|y| self.to_design(y.as_slice())).collect();
+        let xs: Vec<Vec<f64>> = designs.iter().map(|d| d.0.clone()).collect();
+        let evals = problem
+            .bulk_problem("cost_count", lambda, |c| {
+                evaluate_batch(c, &xs).map_err(argmin::core::Error::from)
+            })
+            .map_err(driver::from_argmin)?;
+        let m = problem
+            .problem
+            .as_ref()
+            .map(|c| c.n_constraints())
+            .unwrap_or(0);
+        let mut samples: Vec<Sample> = Vec::with_capacity(lambda);
+        for (k, ev) in evals.into_iter().enumerate() {
+            driver::check_evaluation(&ev, &xs[k], m, false, "optimize::cmaes")?;
+            let violation = designs[k].1 + ev.g.iter().map(|g| g.max(0.0)).sum::<f64>();
+            samples.push(Sample {
+                y: ys[k].as_slice().to_vec(),
+                x: xs[k].clone(),
+                f: ev.f,
+                g: ev.g,
+                violation,
+            });
+        }
+        let mut order: Vec<usize> = (0..lambda).collect();
+        order.sort_by(|&a, &b| better(&samples[a], &samples[b]).then(a.cmp(&b)));
+        let top = &samples[order[0]];
+        if self.best.as_ref().is_none_or(|b| better(top, b).is_lt()) {
+            self.best = Some(top.clone());
+        }
+        self.update(&samples, &order);
+        self.generations += 1;
+        let best = self.best.as_ref().expect("a best sample");
+        let (fc, gc) = problem
+            .problem
+            .as_ref()
+            .map(|c| (c.function_calls(), c.gradient_calls()))
+            .unwrap_or((0, 0));
+        let sigma = self.run.as_ref().map(|r| r.sigma).unwrap_or(0.0);
+        self.record = Some(IterRecord {
+            iteration: self.generations - 1,
+            x: best.x.clone(),
+            f: best.f,
+            max_g: best.g.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            step: sigma,
+            function_calls: fc,
+            gradient_calls: gc,
+        });
+        if let Some(t) = self.options.target {
+            if best.violation <= 0.0 && best.f <= t {
+                self.termination = Some(Termination::TargetReached);
+                return Ok(());
+            }
+        }
+        if let Some(stop) = self.run_should_stop(&samples) {
+            if self.restarts >= self.options.max_restarts {
+                self.termination = Some(stop);
+            } else {
+                self.restarts += 1;
+                self.run = None;
+            }
+        }
+        Ok(())
+    }
+
+    /// Hansen's update of mean, paths, covariance and step size.
+    fn update(&mut self, samples: &[Sample], order: &[usize]) {
+        let n = self.n();
+        let run = self.run.as_mut().expect("run started");
+        let p = &run.p;
+        let old_mean = run.mean.clone();
+        let steps: Vec<DVector<f64>> = order
+            .iter()
+            .take(p.weights.len())
+            .map(|&k| (DVector::from_column_slice(&samples[k].y) - &old_mean) / run.sigma)
+            .collect();
+        let mut yw = DVector::zeros(n);
+        for (w, s) in p.weights.iter().zip(&steps) {
+            yw += *w * s;
+        }
+        run.mean = &old_mean + run.sigma * &yw;
+        // C^{-1/2} y_w = B D⁻¹ Bᵀ y_w
+        let bt_yw = run.b.transpose() * &yw;
+        let inv_sqrt = &run.b * bt_yw.component_div(&run.d);
+        run.ps = (1.0 - p.cs) * &run.ps + (p.cs * (2.0 - p.cs) * p.mueff).sqrt() * inv_sqrt;
+        let gen = (run.generation + 1) as f64;
+        let ps_norm = run.ps.norm();
+        let hsig = ps_norm / (1.0 - (1.0 - p.cs).powf(2.0 * gen)).sqrt()
+            < (1.4 + 2.0 / (n as f64 + 1.0)) * p.chi_n;
+        let h = if hsig { 1.0 } else { 0.0 };
+        run.pc = (1.0 - p.cc) * &run.pc + h * (p.cc * (2.0 - p.cc) * p.mueff).sqrt() * &yw;
+        let mut rank_mu = DMatrix::zeros(n, n);
+        for (w, s) in p.weights.iter().zip(&steps) {
+            rank_mu += *w * (s * s.transpose());
+        }
+        let decay = 1.0 - p.c1 - p.cmu + (1.0 - h) * p.c1 * p.cc * (2.0 - p.cc);
+        run.cov = decay * &run.cov + p.c1 * (&run.pc * run.pc.transpose()) + p.cmu * rank_mu;
+        run.cov = 0.5 * (&run.cov + run.cov.transpose());
+        run.sigma *= ((p.cs / p.ds) * (ps_norm / p.chi_n - 1.0)).exp();
+        let eig = run.cov.clone().symmetric_eigen();
+        run.b = eig.eigenvectors;
+        run.d = eig.eigenvalues.map(|l| l.max(1e-300).sqrt());
+        run.generation += 1;
+        let best = &samples[order[0]];
+        run.best_history.push(if best.violation <= 0.0 {
+            best.f
+        } else {
+            f64::INFINITY
+        });
+    }
+
+    /// Restart criteria of one run (Hansen 2016, App. B.3): TolFun, TolX,
+    /// condition of C above 1e14, no effect of an axis or a coordinate,
+    /// generation limit `100 + 150 (n+3)²/√λ`.
+    fn run_should_stop(&self, samples: &[Sample]) -> Option<Termination> {
+        let run = self.run.as_ref()?;
+        let n = self.n();
+        let lambda = run.p.lambda;
+        let hist_len = 10 + (30.0 * n as f64 / lambda as f64).ceil() as usize;
+        let all_feasible = samples.iter().all(|s| s.violation <= 0.0);
+        if all_feasible && run.best_history.len() >= hist_len {
+            let recent = &run.best_history[run.best_history.len() - hist_len..];
+            let (lo, hi) = recent
+                .iter()
+                .chain(samples.iter().map(|s| &s.f))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(v), hi.max(v))
+                });
+            if hi - lo <= self.options.tol_fun {
+                return Some(Termination::Stagnation);
+            }
+        }
+        let max_sd = (0..n).map(|i| run.cov[(i, i)].sqrt()).fold(0.0, f64::max);
+        if run.sigma * max_sd.max(run.pc.amax()) < self.options.tol_x {
+            return Some(Termination::Stagnation);
+        }
+        let dmax = run.d.max();
+        let dmin = run.d.min();
+        if dmin.is_nan() || dmin <= 0.0 || (dmax / dmin).powi(2) > 1e14 || !run.sigma.is_finite() {
+            return Some(Termination::Stagnation);
+        }
+        // No effect of the principal axis of this generation / coordinates.
+        let axis = run.generation % n;
+        let shift = 0.1 * run.sigma * run.d[axis] * run.b.column(axis);
+        if (0..n).all(|i| run.mean[i] + shift[i] == run.mean[i]) {
+            return Some(Termination::Stagnation);
+        }
+        if (0..n).any(|i| run.mean[i] + 0.2 * run.sigma * run.cov[(i, i)].sqrt() == run.mean[i]) {
+            return Some(Termination::Stagnation);
+        }
+        let max_gen = 100.0 + 150.0 * ((n + 3) as f64).powi(2) / (lambda as f64).sqrt();
+        if run.generation as f64 >= max_gen {
+            return Some(Termination::Stagnation);
+        }
+        None
+    }
+}
+
+impl Recorded for Cmaes {
+    fn take_record(&mut self) -> Option<IterRecord> {
+        self.record.take()
+    }
+}
+
+impl<'a> Solver<Counted<'a>, OptState> for Cmaes {
+    fn name(&self) -> &str {
+        "IPOP-CMA-ES"
+    }
+
+    fn next_iter(
+        &mut self,
+        problem: &mut ArgminProblem<Counted<'a>>,
+        state: OptState,
+    ) -> std::result::Result<(OptState, Option<KV>), argmin::core::Error> {
+        self.generation(problem)
+            .map_err(argmin::core::Error::from)?;
+        let state = match &self.best {
+            Some(b) => state.param(b.x.clone()).cost(b.f),
+            None => state,
+        };
+        Ok((state, None))
+    }
+
+    fn terminate(&mut self, _state: &OptState) -> TerminationStatus {
+        match &self.termination {
+            Some(t) => TerminationStatus::Terminated(TerminationReason::SolverExit(t.to_string())),
+            None => TerminationStatus::NotTerminated,
+        }
+    }
+}
+
+/// Minimize `problem` with IPOP-CMA-ES within `options.max_evaluations`;
+/// one record per generation (best-so-far design, σ in `step`) goes to
+/// `observer`.
+pub fn minimize(
+    problem: &dyn Problem,
+    options: &CmaesOptions,
+    observer: &mut dyn Observer,
+) -> Result<GlobalOutcome> {
+    let mut solver = Cmaes::new(problem, options.clone())?;
+    let mut ap = ArgminProblem::new(Counted::new(problem));
+    driver::run(&mut solver, &mut ap, OptState::new(), observer)?;
+    let function_calls = ap.problem.as_ref().map(|c| c.function_calls()).unwrap_or(0);
+    let best = solver.best.clone().ok_or_else(|| {
+        Error::input(
+            "cmaes.max_evaluations",
+            options.max_evaluations,
+            "a budget of at least one generation",
+        )
+    })?;
+    Ok(GlobalOutcome {
+        feasible: best.violation <= 0.0,
+        x: best.x,
+        f: best.f,
+        g: best.g,
+        function_calls,
+        generations: solver.generations,
+        restarts: solver.restarts,
+        termination: solver.termination.unwrap_or(Termination::MaxEvaluations),
+    })
+}
