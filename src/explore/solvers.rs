@@ -103,8 +103,12 @@ pub fn local(method: &str, mmfd: &MmfdSettings) -> Result<Box<LocalSolver<'stati
 pub fn global() -> Box<GlobalSolver<'static>> {
     Box::new(
         |p: &dyn Problem, r: &Request, obs: &mut dyn crate::optimize::Observer| {
-            let _ = (p, r, obs);
-            Err(Error::input("evolve", "cmaes", "PENDING-MERGE"))
+            let options = crate::optimize::cmaes::CmaesOptions {
+                seed: r.seed,
+                max_evaluations: r.max_evaluations,
+                ..Default::default()
+            };
+            crate::optimize::cmaes::minimize(p, &options, obs)
         },
     )
 }

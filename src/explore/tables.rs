@@ -60,9 +60,15 @@ pub struct RunRecord {
     pub optimum: Option<usize>,
 }
 
-/// Shortest round-trip text of a float (never NaN: callers check).
+/// Shortest round-trip text of a float (never NaN: callers check):
+/// positional for `1e-4 <= |x| < 1e15` and zero, scientific otherwise.
 pub fn num(x: f64) -> String {
-    format!("{x}")
+    let a = x.abs();
+    if x == 0.0 || (1e-4..1e15).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 fn opt_num(x: Option<f64>) -> String {
@@ -351,6 +357,25 @@ mod tests {
             wall_seconds: 0.125,
             optimum: None,
         }
+    }
+
+    #[test]
+    fn numbers_round_trip_exactly() {
+        for x in [
+            0.0,
+            -0.0,
+            1e-300,
+            -2.5e-17,
+            1.0 / 3.0,
+            123456.789,
+            1e15,
+            5e-324,
+            f64::MAX,
+        ] {
+            assert_eq!(num(x).parse::<f64>().unwrap().to_bits(), x.to_bits(), "{x}");
+        }
+        assert_eq!(num(1.5e-14), "1.5e-14");
+        assert_eq!(num(0.25), "0.25");
     }
 
     #[test]
