@@ -123,3 +123,42 @@ fn evolution_table_and_map_match_direct_evaluation() {
     assert!(mean.iter().all(|m| !m.is_empty()));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn more_than_two_variables_get_slices_through_the_base_design() {
+    let dir = temp_dir("cmp-slices");
+    let s = study(
+        "r",
+        "[study]\nname = \"r\"\n[problem]\nname = \"rosenbrock\"\ndimension = 4\n\
+         [map]\nresolution = 5\npairs = [[0, 1], [3, 2]]\n",
+    );
+    let slices = explore::run_map(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    assert_eq!(slices.len(), 2);
+    let p = explore::problem(&s).unwrap();
+    let centre: Vec<f64> = p
+        .variables()
+        .iter()
+        .map(|v| 0.5 * (v.lower + v.upper))
+        .collect();
+    // Slice (3, 2): x3 along the first axis, x2 along the second, x0 and x1
+    // at the box centre (no optima yet).
+    let t = table_without(&dir.join("r/map_3_2.csv"), &[]);
+    assert_eq!(t.len(), 1 + 25);
+    for row in &t[1..] {
+        let mut x = centre.clone();
+        x[3] = row[0].parse().unwrap();
+        x[2] = row[1].parse().unwrap();
+        assert_eq!(
+            row[2].parse::<f64>().unwrap(),
+            p.evaluate(&x, false).unwrap().f
+        );
+    }
+    assert!(dir.join("r/map_0_1.svg").exists());
+    let bad = study(
+        "b",
+        "[problem]\nname = \"rosenbrock\"\ndimension = 4\n[map]\npairs = [[0, 4]]\n",
+    );
+    let e = explore::run_map(&ctx(&bad, &dir, 1, DriveFlags::default())).unwrap_err();
+    assert!(e.to_string().contains("map.pairs[0]"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
