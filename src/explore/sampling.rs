@@ -408,6 +408,28 @@ mod tests {
     }
 
     #[test]
+    fn feasible_filter_keeps_only_feasible_starts_and_is_seeded() {
+        use crate::explore::problems::Hs22;
+        let p = Hs22::new();
+        let spec = StartsSpec {
+            sampler: "sobol".into(),
+            count: 20,
+            points: vec![vec![0.0, 1.0], vec![4.0, 4.0]],
+            feasible_only: true,
+        };
+        let s = spec.generate(&p, 9).unwrap();
+        // The listed (0, 1) is feasible and kept first; (4, 4) is not.
+        assert_eq!(s.points.len(), 21);
+        assert_eq!(s.points[0], vec![0.0, 1.0]);
+        for x in &s.points {
+            assert!(p.evaluate(x, false).unwrap().max_g() <= 0.0);
+        }
+        assert!(s.filter_evaluations > 21);
+        assert_eq!(spec.generate(&p, 9).unwrap(), s);
+        assert_ne!(spec.generate(&p, 10).unwrap(), s);
+    }
+
+    #[test]
     fn periodic_coordinates_stay_in_their_box() {
         let vars = vec![Variable::periodic("t", -90.0, 180.0).unwrap()];
         let mut rng = ChaCha8Rng::seed_from_u64(0);
