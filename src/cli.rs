@@ -45,7 +45,7 @@ pub enum Command {
     },
     /// Local optimizer from many start points; runs.csv, optima.csv.
     Multistart {
-        /// Study file (TOML) with [problem] and [multistart].
+        /// Study file (TOML) with the sections `problem` and `multistart`.
         study: PathBuf,
         #[command(flatten)]
         common: Common,
@@ -54,14 +54,14 @@ pub enum Command {
     },
     /// CMA-ES with restarts; evolution.csv.
     Evolve {
-        /// Study file (TOML) with [problem] (and optionally [evolve]).
+        /// Study file (TOML) with a `problem` section (`evolve` optional).
         study: PathBuf,
         #[command(flatten)]
         common: Common,
     },
     /// Multistart, then CMA-ES on the same budget, then comparison.csv.
     Compare {
-        /// Study file (TOML) with [problem] and [multistart].
+        /// Study file (TOML) with the sections `problem` and `multistart`.
         study: PathBuf,
         #[command(flatten)]
         common: Common,
@@ -70,17 +70,17 @@ pub enum Command {
     },
     /// Grid of f and constraints over two variables; map.csv, map.svg.
     Map {
-        /// Study file (TOML) with [problem] (and optionally [map]).
+        /// Study file (TOML) with a `problem` section (`map` optional).
         study: PathBuf,
         #[command(flatten)]
         common: Common,
     },
     /// Combine the shard directories of one multistart into one set of tables.
     Merge {
-        /// Shard directories (results/<study>/shard-<i>-of-<n>).
+        /// Shard directories (`results/STUDY/shard-I-of-N`).
         #[arg(required = true)]
         dirs: Vec<PathBuf>,
-        /// Root directory for the merged tables (written to <out>/<study>/).
+        /// Root directory for the merged tables (written to `OUT/STUDY/`).
         #[arg(long, default_value = "results")]
         out: PathBuf,
         /// No summary output.
