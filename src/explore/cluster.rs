@@ -86,7 +86,7 @@ pub fn cluster(vars: &[Variable], runs: &mut [RunRecord], tol: Tolerances) -> Ve
             None => members.push(vec![i]),
         }
     }
-    let mut optima: Vec<Optimum> = members
+    let optima: Vec<Optimum> = members
         .iter()
         .map(|m| {
             let rep = &runs[m[0]];
@@ -132,7 +132,6 @@ pub fn cluster(vars: &[Variable], runs: &mut [RunRecord], tol: Tolerances) -> Ve
         o.id = id;
         sorted.push(o);
     }
-    optima.clear();
     sorted
 }
 

@@ -743,10 +743,16 @@ pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<multistart::Re
         .filter_map(|d| crate::report::read_manifest(d).ok()?["wall_seconds"].as_f64())
         .fold(0.0, f64::max);
     let report = multistart::finish(vars, m, rows, plan.tolerances, &dir, wall)?;
+    // The manifest's thread count: the largest any shard used.
+    let threads = dirs
+        .iter()
+        .filter_map(|d| crate::report::read_manifest(d).ok()?["threads"].as_u64())
+        .max()
+        .unwrap_or(1) as usize;
     let ctx = Context {
         study: &study,
         out,
-        threads: 0,
+        threads,
         quiet,
         flags: DriveFlags::default(),
     };

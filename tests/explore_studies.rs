@@ -1,0 +1,61 @@
+//! The shipped analytic studies run end to end through `plyscape run`.
+
+mod explore_common;
+
+use explore_common::{column, table_without, temp_dir};
+use plyscape::cli::{run_study, RunConfig};
+use plyscape::study::Study;
+
+fn run(file: &str, out: &std::path::Path) -> Study {
+    let study = Study::load(file).unwrap();
+    let cfg = RunConfig {
+        study: study.clone(),
+        out: out.to_path_buf(),
+        threads: 2,
+        quiet: true,
+    };
+    run_study(&cfg).unwrap_or_else(|e| panic!("{file}: {e}"));
+    study
+}
+
+#[test]
+fn analytic_studies_run_and_find_their_known_optima() {
+    let dir = temp_dir("studies");
+    // Known optima: Himmelblau f* = 0 (Himmelblau 1972); HS 22 f* = 1 at
+    // (1, 1) (Hock & Schittkowski 1981); Periodic2 f* = -5 (closed form in
+    // explore::problems::Periodic2).
+    for (file, f_star, tol) in [
+        ("studies/himmelblau.toml", 0.0, 1e-6),
+        // MMFD ends within DOT's CTMIN = 3e-3 of the active constraints,
+        // which lowers f by up to ~2e-3 below f*.
+        ("studies/hs_constrained.toml", 1.0, 3e-3),
+        ("studies/periodic2.toml", -5.0, 1e-6),
+    ] {
+        let s = run(file, &dir);
+        let d = dir.join(s.name());
+        for f in [
+            "runs.csv",
+            "optima.csv",
+            "evolution.csv",
+            "comparison.csv",
+            "map.csv",
+            "map.svg",
+            "convergence.svg",
+            "manifest.json",
+        ] {
+            assert!(d.join(f).exists(), "{file}: {f}");
+        }
+        let t = table_without(&d.join("comparison.csv"), &[]);
+        for (m, f) in column(&t, "method").iter().zip(column(&t, "best_f")) {
+            let f: f64 = f.parse().unwrap();
+            assert!((f - f_star).abs() <= tol, "{file} {m}: f = {f}");
+        }
+        assert_eq!(column(&t, "feasible"), ["true", "true"], "{file}");
+    }
+    // The timing study is valid (it is run by hand: it takes ~20 s).
+    let s = Study::load("studies/multistart_cost.toml").unwrap();
+    let p = plyscape::explore::problem(&s).unwrap();
+    let plan = plyscape::explore::multistart_plan(&s, p.as_ref()).unwrap();
+    assert_eq!(plan.starts.points.len(), 64);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
