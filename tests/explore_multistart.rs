@@ -217,6 +217,46 @@ fn merged_shards_equal_the_unsharded_run() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[test]
+fn wall_time_budget_stops_cleanly_and_resume_completes() {
+    let dir = temp_dir("ms-wall");
+    let costly = |extra: &str| {
+        format!(
+            "[study]\nname = \"w\"\nseed = 8\n[problem]\nname = \"himmelblau\"\ncost_ms = 1.0\n\
+             [multistart]\nstarts = 16\n{extra}"
+        )
+    };
+    let full = dir.join("full");
+    let s = study("w", &costly(""));
+    explore::run_multistart(&ctx(&s, &full, 2, DriveFlags::default())).unwrap();
+    let part = dir.join("part");
+    let sw = study("w", &costly("max_wall_seconds = 0.02\n"));
+    let r = explore::run_multistart(&ctx(&sw, &part, 1, DriveFlags::default())).unwrap();
+    assert!(
+        r.runs.len() < 16,
+        "{} runs in 20 ms at 1 ms per evaluation",
+        r.runs.len()
+    );
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(part.join("w/manifest.json")).unwrap())
+            .unwrap();
+    assert_eq!(m["complete"], false);
+    let flags = DriveFlags {
+        resume: true,
+        ..Default::default()
+    };
+    let r2 = explore::run_multistart(&ctx(&s, &part, 2, flags)).unwrap();
+    assert_eq!(r2.new_runs, 16 - r.runs.len());
+    for f in ["runs.csv", "optima.csv"] {
+        assert_eq!(
+            table_without(&full.join("w").join(f), &["wall_seconds"]),
+            table_without(&part.join("w").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 fn error_of(text: &str) -> String {
     let dir = temp_dir("ms-bad");
     let s = match plyscape::study::Study::parse("bad.toml", text) {

@@ -195,3 +195,34 @@ pub fn steepest(problem: &dyn Problem, x0: &[f64]) -> Result<LocalOutcome> {
         termination,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optimize::testproblems;
+
+    #[test]
+    fn steepest_descent_reaches_known_minima() {
+        // Himmelblau from (0, 0) flows to the minimum (3, 2), f* = 0
+        // (Himmelblau 1972, p. 428).
+        let h = testproblems::himmelblau();
+        let o = steepest(&h, &[0.0, 0.0]).unwrap();
+        assert!(
+            o.f < 1e-12 && (o.x[0] - 3.0).abs() < 1e-6 && (o.x[1] - 2.0).abs() < 1e-6,
+            "{o:?}"
+        );
+        assert!(o.function_calls >= o.gradient_calls && o.gradient_calls > 0);
+        // The seam problem: from (-80, 80) the optimum (88, -85) lies across
+        // the +-90 seam (testproblems::seam doc); wrapping must find it.
+        let s = testproblems::seam();
+        let o = steepest(&s, &[-80.0, 80.0]).unwrap();
+        assert!(o.f < 1e-10, "{o:?}");
+        assert!(
+            (o.x[0] - 88.0).abs() < 1e-3 && (o.x[1] + 85.0).abs() < 1e-3,
+            "{o:?}"
+        );
+        // Constraints are refused with an input error.
+        let e = steepest(&crate::explore::problems::Hs22::new(), &[0.0, 0.0]).unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+    }
+}
