@@ -31,12 +31,21 @@ pub struct ProblemSpec {
     pub name: String,
     /// Number of variables (only `rosenbrock`, `rastrigin`; default 2).
     pub dimension: Option<usize>,
-    /// CPU time burnt per evaluation \[ms\] (default 0).
+    /// Time each evaluation takes \[ms\] (default 0).
     #[serde(default)]
     pub cost_ms: f64,
+    /// How that time is spent: `spin` (default: busy wait, occupies a core
+    /// like a simulation) or `sleep` (the thread sleeps: measures the
+    /// driver's parallel structure without competing for cores).
+    #[serde(default = "default_cost_mode")]
+    pub cost_mode: String,
     /// Replacement box `[[lower, upper], ...]`, one pair per variable
     /// (non-periodic variables only; periodic ones must repeat their box).
     pub bounds: Option<Vec<[f64; 2]>>,
+}
+
+fn default_cost_mode() -> String {
+    "spin".into()
 }
 
 /// Names accepted by [`ProblemSpec::build`].
@@ -54,6 +63,17 @@ impl ProblemSpec {
                 "a finite time >= 0 ms",
             ));
         }
+        let sleep = match self.cost_mode.as_str() {
+            "spin" => false,
+            "sleep" => true,
+            other => {
+                return Err(Error::input(
+                    "cost_mode",
+                    format!("\"{other}\""),
+                    "spin or sleep",
+                ))
+            }
+        };
         let sized = matches!(self.name.as_str(), "rosenbrock" | "rastrigin");
         if self.dimension.is_some() && !sized {
             return Err(Error::input(
@@ -95,6 +115,7 @@ impl ProblemSpec {
             Ok(Box::new(Costly {
                 inner,
                 cost: Duration::from_secs_f64(self.cost_ms * 1e-3),
+                sleep,
             }))
         } else {
             Ok(inner)
@@ -308,13 +329,15 @@ impl Problem for Periodic2 {
     }
 }
 
-/// Any problem plus a fixed CPU cost per evaluation (busy wait on the
-/// monotonic clock, so the thread really occupies a core).
+/// Any problem plus a fixed time per evaluation: a busy wait on the
+/// monotonic clock (the thread really occupies a core), or a sleep.
 pub struct Costly {
     /// The problem that gives the numbers.
     pub inner: Box<dyn Problem>,
     /// Time burnt per evaluation (with or without gradients).
     pub cost: Duration,
+    /// Sleep instead of spinning.
+    pub sleep: bool,
 }
 
 impl Problem for Costly {
@@ -327,6 +350,9 @@ impl Problem for Costly {
     fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
         let start = Instant::now();
         let out = self.inner.evaluate(x, gradients);
+        if self.sleep {
+            std::thread::sleep(self.cost.saturating_sub(start.elapsed()));
+        }
         while start.elapsed() < self.cost {
             std::hint::spin_loop();
         }
@@ -397,12 +423,21 @@ mod tests {
             name: name.into(),
             dimension: None,
             cost_ms,
+            cost_mode: "spin".into(),
             bounds: None,
         };
         let e = spec("himmelbau", 0.0).build().err().unwrap().to_string();
         assert!(e.contains("himmelbau") && e.contains("himmelblau"), "{e}");
         assert!(spec("himmelblau", -1.0).build().is_err());
         assert!(spec("himmelblau", 1.0).build().is_ok());
+        let mut s = spec("himmelblau", 1.0);
+        s.cost_mode = "nap".into();
+        assert!(s
+            .build()
+            .err()
+            .unwrap()
+            .to_string()
+            .contains("spin or sleep"));
         let mut s = spec("himmelblau", 0.0);
         s.bounds = Some(vec![[-1.0, 1.0], [2.0, -2.0]]);
         let e = s.build().err().unwrap().to_string();

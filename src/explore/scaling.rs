@@ -4,10 +4,12 @@
 //! Columns, per thread count `t` over `R` runs with `E` function calls:
 //! - `wall_seconds` `W_t` of the whole multistart and `speedup` `W_1 / W_t`;
 //! - `run_seconds` `Σ w_r`, the summed wall time of the runs themselves;
-//! - `driver_overhead_per_run_s` `(t · W_t − Σ w_r) / R`: time per run spent
-//!   outside the local solver (thread start-up, scheduling, CSV appends,
-//!   clustering, final tables), and `driver_overhead_fraction`, the same
-//!   divided by the mean evaluation time per run `Σ w_r / R`;
+//! - `driver_overhead_per_run_s` `(t · W_t − Σ w_r) / R`: thread time per
+//!   run spent outside the local solver (pool start-up, scheduling, CSV
+//!   appends, clustering, final tables; for `t > 1` also the idle time of
+//!   threads that ran out of starts while the last runs finish), and
+//!   `driver_overhead_fraction`, the same divided by the mean run time
+//!   `Σ w_r / R`;
 //! - with `cost_ms > 0`, `solver_overhead_fraction`
 //!   `(Σ w_r − E · cost) / (E · cost)`: time inside the runs that is not
 //!   evaluation.
