@@ -52,10 +52,15 @@ fn analytic_studies_run_and_find_their_known_optima() {
         }
         assert_eq!(column(&t, "feasible"), ["true", "true"], "{file}");
     }
-    // The timing study is valid (it is run by hand: it takes ~20 s).
-    let s = Study::load("studies/multistart_cost.toml").unwrap();
-    let p = plyscape::explore::problem(&s).unwrap();
-    let plan = plyscape::explore::multistart_plan(&s, p.as_ref()).unwrap();
-    assert_eq!(plan.starts.points.len(), 64);
+    // The timing studies are valid (they are run by hand: ~20 s each).
+    for file in [
+        "studies/multistart_cost.toml",
+        "studies/multistart_sleep.toml",
+    ] {
+        let s = Study::load(file).unwrap();
+        let p = plyscape::explore::problem(&s).unwrap();
+        let plan = plyscape::explore::multistart_plan(&s, p.as_ref()).unwrap();
+        assert_eq!(plan.starts.points.len(), 64);
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
