@@ -207,6 +207,23 @@ fn merged_shards_equal_the_unsharded_run() {
     assert!(explore::merge(&dirs[..2], &sharded, true).is_err());
     dirs.reverse();
     explore::merge(&dirs, &sharded, true).unwrap();
+    // Compare is not sharded; after the merge, --resume runs nothing new.
+    let shard = DriveFlags {
+        resume: false,
+        shard: Shard { index: 0, count: 3 },
+    };
+    let e = explore::run_compare(&ctx(&s, &sharded, 1, shard)).unwrap_err();
+    assert!(e.to_string().contains("--shard"), "{e}");
+    let flags = DriveFlags {
+        resume: true,
+        ..Default::default()
+    };
+    assert_eq!(
+        explore::run_multistart(&ctx(&s, &sharded, 1, flags))
+            .unwrap()
+            .new_runs,
+        0
+    );
     for f in ["runs.csv", "optima.csv"] {
         assert_eq!(
             table_without(&full.join("h").join(f), &["wall_seconds"]),

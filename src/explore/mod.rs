@@ -415,8 +415,20 @@ pub struct ComparisonRow {
 
 /// `plyscape compare`: multistart, then CMA-ES on the same budget, then the
 /// comparison table (printed and `comparison.csv`).
+///
+/// Not sharded: run the shards with `plyscape multistart --shard`, merge
+/// them, then `plyscape compare --resume` finds every run done and adds the
+/// evolution and the table.
 pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
     ctx.study.section::<CompareSection>("compare")?;
+    let s = ctx.flags.shard;
+    if s.count > 1 {
+        return Err(Error::input(
+            "--shard",
+            format!("{}/{}", s.index, s.count),
+            "no shard for compare: shard `plyscape multistart`, merge, then `plyscape compare --resume`",
+        ));
+    }
     let problem = problem(ctx.study)?;
     let plan = multistart_plan(ctx.study, problem.as_ref())?;
     let ms = multistart_with(ctx, problem.as_ref(), &plan)?;
