@@ -45,9 +45,9 @@ impl Progress {
         self.bar.set_position(pos);
     }
 
-    /// Leave the final state on screen.
+    /// Remove the bar (the drivers print a summary instead).
     pub fn finish(&self) {
-        self.bar.finish();
+        self.bar.finish_and_clear();
     }
 }
 
