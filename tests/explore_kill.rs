@@ -80,9 +80,11 @@ fn killed_multistart_resumes_to_the_same_tables() {
         serde_json::from_str(&std::fs::read_to_string(part.join("k/manifest.json")).unwrap())
             .unwrap();
     assert_eq!(m["seed"], 3);
-    assert_eq!(m["resume"], true);
-    assert_eq!(m["complete"], true);
-    assert!(m["runs_this_invocation"].as_u64().unwrap() <= 24 - 3);
+    let ms = &m["commands"]["multistart"];
+    assert_eq!(ms["resume"], true);
+    assert_eq!(ms["threads"], 1);
+    assert_eq!(ms["complete"], true);
+    assert!(ms["runs_this_invocation"].as_u64().unwrap() <= 24 - 3);
     assert_eq!(m["study_text"], STUDY);
     std::fs::remove_dir_all(&dir).unwrap();
 }

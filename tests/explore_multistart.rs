@@ -257,7 +257,7 @@ fn wall_time_budget_stops_cleanly_and_resume_completes() {
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(part.join("w/manifest.json")).unwrap())
             .unwrap();
-    assert_eq!(m["complete"], false);
+    assert_eq!(m["commands"]["multistart"]["complete"], false);
     let flags = DriveFlags {
         resume: true,
         ..Default::default()

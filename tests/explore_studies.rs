@@ -51,6 +51,13 @@ fn analytic_studies_run_and_find_their_known_optima() {
             assert!((f - f_star).abs() <= tol, "{file} {m}: f = {f}");
         }
         assert_eq!(column(&t, "feasible"), ["true", "true"], "{file}");
+        // The manifest keeps every step `plyscape run` did.
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("manifest.json")).unwrap())
+                .unwrap();
+        for c in ["multistart", "evolve", "map"] {
+            assert!(m["commands"][c].is_object(), "{file}: {c}");
+        }
     }
     // The timing studies are valid (they are run by hand: ~20 s each).
     for file in [

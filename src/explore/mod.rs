@@ -175,17 +175,29 @@ impl Context<'_> {
         Ok(dir)
     }
 
+    /// Update `manifest.json`: common fields at the top, one entry per
+    /// command under `commands` (entries of earlier commands on the same
+    /// study text are kept, so `plyscape run` records every step).
     fn manifest(&self, dir: &Path, command: &str, extra: serde_json::Value) -> Result<()> {
+        let mut commands = crate::report::read_manifest(dir)
+            .ok()
+            .filter(|m| m["study_text"].as_str() == Some(self.study.text.as_str()))
+            .and_then(|m| m["commands"].as_object().cloned())
+            .unwrap_or_default();
+        let mut entry = serde_json::Map::new();
+        entry.insert("threads".into(), json!(self.threads));
+        entry.insert("resume".into(), json!(self.flags.resume));
+        if let serde_json::Value::Object(e) = extra {
+            entry.extend(e);
+        }
+        commands.insert(command.into(), serde_json::Value::Object(entry));
         let mut m = serde_json::Map::new();
-        m.insert("command".into(), json!(command));
-        m.insert("resume".into(), json!(self.flags.resume));
         m.insert(
             "shard".into(),
             json!({"index": self.flags.shard.index, "count": self.flags.shard.count}),
         );
-        if let serde_json::Value::Object(e) = extra {
-            m.extend(e);
-        }
+        m.insert("last_command".into(), json!(command));
+        m.insert("commands".into(), serde_json::Value::Object(commands));
         crate::report::write_manifest(dir, self.study, self.threads, m)
     }
 }
@@ -684,7 +696,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<multistart::Re
                 "a shard manifest",
             ));
         };
-        if m["complete"].as_bool() != Some(true) {
+        if m["commands"]["multistart"]["complete"].as_bool() != Some(true) {
             return Err(Error::input(
                 d.display().to_string(),
                 format!("shard {i}/{n} (incomplete)"),
@@ -752,7 +764,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<multistart::Re
     let dir = study.output_dir(out)?;
     let wall = dirs
         .iter()
-        .filter_map(|d| crate::report::read_manifest(d).ok()?["wall_seconds"].as_f64())
+        .filter_map(|d| {
+            crate::report::read_manifest(d).ok()?["commands"]["multistart"]["wall_seconds"].as_f64()
+        })
         .fold(0.0, f64::max);
     let report = multistart::finish(vars, m, rows, plan.tolerances, &dir, wall)?;
     // The manifest's thread count: the largest any shard used.
