@@ -107,7 +107,20 @@ impl Report {
 pub fn one_run(problem: &dyn Problem, solver: &LocalSolver, start: usize, x0: &[f64]) -> RunRecord {
     let t = Instant::now();
     let counted = Counted::new(problem);
-    let out = solver(&counted, x0);
+    // A panic inside one run (a solver bug) becomes that run's error
+    // instead of ending a long campaign.
+    let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| solver(&counted, x0)))
+        .unwrap_or_else(|p| {
+            let msg = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(Error::numerical(
+                "explore::multistart",
+                format!("solver panicked: {msg}"),
+            ))
+        });
     let wall_seconds = t.elapsed().as_secs_f64();
     let (result, exit, iterations) = match out {
         Ok(o) if o.f.is_finite() && o.x.iter().chain(&o.g).all(|v| v.is_finite()) => (
@@ -378,6 +391,26 @@ fn check_row(row: &RunRecord, starts: &[Vec<f64>], shard: Shard, path: &Path) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn failing_and_panicking_runs_become_rows_with_an_error() {
+        let p = crate::optimize::testproblems::himmelblau();
+        let fails: &LocalSolver =
+            &|_: &dyn Problem, _: &[f64]| Err(Error::numerical("test", "singular"));
+        let row = one_run(&p, fails, 3, &[0.0, 1.0]);
+        assert!(row.result.is_none() && row.exit.contains("singular"));
+        let panics: &LocalSolver = &|q: &dyn Problem, x: &[f64]| {
+            q.evaluate(x, true)?;
+            panic!("index out of bounds")
+        };
+        let row = one_run(&p, panics, 4, &[0.0, 1.0]);
+        assert!(
+            row.exit.contains("solver panicked: index out of bounds"),
+            "{}",
+            row.exit
+        );
+        assert_eq!((row.function_calls, row.gradient_calls), (1, 1));
+    }
 
     #[test]
     fn shard_parsing() {
