@@ -32,14 +32,18 @@
 //!    `c₀ = −N_B(N_BᵀN_B)⁻¹ g_B` first moves onto the binding constraints'
 //!    linearised limits; every trial point is pulled back onto them by
 //!    Newton corrections with the frozen gradients N_B (constraint
-//!    following; one function call each, at most `max_corrections`). The
-//!    first trial length is the smallest of: the one that changes f by
-//!    `dobj1`·|f| (first iteration) / `dobj2`·|f| later on the linear model,
-//!    the one that moves a variable by `dx2` of its range, and the distance
-//!    to the nearest bound. A quadratic through `f(0)`, `f'(0)` and the
-//!    trial gives the next length (extrapolating up to 4×, interpolating
-//!    down to 0.1×); a constraint that becomes violated is interpolated to
-//!    its zero crossing (quadratic in α from `g(0)`, `∇gᵀS` and the trial).
+//!    following; one function call each, at most `max_corrections`, stopped
+//!    early if they diverge). The pull-back of the last trial, scaled by
+//!    `(α/α_last)²`, predicts the next one (the curvature of the limits).
+//!    First trial length: on the first iteration the one that changes f by
+//!    `dobj1`·|f| on the linear model, but at least a `dx1` move; later the
+//!    Nocedal–Wright estimates `α_prev f'_prev/f'` and `2|Δf_prev|/|f'|`
+//!    capped by `dobj2`·|f|, or the previous α when following constraints;
+//!    always at most a `dx2` move of any variable and inside the bounds. A
+//!    quadratic through `f(0)`, `f'(0)` and the trial (later three points)
+//!    gives the next length (extrapolating up to 4×, interpolating down to
+//!    0.01×); a constraint that becomes violated is interpolated to its zero
+//!    crossing (quadratic in α from `g(0)`, `∇gᵀS` and the trial).
 //! 6. Convergence: `|Δf| < DABOBJ` or `|Δf|/|f| < DELOBJ` for ITRMOP
 //!    consecutive feasible iterations, or the Kuhn–Tucker test
 //!    `|S| <= kt_tolerance · max(|f|, 1)` with the binding constraints within
@@ -84,6 +88,10 @@ pub struct MmfdOptions {
     /// DOBJ2: largest relative change of f sought by later first trials.
     /// DOT: 0.2.
     pub dobj2: f64,
+    /// DX1: smallest move of the largest-moving variable in the first
+    /// trial, as a fraction of its range (so that f ≈ 0 at the start does
+    /// not make the DOBJ1 step vanish). DOT: 0.01 (relative to the value).
+    pub dx1: f64,
     /// DX2: largest move of any variable per first trial, as a fraction of
     /// its range. DOT: 0.2 (relative to the variable's value there; here to
     /// its range, since the variables are range-scaled).
@@ -113,6 +121,7 @@ impl Default for MmfdOptions {
             max_iterations: 100,
             dobj1: 0.1,
             dobj2: 0.2,
+            dx1: 0.01,
             dx2: 0.2,
             kt_tolerance: 1e-4,
             max_line_evaluations: 6,
@@ -138,6 +147,7 @@ impl MmfdOptions {
             ("delobj", self.delobj),
             ("dobj1", self.dobj1),
             ("dobj2", self.dobj2),
+            ("dx1", self.dx1),
             ("dx2", self.dx2),
             ("kt_tolerance", self.kt_tolerance),
             ("follow_tolerance", self.follow_tolerance),
@@ -284,6 +294,10 @@ struct Search<'s> {
     s: &'s [f64],
     c0: &'s [f64],
     binding: &'s [usize],
+    /// Last trial's α and its pull-back beyond `c₀` (scaled): the curvature
+    /// of the followed constraints, reused as `(α/α_last)²` times that
+    /// pull-back to predict the next trial's (second-order prediction).
+    learned: std::cell::RefCell<Option<(f64, Vec<f64>)>>,
 }
 
 impl Mmfd {
@@ -356,18 +370,30 @@ impl Mmfd {
 
     /// Evaluate the trial `x + c₀ + αS` with constraint following.
     fn trial(&self, problem: &mut Ap<'_>, sr: &Search<'_>, alpha: f64) -> Result<Point> {
-        let mut z: Vec<f64> = sr.c0.iter().zip(sr.s).map(|(c, s)| c + alpha * s).collect();
+        let lin: Vec<f64> = sr.c0.iter().zip(sr.s).map(|(c, s)| c + alpha * s).collect();
+        let mut z = lin.clone();
+        if let Some((a_last, pull)) = sr.learned.borrow().as_ref() {
+            let k = (alpha / a_last).powi(2);
+            for (zi, p) in z.iter_mut().zip(pull) {
+                *zi += k * p;
+            }
+        }
         let mut x = self.moved(problem, &sr.base.x, &z);
         let mut ev = evaluate(problem, &x, false)?;
         let follow_tol = self.options.follow_tolerance;
+        let mut last_r = f64::INFINITY;
         for _ in 0..self.options.max_corrections {
             if sr.binding.is_empty() {
                 break;
             }
             let r: Vec<f64> = sr.binding.iter().map(|&j| ev.g[j]).collect();
-            if r.iter().all(|v| v.abs() <= follow_tol) {
+            let r_max = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            // Converged, or diverging (the step is too long for the frozen
+            // gradients: the line search will shorten it).
+            if r_max <= follow_tol || r_max >= last_r {
                 break;
             }
+            last_r = r_max;
             let cols: Vec<&[f64]> = sr.binding.iter().map(|&j| sr.gg[j].as_slice()).collect();
             let Some(dz) = least_norm(&cols, &r) else {
                 break;
@@ -377,6 +403,10 @@ impl Mmfd {
             }
             x = self.moved(problem, &sr.base.x, &z);
             ev = evaluate(problem, &x, false)?;
+        }
+        if !sr.binding.is_empty() && alpha > 0.0 {
+            let pull = z.iter().zip(&lin).map(|(a, b)| a - b).collect();
+            *sr.learned.borrow_mut() = Some((alpha, pull));
         }
         Ok(Point {
             x,
@@ -452,12 +482,16 @@ impl Mmfd {
         let amax = self.alpha_max(problem, sr);
         let fscale = sr.base.f.abs().max(self.dabobj);
         let mut alpha = match self.prev_step {
-            None => o.dobj1 * fscale / d0.abs(),
+            None => (o.dobj1 * fscale / d0.abs()).max(o.dx1 / snorm),
+            // Following curved limits, f'(0) = −|S|² shrinks quadratically
+            // near the optimum while the best α stays about the same.
+            Some((a, _)) if !sr.binding.is_empty() => a,
             Some((a, dprev)) => (a * dprev / d0)
                 .min(o.dobj2 * fscale / d0.abs())
                 .min(2.02 * self.last_change.max(1e-300) / d0.abs()),
         };
         alpha = alpha.min(o.dx2 / snorm).min(amax);
+
         if !(alpha > 0.0 && alpha.is_finite()) {
             return Ok(None);
         }
@@ -645,6 +679,9 @@ impl Mmfd {
             b.push(y);
         }
         let sol = qp::solve(&vec![0.0; n], &rows, &b)?;
+        if sol.s.iter().all(|&v| v == 0.0) {
+            return Ok(None);
+        }
         let v0 = base.max_g();
         let mut alpha = 1.0;
         for _ in 0..6 {
@@ -821,6 +858,7 @@ impl Mmfd {
             s: &s,
             c0: &c0,
             binding: &binding,
+            learned: std::cell::RefCell::new(None),
         };
         match self.line_search(problem, &sr)? {
             Some((p, alpha)) => {
