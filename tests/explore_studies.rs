@@ -26,9 +26,11 @@ fn analytic_studies_run_and_find_their_known_optima() {
     // explore::problems::Periodic2).
     for (file, f_star, tol) in [
         ("studies/himmelblau.toml", 0.0, 1e-6),
-        // MMFD ends within DOT's CTMIN = 3e-3 of the active constraints,
-        // which lowers f by up to ~2e-3 below f*.
-        ("studies/hs_constrained.toml", 1.0, 3e-3),
+        // MMFD may end with the active constraints violated by up to DOT's
+        // CTMIN = 3e-3, which lowers f by up to (λ1 + λ2) CTMIN = 4e-3 to
+        // first order (multipliers λ1 = λ2 = 2/3 at (1, 1), from
+        // ∇f + λ1 ∇g1 + λ2 ∇g2 = 0, derived here); 5e-3 allows second order.
+        ("studies/hs_constrained.toml", 1.0, 5e-3),
         ("studies/periodic2.toml", -5.0, 1e-6),
     ] {
         let s = run(file, &dir);
