@@ -43,6 +43,74 @@ pub enum Command {
         #[command(flatten)]
         common: Common,
     },
+    /// Local optimizer from many start points; runs.csv, optima.csv.
+    Multistart {
+        /// Study file (TOML) with the sections `problem` and `multistart`.
+        study: PathBuf,
+        #[command(flatten)]
+        common: Common,
+        #[command(flatten)]
+        drive: DriveArgs,
+    },
+    /// CMA-ES with restarts; evolution.csv.
+    Evolve {
+        /// Study file (TOML) with a `problem` section (`evolve` optional).
+        study: PathBuf,
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Multistart, then CMA-ES on the same budget, then comparison.csv.
+    Compare {
+        /// Study file (TOML) with the sections `problem` and `multistart`.
+        study: PathBuf,
+        #[command(flatten)]
+        common: Common,
+        #[command(flatten)]
+        drive: DriveArgs,
+    },
+    /// Grid of f and constraints over two variables; map.csv, map.svg.
+    Map {
+        /// Study file (TOML) with a `problem` section (`map` optional).
+        study: PathBuf,
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Combine the shard directories of one multistart into one set of tables.
+    Merge {
+        /// Shard directories (`results/STUDY/shard-I-of-N`).
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Root directory for the merged tables (written to `OUT/STUDY/`).
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+        /// No summary output.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+}
+
+/// Flags of the multistart drivers.
+#[derive(Debug, Clone, Args)]
+pub struct DriveArgs {
+    /// Continue from the runs already in runs.csv.
+    #[arg(long)]
+    pub resume: bool,
+    /// Run only every n-th start, beginning at i (0-based): `--shard i/n`.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+}
+
+impl DriveArgs {
+    fn resolve(&self) -> Result<crate::explore::DriveFlags> {
+        let mut f = crate::explore::DriveFlags {
+            resume: self.resume,
+            ..Default::default()
+        };
+        if let Some(s) = &self.shard {
+            f.shard = crate::explore::multistart::Shard::parse(s)?;
+        }
+        Ok(f)
+    }
 }
 
 /// A resolved run: the study and the common options.
@@ -82,8 +150,77 @@ pub fn execute(cli: Cli) -> Result<()> {
             let cfg = RunConfig::resolve(study.as_ref(), &common)?;
             run_study(&cfg)
         }
+        Command::Multistart {
+            study,
+            common,
+            drive,
+        } => {
+            let cfg = RunConfig::resolve(Some(&study), &common)?;
+            crate::explore::run_multistart(&explore_context(&cfg, drive.resolve()?)).map(|_| ())
+        }
+        Command::Evolve { study, common } => {
+            let cfg = RunConfig::resolve(Some(&study), &common)?;
+            crate::explore::run_evolve(&explore_context(&cfg, Default::default()), None).map(|_| ())
+        }
+        Command::Compare {
+            study,
+            common,
+            drive,
+        } => {
+            let cfg = RunConfig::resolve(Some(&study), &common)?;
+            crate::explore::run_compare(&explore_context(&cfg, drive.resolve()?)).map(|_| ())
+        }
+        Command::Map { study, common } => {
+            let cfg = RunConfig::resolve(Some(&study), &common)?;
+            crate::explore::run_map(&explore_context(&cfg, Default::default())).map(|_| ())
+        }
+        Command::Merge { dirs, out, quiet } => {
+            crate::explore::merge(&dirs, &out, quiet).map(|_| ())
+        }
     }
 }
+
+/// The exploration drivers' view of a resolved run.
+fn explore_context(
+    cfg: &RunConfig,
+    flags: crate::explore::DriveFlags,
+) -> crate::explore::Context<'_> {
+    crate::explore::Context {
+        study: &cfg.study,
+        out: &cfg.out,
+        threads: cfg.threads,
+        quiet: cfg.quiet,
+        flags,
+    }
+}
+
+/// `plyscape run` handlers of the exploration drivers. Under `[compare]`
+/// the multistart and evolution run as part of the comparison (and under
+/// `[scaling]` the multistart runs once per thread count).
+fn run_multistart_handler(cfg: &RunConfig) -> Result<()> {
+    if cfg.study.has("compare") || cfg.study.has("scaling") {
+        return Ok(());
+    }
+    crate::explore::run_multistart(&explore_context(cfg, Default::default())).map(|_| ())
+}
+fn run_evolve_handler(cfg: &RunConfig) -> Result<()> {
+    if cfg.study.has("compare") {
+        return Ok(());
+    }
+    crate::explore::run_evolve(&explore_context(cfg, Default::default()), None).map(|_| ())
+}
+fn run_compare_handler(cfg: &RunConfig) -> Result<()> {
+    crate::explore::run_compare(&explore_context(cfg, Default::default())).map(|_| ())
+}
+fn run_scaling_handler(cfg: &RunConfig) -> Result<()> {
+    crate::explore::scaling::run_scaling(&explore_context(cfg, Default::default())).map(|_| ())
+}
+fn run_map_handler(cfg: &RunConfig) -> Result<()> {
+    crate::explore::run_map(&explore_context(cfg, Default::default())).map(|_| ())
+}
+
+/// Sections that hold data other sections use; they do no work themselves.
+const DATA_SECTIONS: &[&str] = &["problem"];
 
 /// A kind of work a study can ask for: the top-level section that asks for
 /// it, and the function that does it.
@@ -91,7 +228,13 @@ type Handler = fn(&RunConfig) -> Result<()>;
 
 /// Every section `plyscape run` knows, in the order the work is done.
 fn handlers() -> Vec<(&'static str, Handler)> {
-    vec![]
+    vec![
+        ("multistart", run_multistart_handler),
+        ("evolve", run_evolve_handler),
+        ("compare", run_compare_handler),
+        ("scaling", run_scaling_handler),
+        ("map", run_map_handler),
+    ]
 }
 
 /// `plyscape run`: do every kind of work the study has a section for.
@@ -100,6 +243,7 @@ pub fn run_study(cfg: &RunConfig) -> Result<()> {
     let handlers = handlers();
     let mut known: Vec<&str> = vec!["study"];
     known.extend(handlers.iter().map(|(k, _)| *k));
+    known.extend(DATA_SECTIONS);
     for key in cfg.study.table.keys() {
         if !known.contains(&key.as_str()) {
             return Err(cfg.study.error(
@@ -120,7 +264,14 @@ pub fn run_study(cfg: &RunConfig) -> Result<()> {
         return Err(cfg.study.error(
             "",
             "(no work)",
-            format!("at least one of the sections: {}", known[1..].join(", ")),
+            format!(
+                "at least one of the sections: {}",
+                handlers
+                    .iter()
+                    .map(|(k, _)| *k)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
         ));
     }
     Ok(())

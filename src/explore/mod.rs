@@ -1,1 +1,798 @@
-//! (module under construction; see lib.rs)
+//! Exploration drivers: multistart, evolutionary comparison, design-space
+//! maps, resumable and shardable tables (issue 5).
+//!
+//! A gradient-based local optimizer (MMFD) finds the optimum of the basin it
+//! starts in; ply-angle problems have many basins. The drivers here answer
+//! "how many optima are there, which is best, and how likely is one start to
+//! find it?" by running the local optimizer from many seeded start points in
+//! parallel ([`multistart`]), merging the results into distinct optima
+//! ([`cluster`]), comparing with an evolutionary search on the same budget
+//! ([`evolve`]) and drawing the landscape ([`map`]).
+//!
+//! Every table is reproducible from the study file: random choices come
+//! from `[study] seed`, rows are sorted by start index, numbers round-trip
+//! exactly, and `manifest.json` records the study text, seed, threads and
+//! crate versions. `runs.csv` survives a kill (see [`tables`]); `--resume`
+//! continues a stopped multistart and `--shard i/n` splits one over
+//! machines, with `plyscape merge` putting the pieces back together.
+//!
+//! Study sections read here: `[problem]` ([`problems::ProblemSpec`]),
+//! `[multistart]` ([`MultistartSection`]), `[evolve]` ([`EvolveSection`]),
+//! `[compare]` (no keys), `[map]` ([`MapSection`]) and `[scaling]`
+//! ([`scaling::ScalingSection`]).
+
+pub mod cluster;
+pub mod evolve;
+pub mod map;
+pub mod multistart;
+pub mod problems;
+pub mod sampling;
+pub mod scaling;
+pub mod solvers;
+pub mod tables;
+
+use crate::error::{Error, Result};
+use crate::optimize::Problem;
+use crate::study::Study;
+use cluster::Tolerances;
+use multistart::Shard;
+use serde::Deserialize;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// The `[multistart]` section.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MultistartSection {
+    /// Local optimizer (default `mmfd`).
+    #[serde(default = "default_method")]
+    pub method: String,
+    /// Sampler of the start points: `lhs` (default), `sobol`, `uniform`.
+    #[serde(default = "default_sampler")]
+    pub sampler: String,
+    /// Number of sampled start points.
+    #[serde(default)]
+    pub starts: usize,
+    /// Listed start points (run first).
+    #[serde(default)]
+    pub points: Vec<Vec<f64>>,
+    /// Keep only feasible starts.
+    #[serde(default)]
+    pub feasible_only: bool,
+    /// Stop launching runs once this many function calls are used.
+    pub max_evaluations: Option<usize>,
+    /// Stop launching runs after this wall time \[s\].
+    pub max_wall_seconds: Option<f64>,
+    /// Same optimum: coordinates within this fraction of each range
+    /// (default 1e-2: 1.8° on a 180° ply angle; MMFD with DOT's default
+    /// DELOBJ = 1e-3 stops that far from the exact optimum on flat valleys).
+    #[serde(default = "default_x_tol")]
+    pub x_tolerance: f64,
+    /// Same optimum: `|Δf| <= f_tolerance · max(1, |f|)` (default 1e-2:
+    /// ten times DOT's DELOBJ, since runs that end on active constraints
+    /// within CTMIN differ in f by that much; distinct optima are told apart
+    /// by `x_tolerance`).
+    #[serde(default = "default_f_tol")]
+    pub f_tolerance: f64,
+    /// Feasible: `max g <= feasibility_tolerance` (default 3e-3, DOT's
+    /// CTMIN, the violation MMFD accepts at its optimum).
+    #[serde(default = "default_feas_tol")]
+    pub feasibility_tolerance: f64,
+    /// MMFD convergence settings (`[multistart.mmfd]`; DOT defaults).
+    #[serde(default)]
+    pub mmfd: solvers::MmfdSettings,
+}
+
+fn default_method() -> String {
+    "mmfd".into()
+}
+fn default_sampler() -> String {
+    "lhs".into()
+}
+fn default_x_tol() -> f64 {
+    1e-2
+}
+fn default_f_tol() -> f64 {
+    1e-2
+}
+fn default_feas_tol() -> f64 {
+    3e-3
+}
+
+/// The `[evolve]` section.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct EvolveSection {
+    /// Evaluation budget. Default: under `compare`, the function calls the
+    /// multistart used; alone, 100 per start of `[multistart]`, else 10 000.
+    pub max_evaluations: Option<usize>,
+}
+
+/// The `[compare]` section (no keys).
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct CompareSection {}
+
+/// The `[map]` section.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapSection {
+    /// Grid points per axis (default 61).
+    #[serde(default = "default_resolution")]
+    pub resolution: usize,
+    /// Variable pairs for more than two variables (default: consecutive
+    /// pairs (0,1), (2,3), ...).
+    pub pairs: Option<Vec<[usize; 2]>>,
+}
+
+fn default_resolution() -> usize {
+    61
+}
+
+/// Flags of the driver commands beyond the common ones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DriveFlags {
+    /// Continue from an existing `runs.csv`.
+    pub resume: bool,
+    /// Which starts to run.
+    pub shard: Shard,
+}
+
+impl Default for DriveFlags {
+    fn default() -> Self {
+        DriveFlags {
+            resume: false,
+            shard: Shard { index: 0, count: 1 },
+        }
+    }
+}
+
+/// What a driver command needs from the command line.
+#[derive(Debug, Clone)]
+pub struct Context<'a> {
+    /// The study.
+    pub study: &'a Study,
+    /// Results root (`results/`).
+    pub out: &'a Path,
+    /// Worker threads.
+    pub threads: usize,
+    /// No progress bars or summaries.
+    pub quiet: bool,
+    /// Resume and shard.
+    pub flags: DriveFlags,
+}
+
+impl Context<'_> {
+    /// `out/<study>/`, or `out/<study>/shard-<i>-of-<n>/` for a shard.
+    pub fn dir(&self) -> Result<PathBuf> {
+        let base = self.study.output_dir(self.out)?;
+        let s = self.flags.shard;
+        if s.count == 1 {
+            return Ok(base);
+        }
+        let dir = base.join(format!("shard-{}-of-{}", s.index, s.count));
+        std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+        Ok(dir)
+    }
+
+    /// Update `manifest.json`: common fields at the top, one entry per
+    /// command under `commands` (entries of earlier commands on the same
+    /// study text are kept, so `plyscape run` records every step).
+    fn manifest(&self, dir: &Path, command: &str, extra: serde_json::Value) -> Result<()> {
+        let mut commands = crate::report::read_manifest(dir)
+            .ok()
+            .filter(|m| m["study_text"].as_str() == Some(self.study.text.as_str()))
+            .and_then(|m| m["commands"].as_object().cloned())
+            .unwrap_or_default();
+        let mut entry = serde_json::Map::new();
+        entry.insert("threads".into(), json!(self.threads));
+        entry.insert("resume".into(), json!(self.flags.resume));
+        if let serde_json::Value::Object(e) = extra {
+            entry.extend(e);
+        }
+        commands.insert(command.into(), serde_json::Value::Object(entry));
+        let mut m = serde_json::Map::new();
+        m.insert(
+            "shard".into(),
+            json!({"index": self.flags.shard.index, "count": self.flags.shard.count}),
+        );
+        m.insert("last_command".into(), json!(command));
+        m.insert("commands".into(), serde_json::Value::Object(commands));
+        crate::report::write_manifest(dir, self.study, self.threads, m)
+    }
+}
+
+/// Build the study's `[problem]`.
+pub fn problem(study: &Study) -> Result<Box<dyn Problem>> {
+    let spec: problems::ProblemSpec =
+        study.require_section("problem", "the problem to explore (name = ...)")?;
+    spec.build().map_err(study.locate("problem"))
+}
+
+/// Validated `[multistart]` with its start points.
+pub struct MultistartPlan {
+    /// The section.
+    pub section: MultistartSection,
+    /// Start points (all shards).
+    pub starts: sampling::Starts,
+    /// Clustering tolerances.
+    pub tolerances: Tolerances,
+}
+
+/// Read and check `[multistart]`, generate the starts.
+pub fn multistart_plan(study: &Study, problem: &dyn Problem) -> Result<MultistartPlan> {
+    let s: MultistartSection =
+        study.require_section("multistart", "starts = ..., sampler = ...")?;
+    let loc = study.locate("multistart");
+    solvers::check_local(&s.method).map_err(&loc)?;
+    s.mmfd.check().map_err(study.locate("multistart.mmfd"))?;
+    for (key, v) in [
+        ("x_tolerance", s.x_tolerance),
+        ("f_tolerance", s.f_tolerance),
+    ] {
+        crate::error::require_positive(key, v).map_err(&loc)?;
+    }
+    if !(s.feasibility_tolerance.is_finite() && s.feasibility_tolerance >= 0.0) {
+        return Err(loc(Error::input(
+            "feasibility_tolerance",
+            s.feasibility_tolerance,
+            "a finite value >= 0",
+        )));
+    }
+    if let Some(w) = s.max_wall_seconds {
+        crate::error::require_positive("max_wall_seconds", w).map_err(&loc)?;
+    }
+    if s.max_evaluations == Some(0) {
+        return Err(loc(Error::input(
+            "max_evaluations",
+            0,
+            "a budget >= 1 (or no key)",
+        )));
+    }
+    let spec = sampling::StartsSpec {
+        sampler: s.sampler.clone(),
+        count: s.starts,
+        points: s.points.clone(),
+        feasible_only: s.feasible_only,
+    };
+    let starts = spec.generate(problem, study.meta.seed).map_err(|e| {
+        // `count` is called `starts` in the study file.
+        match e {
+            Error::Input {
+                key,
+                value,
+                expected,
+                file,
+            } if key == "count" => loc(Error::Input {
+                key: "starts".into(),
+                value,
+                expected,
+                file,
+            }),
+            e => loc(e),
+        }
+    })?;
+    Ok(MultistartPlan {
+        tolerances: Tolerances {
+            x: s.x_tolerance,
+            f: s.f_tolerance,
+            feasibility: s.feasibility_tolerance,
+        },
+        section: s,
+        starts,
+    })
+}
+
+/// `plyscape multistart`: runs, optima, manifest.
+pub fn run_multistart(ctx: &Context) -> Result<multistart::Report> {
+    let problem = problem(ctx.study)?;
+    let plan = multistart_plan(ctx.study, problem.as_ref())?;
+    multistart_with(ctx, problem.as_ref(), &plan)
+}
+
+fn multistart_with(
+    ctx: &Context,
+    problem: &dyn Problem,
+    plan: &MultistartPlan,
+) -> Result<multistart::Report> {
+    let dir = ctx.dir()?;
+    ctx.manifest(&dir, "multistart", json!({"complete": false}))?;
+    let solver = solvers::local(&plan.section.method, &plan.section.mmfd)?;
+    let settings = multistart::Settings {
+        threads: ctx.threads,
+        max_evaluations: plan.section.max_evaluations,
+        max_wall_seconds: plan.section.max_wall_seconds,
+        tolerances: plan.tolerances,
+        resume: ctx.flags.resume,
+        shard: ctx.flags.shard,
+        quiet: ctx.quiet,
+    };
+    let report = multistart::run(
+        problem,
+        solver.as_ref(),
+        &plan.starts.points,
+        &settings,
+        &dir,
+    )?;
+    let mine = (0..plan.starts.points.len())
+        .filter(|&k| ctx.flags.shard.owns(k))
+        .count();
+    ctx.manifest(
+        &dir,
+        "multistart",
+        json!({
+            "complete": report.runs.len() == mine || plan.section.max_evaluations.is_some(),
+            "starts": plan.starts.points.len(),
+            "runs_in_tables": report.runs.len(),
+            "runs_this_invocation": report.new_runs,
+            "filter_evaluations": plan.starts.filter_evaluations,
+            "wall_seconds": report.wall_seconds,
+        }),
+    )?;
+    if !ctx.quiet {
+        print_optima(problem, &report);
+    }
+    Ok(report)
+}
+
+fn print_optima(problem: &dyn Problem, r: &multistart::Report) {
+    println!(
+        "multistart on {}: {} runs, {} distinct optima, {} function + {} gradient calls, {:.3} s",
+        problem.name(),
+        r.runs.len(),
+        r.optima.len(),
+        r.function_calls,
+        r.gradient_calls,
+        r.wall_seconds
+    );
+    for o in r.optima.iter().take(10) {
+        println!(
+            "  optimum {:>3}: f = {:>14.8e}  x = {:?}  feasible = {}  basin share = {:.3}",
+            o.id, o.f, o.x, o.feasible, o.basin_share
+        );
+    }
+}
+
+/// `plyscape evolve`: evolution.csv (and the outcome). `budget` overrides
+/// the study's.
+pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<evolve::Report> {
+    let problem = problem(ctx.study)?;
+    let sec: EvolveSection = ctx.study.section("evolve")?.unwrap_or_default();
+    if sec.max_evaluations == Some(0) {
+        return Err(ctx
+            .study
+            .error("evolve.max_evaluations", 0, "a budget >= 1"));
+    }
+    let starts = ctx
+        .study
+        .section::<MultistartSection>("multistart")?
+        .map(|m| m.starts + m.points.len());
+    let max_evaluations = sec
+        .max_evaluations
+        .or(budget)
+        .or(starts.map(|s| 100 * s.max(1)))
+        .unwrap_or(10_000);
+    let dir = ctx.dir()?;
+    let request = evolve::Request {
+        seed: ctx.study.meta.seed,
+        max_evaluations,
+    };
+    let solver = solvers::global();
+    let report = evolve::run(
+        problem.as_ref(),
+        solver.as_ref(),
+        &request,
+        ctx.threads,
+        ctx.quiet,
+        &dir,
+    )?;
+    ctx.manifest(
+        &dir,
+        "evolve",
+        json!({"max_evaluations": max_evaluations, "wall_seconds": report.wall_seconds}),
+    )?;
+    convergence_plot(problem.as_ref(), &dir, None, Some(&report))?;
+    if !ctx.quiet {
+        let o = &report.outcome;
+        println!(
+            "evolution on {}: best f = {:.8e} at x = {:?} (feasible = {}), {} evaluations, {} generations, {} restarts, {}",
+            problem.name(), o.f, o.x, o.feasible, report.function_calls, o.generations, o.restarts, o.termination
+        );
+    }
+    Ok(report)
+}
+
+/// One row of the comparison table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComparisonRow {
+    /// `multistart-<method>` or `cmaes`.
+    pub method: String,
+    /// Best objective.
+    pub best_f: f64,
+    /// Best design.
+    pub best_x: Vec<f64>,
+    /// Feasible within the tolerance.
+    pub feasible: bool,
+    /// Function calls.
+    pub function_calls: usize,
+    /// Gradient calls.
+    pub gradient_calls: usize,
+    /// Wall time \[s\].
+    pub wall_seconds: f64,
+    /// Distinct optima (multistart only).
+    pub distinct_optima: Option<usize>,
+    /// Probability that one start reaches the best optimum (multistart only).
+    pub p_single_start: Option<f64>,
+}
+
+/// `plyscape compare`: multistart, then CMA-ES on the same budget, then the
+/// comparison table (printed and `comparison.csv`).
+///
+/// Not sharded: run the shards with `plyscape multistart --shard`, merge
+/// them, then `plyscape compare --resume` finds every run done and adds the
+/// evolution and the table.
+pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
+    ctx.study.section::<CompareSection>("compare")?;
+    let s = ctx.flags.shard;
+    if s.count > 1 {
+        return Err(Error::input(
+            "--shard",
+            format!("{}/{}", s.index, s.count),
+            "no shard for compare: shard `plyscape multistart`, merge, then `plyscape compare --resume`",
+        ));
+    }
+    let problem = problem(ctx.study)?;
+    let plan = multistart_plan(ctx.study, problem.as_ref())?;
+    let ms = multistart_with(ctx, problem.as_ref(), &plan)?;
+    let budget = ms.function_calls + plan.starts.filter_evaluations;
+    let ev = run_evolve(ctx, Some(budget))?;
+    let dir = ctx.dir()?;
+    let mut rows = Vec::new();
+    if let Some(best) = ms.optima.first() {
+        rows.push(ComparisonRow {
+            method: format!("multistart-{}", plan.section.method),
+            best_f: best.f,
+            best_x: best.x.clone(),
+            feasible: best.feasible,
+            function_calls: budget,
+            gradient_calls: ms.gradient_calls,
+            wall_seconds: ms.wall_seconds,
+            distinct_optima: Some(ms.optima.len()),
+            p_single_start: ms.p_best(),
+        });
+    }
+    let o = &ev.outcome;
+    rows.push(ComparisonRow {
+        method: "cmaes".into(),
+        best_f: o.f,
+        best_x: o.x.clone(),
+        feasible: o.g.iter().all(|&g| g <= plan.tolerances.feasibility),
+        function_calls: ev.function_calls,
+        gradient_calls: ev.gradient_calls,
+        wall_seconds: ev.wall_seconds,
+        distinct_optima: None,
+        p_single_start: None,
+    });
+    let table = comparison_table(problem.as_ref(), &rows);
+    tables::write_atomic(&dir.join("comparison.csv"), &table)?;
+    convergence_plot(problem.as_ref(), &dir, Some(&ms), Some(&ev))?;
+    if !ctx.quiet {
+        print_table(&table);
+    }
+    Ok(rows)
+}
+
+/// `comparison.csv`: header and rows.
+pub fn comparison_table(problem: &dyn Problem, rows: &[ComparisonRow]) -> Vec<Vec<String>> {
+    let mut h = vec!["method".to_string(), "best_f".into()];
+    h.extend(problem.variables().iter().map(|v| format!("x_{}", v.name)));
+    h.extend(
+        [
+            "feasible",
+            "function_calls",
+            "gradient_calls",
+            "wall_seconds",
+            "distinct_optima",
+            "p_single_start",
+        ]
+        .map(String::from),
+    );
+    let mut out = vec![h];
+    for r in rows {
+        let mut v = vec![r.method.clone(), tables::num(r.best_f)];
+        v.extend(r.best_x.iter().map(|&x| tables::num(x)));
+        v.push(r.feasible.to_string());
+        v.push(r.function_calls.to_string());
+        v.push(r.gradient_calls.to_string());
+        v.push(format!("{:.3}", r.wall_seconds));
+        v.push(r.distinct_optima.map(|d| d.to_string()).unwrap_or_default());
+        v.push(tables::field(r.p_single_start));
+        out.push(v);
+    }
+    out
+}
+
+fn print_table(rows: &[Vec<String>]) {
+    let widths: Vec<usize> = (0..rows[0].len())
+        .map(|c| rows.iter().map(|r| r[c].len()).max().unwrap_or(0))
+        .collect();
+    for r in rows {
+        let line: Vec<String> = r
+            .iter()
+            .zip(&widths)
+            .map(|(s, w)| format!("{s:>w$}"))
+            .collect();
+        println!("{}", line.join("  "));
+    }
+}
+
+/// `convergence.svg`: multistart best-so-far over cumulative function calls
+/// (runs in start order) and the evolution's best-so-far per generation.
+fn convergence_plot(
+    problem: &dyn Problem,
+    dir: &Path,
+    ms: Option<&multistart::Report>,
+    ev: Option<&evolve::Report>,
+) -> Result<()> {
+    let mut curves = Vec::new();
+    if let Some(ms) = ms {
+        let (mut calls, mut best) = (0usize, f64::INFINITY);
+        let mut pts = Vec::new();
+        for r in &ms.runs {
+            calls += r.function_calls;
+            if let Some(res) = &r.result {
+                best = best.min(res.f);
+            }
+            if best.is_finite() {
+                pts.push((calls as f64, best));
+            }
+        }
+        curves.push(crate::report::Curve {
+            label: "multistart (best so far)".into(),
+            points: pts,
+        });
+    }
+    if let Some(ev) = ev {
+        curves.push(crate::report::Curve {
+            label: "CMA-ES (best so far)".into(),
+            points: ev
+                .generations
+                .iter()
+                .filter(|g| g.best_f.is_finite())
+                .map(|g| (g.function_calls as f64, g.best_f))
+                .collect(),
+        });
+    }
+    crate::report::line_plot(
+        &dir.join("convergence.svg"),
+        &crate::report::Axes {
+            title: &format!("{}: best objective vs function calls", problem.name()),
+            x: "function calls",
+            y: "best f",
+        },
+        &curves,
+    )
+}
+
+/// `plyscape map`: the grid(s), marked with the optima in `optima.csv` and
+/// the evolution's best in `evolution.csv` when those exist in the study's
+/// output directory.
+pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
+    let problem = problem(ctx.study)?;
+    let sec: MapSection = ctx.study.section("map")?.unwrap_or(MapSection {
+        resolution: default_resolution(),
+        pairs: None,
+    });
+    let loc = ctx.study.locate("map");
+    if !(2..=2001).contains(&sec.resolution) {
+        return Err(loc(Error::input(
+            "resolution",
+            sec.resolution,
+            "2 <= resolution <= 2001",
+        )));
+    }
+    let vars = problem.variables();
+    let n = vars.len();
+    let pairs: Vec<(usize, usize)> = match &sec.pairs {
+        Some(p) => {
+            for (k, &[a, b]) in p.iter().enumerate() {
+                if a >= n || b >= n || a == b {
+                    return Err(loc(Error::input(
+                        format!("pairs[{k}]"),
+                        format!("[{a}, {b}]"),
+                        format!("two different variable indices < {n}"),
+                    )));
+                }
+            }
+            p.iter().map(|&[a, b]| (a, b)).collect()
+        }
+        None => (0..n / 2).map(|k| (2 * k, 2 * k + 1)).collect(),
+    };
+    let dir = ctx.dir()?;
+    let optima = read_points(&dir.join("optima.csv"), "x_", vars)?;
+    let evo = read_points(&dir.join("evolution.csv"), "best_x_", vars)?;
+    let base = optima
+        .first()
+        .cloned()
+        .unwrap_or_else(|| vars.iter().map(|v| 0.5 * (v.lower + v.upper)).collect());
+    let mut marks = Vec::new();
+    if !optima.is_empty() {
+        marks.push(("local optima".to_string(), optima));
+    }
+    if let Some(best) = evo.last() {
+        marks.push(("CMA-ES best".to_string(), vec![best.clone()]));
+    }
+    let req = map::MapRequest {
+        resolution: sec.resolution,
+        pairs,
+        base,
+        marks,
+    };
+    let slices = map::run(problem.as_ref(), &req, ctx.threads, &dir)?;
+    ctx.manifest(&dir, "map", json!({"resolution": sec.resolution}))?;
+    if !ctx.quiet {
+        println!(
+            "map of {}: {} slice(s) of {}^2 points in {}",
+            problem.name(),
+            slices.len(),
+            sec.resolution,
+            dir.display()
+        );
+    }
+    Ok(slices)
+}
+
+/// Designs from the `<prefix><name>` columns of a CSV, if the file exists.
+fn read_points(
+    path: &Path,
+    prefix: &str,
+    vars: &[crate::optimize::Variable],
+) -> Result<Vec<Vec<f64>>> {
+    if !path.exists() {
+        return Ok(vec![]);
+    }
+    let mut rd = csv::Reader::from_path(path).map_err(|e| Error::csv(path, e))?;
+    let headers = rd.headers().map_err(|e| Error::csv(path, e))?.clone();
+    let cols: Option<Vec<usize>> = vars
+        .iter()
+        .map(|v| {
+            headers
+                .iter()
+                .position(|h| h == format!("{prefix}{}", v.name))
+        })
+        .collect();
+    let Some(cols) = cols else { return Ok(vec![]) };
+    let mut out = Vec::new();
+    for r in rd.records() {
+        let r = r.map_err(|e| Error::csv(path, e))?;
+        let x: Option<Vec<f64>> = cols.iter().map(|&c| r.get(c)?.parse().ok()).collect();
+        if let Some(x) = x {
+            out.push(x);
+        }
+    }
+    Ok(out)
+}
+
+/// `plyscape merge`: combine the shard directories of one multistart into
+/// the tables an unsharded run gives, in `out/<study>/`.
+pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<multistart::Report> {
+    if dirs.is_empty() {
+        return Err(Error::input(
+            "dirs",
+            "(none)",
+            "at least one shard directory",
+        ));
+    }
+    let mut text = None;
+    let mut seen = Vec::new();
+    for d in dirs {
+        let m = crate::report::read_manifest(d)?;
+        let t = m["study_text"].as_str().unwrap_or_default().to_string();
+        let shard = (m["shard"]["index"].as_u64(), m["shard"]["count"].as_u64());
+        let (Some(i), Some(n)) = shard else {
+            return Err(Error::input(
+                d.display().to_string(),
+                "manifest.json",
+                "a shard manifest",
+            ));
+        };
+        if m["commands"]["multistart"]["complete"].as_bool() != Some(true) {
+            return Err(Error::input(
+                d.display().to_string(),
+                format!("shard {i}/{n} (incomplete)"),
+                "a finished shard (finish it with --resume first)",
+            ));
+        }
+        match &text {
+            None => {
+                text = Some((
+                    t,
+                    m["study_file"].as_str().unwrap_or("study").to_string(),
+                    n,
+                ))
+            }
+            Some((t0, _, n0)) if *t0 == t && *n0 == n => {}
+            Some(_) => {
+                return Err(Error::input(
+                    d.display().to_string(),
+                    format!("shard {i}/{n}"),
+                    "shards of the same study text and shard count",
+                ))
+            }
+        }
+        seen.push(i);
+    }
+    let (text, file, n) = text.expect("dirs is not empty");
+    let mut sorted = seen.clone();
+    sorted.sort_unstable();
+    if sorted != (0..n).collect::<Vec<_>>() {
+        return Err(Error::input(
+            "dirs",
+            format!("shards {seen:?}"),
+            format!("each of the shards 0..{n} exactly once"),
+        ));
+    }
+    let study = Study::parse(&file, &text)?;
+    let problem = problem(&study)?;
+    let plan = multistart_plan(&study, problem.as_ref())?;
+    let vars = problem.variables();
+    let m = problem.n_constraints();
+    let mut rows = Vec::new();
+    for d in dirs {
+        let r = tables::read_runs(&d.join("runs.csv"), vars, m)?;
+        if r.repaired_bytes > 0 {
+            return Err(Error::csv(
+                d.join("runs.csv"),
+                "torn last line in a finished shard",
+            ));
+        }
+        for row in &r.rows {
+            let ok = plan.starts.points.get(row.start).is_some_and(|x0| {
+                x0.iter()
+                    .zip(&row.x0)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            });
+            if !ok {
+                return Err(Error::csv(
+                    d.join("runs.csv"),
+                    format!("row for start {} does not match the study", row.start),
+                ));
+            }
+        }
+        rows.extend(r.rows);
+    }
+    let dir = study.output_dir(out)?;
+    let wall = dirs
+        .iter()
+        .filter_map(|d| {
+            crate::report::read_manifest(d).ok()?["commands"]["multistart"]["wall_seconds"].as_f64()
+        })
+        .fold(0.0, f64::max);
+    let report = multistart::finish(vars, m, rows, plan.tolerances, &dir, wall)?;
+    // The manifest's thread count: the largest any shard used.
+    let threads = dirs
+        .iter()
+        .filter_map(|d| crate::report::read_manifest(d).ok()?["threads"].as_u64())
+        .max()
+        .unwrap_or(1) as usize;
+    let ctx = Context {
+        study: &study,
+        out,
+        threads,
+        quiet,
+        flags: DriveFlags::default(),
+    };
+    ctx.manifest(
+        &dir,
+        "merge",
+        json!({
+            "complete": true,
+            "merged_from": dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>(),
+            "wall_seconds": wall,
+        }),
+    )?;
+    if !quiet {
+        print_optima(problem.as_ref(), &report);
+    }
+    Ok(report)
+}

@@ -1,0 +1,219 @@
+//! Evolutionary search (CMA-ES with restarts) with per-generation records.
+//!
+//! The solver itself lives in `optimize::cmaes`; this driver gives it the
+//! budget and the seed, runs it inside a rayon pool of the study's thread
+//! count (so a solver that evaluates its population with rayon uses exactly
+//! those threads), and turns its per-generation [`IterRecord`]s into
+//! `evolution.csv`.
+//!
+//! The solver reports best-so-far `f` and σ per generation, not the mean of
+//! the population; the driver therefore records every objective value the
+//! solver asks for and, at each generation record, takes the mean of the
+//! values requested since the previous record (sorted before summing, so the
+//! mean does not depend on the order in which parallel evaluations finish).
+
+use super::tables::{num, write_atomic};
+use crate::error::{Error, Result};
+use crate::optimize::{
+    Counted, Evaluation, GlobalOutcome, IterRecord, Observer, Problem, Variable,
+};
+use crate::report::Progress;
+use std::path::Path;
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// What the evolutionary solver is given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Request {
+    /// Seed of every random choice of the solver.
+    pub seed: u64,
+    /// Function-evaluation budget.
+    pub max_evaluations: usize,
+}
+
+/// An evolutionary solver: CMA-ES in the binary, anything in tests.
+pub type GlobalSolver<'a> =
+    dyn Fn(&dyn Problem, &Request, &mut dyn Observer) -> Result<GlobalOutcome> + Sync + 'a;
+
+/// One row of `evolution.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Generation {
+    /// Generation number from the solver (over all restarts).
+    pub generation: usize,
+    /// Function evaluations so far (driver's count).
+    pub function_calls: usize,
+    /// Best-so-far objective.
+    pub best_f: f64,
+    /// Largest constraint at the best-so-far design.
+    pub best_max_g: f64,
+    /// Mean objective of the designs evaluated in this generation.
+    pub mean_f: Option<f64>,
+    /// Step size σ.
+    pub sigma: f64,
+    /// Best-so-far design.
+    pub best_x: Vec<f64>,
+}
+
+/// The result of an evolutionary search.
+#[derive(Debug, Clone)]
+pub struct Report {
+    /// The solver's outcome.
+    pub outcome: GlobalOutcome,
+    /// Per-generation rows.
+    pub generations: Vec<Generation>,
+    /// Function calls (driver's count).
+    pub function_calls: usize,
+    /// Gradient calls (driver's count; CMA-ES uses none).
+    pub gradient_calls: usize,
+    /// Wall time \[s\].
+    pub wall_seconds: f64,
+}
+
+/// Records every objective value requested, in request order.
+struct Recorder<'a> {
+    inner: &'a dyn Problem,
+    values: Mutex<Vec<f64>>,
+}
+
+impl Problem for Recorder<'_> {
+    fn variables(&self) -> &[Variable] {
+        self.inner.variables()
+    }
+    fn n_constraints(&self) -> usize {
+        self.inner.n_constraints()
+    }
+    fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
+        let e = self.inner.evaluate(x, gradients)?;
+        if e.f.is_finite() {
+            self.values.lock().expect("no panics").push(e.f);
+        }
+        Ok(e)
+    }
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+}
+
+struct GenObserver<'a> {
+    recorder: &'a Recorder<'a>,
+    counted: &'a Counted<'a>,
+    seen: usize,
+    rows: Vec<Generation>,
+    progress: Progress,
+    budget: usize,
+}
+
+impl Observer for GenObserver<'_> {
+    fn observe(&mut self, r: &IterRecord) {
+        let values = self.recorder.values.lock().expect("no panics");
+        let mut gen: Vec<f64> = values[self.seen.min(values.len())..].to_vec();
+        self.seen = values.len();
+        drop(values);
+        gen.sort_by(f64::total_cmp);
+        let mean_f = (!gen.is_empty()).then(|| gen.iter().sum::<f64>() / gen.len() as f64);
+        let calls = self.counted.function_calls();
+        self.progress.set(
+            calls.min(self.budget) as u64,
+            &format!("generation {}  best f {:.6e}", r.iteration, r.f),
+        );
+        self.rows.push(Generation {
+            generation: r.iteration,
+            function_calls: calls,
+            best_f: r.f,
+            best_max_g: r.max_g,
+            mean_f,
+            sigma: r.step,
+            best_x: r.x.clone(),
+        });
+    }
+}
+
+/// Run `solver` on `problem` with `threads` rayon threads; write
+/// `evolution.csv` and `convergence` data into `dir`.
+pub fn run(
+    problem: &dyn Problem,
+    solver: &GlobalSolver,
+    request: &Request,
+    threads: usize,
+    quiet: bool,
+    dir: &Path,
+) -> Result<Report> {
+    let t0 = Instant::now();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::input("threads", threads, format!("a usable count ({e})")))?;
+    let recorder = Recorder {
+        inner: problem,
+        values: Mutex::new(Vec::new()),
+    };
+    let counted = Counted::new(&recorder);
+    let mut obs = GenObserver {
+        recorder: &recorder,
+        counted: &counted,
+        seen: 0,
+        rows: Vec::new(),
+        progress: Progress::new("evolution", request.max_evaluations as u64, quiet),
+        budget: request.max_evaluations,
+    };
+    let outcome = pool.install(|| solver(&counted, request, &mut obs))?;
+    obs.progress.finish();
+    if !(outcome.f.is_finite() && outcome.x.iter().chain(&outcome.g).all(|v| v.is_finite())) {
+        return Err(Error::numerical(
+            "explore::evolve",
+            format!(
+                "non-finite best design f = {} at x = {:?}",
+                outcome.f, outcome.x
+            ),
+        ));
+    }
+    let report = Report {
+        function_calls: counted.function_calls(),
+        gradient_calls: counted.gradient_calls(),
+        generations: std::mem::take(&mut obs.rows),
+        outcome,
+        wall_seconds: t0.elapsed().as_secs_f64(),
+    };
+    write_atomic(
+        &dir.join("evolution.csv"),
+        &table(problem, &report.generations),
+    )?;
+    Ok(report)
+}
+
+/// `evolution.csv`: header and one row per generation. Non-finite entries
+/// are left empty.
+pub fn table(problem: &dyn Problem, rows: &[Generation]) -> Vec<Vec<String>> {
+    let vars = problem.variables();
+    let m = problem.n_constraints();
+    let fin = |v: f64| if v.is_finite() { num(v) } else { String::new() };
+    let mut h: Vec<String> = [
+        "generation",
+        "function_calls",
+        "best_f",
+        "best_max_g",
+        "mean_f",
+        "sigma",
+    ]
+    .map(String::from)
+    .to_vec();
+    h.extend(vars.iter().map(|v| format!("best_x_{}", v.name)));
+    let mut out = vec![h];
+    for g in rows {
+        let mut r = vec![
+            g.generation.to_string(),
+            g.function_calls.to_string(),
+            fin(g.best_f),
+            if m > 0 {
+                fin(g.best_max_g)
+            } else {
+                String::new()
+            },
+            g.mean_f.map(fin).unwrap_or_default(),
+            fin(g.sigma),
+        ];
+        r.extend(g.best_x.iter().map(|&v| fin(v)));
+        out.push(r);
+    }
+    out
+}

@@ -1,0 +1,228 @@
+//! The optimizers the drivers can call, by the names study files use.
+//!
+//! - `mmfd` (default): the modified method of feasible directions of
+//!   `optimize::mmfd` with its default options.
+//! - `steepest`: projected steepest descent with Armijo backtracking, for
+//!   problems without general constraints. A cheap baseline for the
+//!   multistart (and a solver the driver tests can rely on independently
+//!   of MMFD): `x ← P(x − α ∇f)`, `α` halved from the previous accepted step
+//!   times 2 until `f(P(x − α∇f)) <= f(x) − 1e-4 ∇f·(x − P(x − α∇f))`;
+//!   stops when the projected step is below `1e-10` of the box in every
+//!   coordinate, when `|Δf| <= 1e-14 max(1, |f|)`, or after 10 000
+//!   iterations. `P` wraps periodic variables and clamps the others.
+//!
+//! The evolutionary solver is `optimize::cmaes`.
+
+use super::evolve::{GlobalSolver, Request};
+use super::multistart::LocalSolver;
+use crate::error::{Error, Result};
+use crate::optimize::{Counted, LocalOutcome, NoObserver, Problem, Termination};
+
+/// Local methods by name.
+pub const LOCAL_METHODS: &str = "mmfd, steepest";
+
+/// Check a local method name (error key `method`).
+pub fn check_local(method: &str) -> Result<()> {
+    match method {
+        "mmfd" | "steepest" => Ok(()),
+        other => Err(Error::input(
+            "method",
+            format!("\"{other}\""),
+            format!("one of {LOCAL_METHODS}"),
+        )),
+    }
+}
+
+/// MMFD settings a study may change (`[multistart.mmfd]`); absent keys
+/// keep DOT's defaults (`optimize::mmfd::MmfdOptions::default()`).
+#[derive(Debug, Clone, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MmfdSettings {
+    /// Relative convergence DELOBJ on |Δf|/|f|.
+    pub delobj: Option<f64>,
+    /// Absolute convergence DABOBJ on |Δf|.
+    pub dabobj: Option<f64>,
+    /// Consecutive converged iterations ITRMOP.
+    pub itrmop: Option<usize>,
+    /// Iteration limit ITMAX.
+    pub max_iterations: Option<usize>,
+    /// Kuhn–Tucker tolerance.
+    pub kt_tolerance: Option<f64>,
+}
+
+impl MmfdSettings {
+    /// Check the given values (error keys inside `[multistart.mmfd]`).
+    pub fn check(&self) -> Result<()> {
+        for (k, v) in [
+            ("delobj", self.delobj),
+            ("dabobj", self.dabobj),
+            ("kt_tolerance", self.kt_tolerance),
+        ] {
+            if let Some(v) = v {
+                crate::error::require_positive(k, v)?;
+            }
+        }
+        for (k, v) in [
+            ("itrmop", self.itrmop),
+            ("max_iterations", self.max_iterations),
+        ] {
+            if v == Some(0) {
+                return Err(Error::input(k, 0, "a count >= 1"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The full option set.
+    pub fn options(&self) -> crate::optimize::mmfd::MmfdOptions {
+        let d = crate::optimize::mmfd::MmfdOptions::default();
+        crate::optimize::mmfd::MmfdOptions {
+            delobj: self.delobj.unwrap_or(d.delobj),
+            dabobj: self.dabobj.or(d.dabobj),
+            itrmop: self.itrmop.unwrap_or(d.itrmop),
+            max_iterations: self.max_iterations.unwrap_or(d.max_iterations),
+            kt_tolerance: self.kt_tolerance.unwrap_or(d.kt_tolerance),
+            ..d
+        }
+    }
+}
+
+/// The local solver called `method` (MMFD with `mmfd`'s settings).
+pub fn local(method: &str, mmfd: &MmfdSettings) -> Result<Box<LocalSolver<'static>>> {
+    check_local(method)?;
+    let options = mmfd.options();
+    Ok(match method {
+        "steepest" => Box::new(|p: &dyn Problem, x0: &[f64]| steepest(p, x0)),
+        _ => Box::new(move |p: &dyn Problem, x0: &[f64]| {
+            crate::optimize::mmfd::minimize(p, x0, &options, &mut NoObserver)
+        }),
+    })
+}
+
+/// CMA-ES with restarts, seeded and budgeted by the request.
+pub fn global() -> Box<GlobalSolver<'static>> {
+    Box::new(
+        |p: &dyn Problem, r: &Request, obs: &mut dyn crate::optimize::Observer| {
+            let options = crate::optimize::cmaes::CmaesOptions {
+                seed: r.seed,
+                max_evaluations: r.max_evaluations,
+                ..Default::default()
+            };
+            crate::optimize::cmaes::minimize(p, &options, obs)
+        },
+    )
+}
+
+/// Projected steepest descent (see the module doc).
+pub fn steepest(problem: &dyn Problem, x0: &[f64]) -> Result<LocalOutcome> {
+    let vars = problem.variables();
+    if problem.n_constraints() > 0 {
+        return Err(Error::input(
+            "method",
+            "\"steepest\"",
+            "mmfd for a problem with constraints",
+        ));
+    }
+    let counted = Counted::new(problem);
+    let problem = &counted;
+    let project =
+        |x: &[f64]| -> Vec<f64> { x.iter().zip(vars).map(|(&v, var)| var.wrap(v)).collect() };
+    let mut x = project(x0);
+    let mut e = problem.evaluate(&x, true)?;
+    let mut alpha = 1.0;
+    let mut iterations = 0;
+    let termination = loop {
+        if iterations == 10_000 {
+            break Termination::MaxIterations;
+        }
+        iterations += 1;
+        let grad = e
+            .grad_f
+            .clone()
+            .ok_or_else(|| Error::numerical("explore::steepest", "problem returned no gradient"))?;
+        alpha *= 2.0;
+        let mut accepted = None;
+        while alpha > 1e-30 {
+            let trial: Vec<f64> = project(
+                &x.iter()
+                    .zip(&grad)
+                    .map(|(a, g)| a - alpha * g)
+                    .collect::<Vec<_>>(),
+            );
+            // Directional decrease along the projected step, periodic aware.
+            let decrease: f64 = grad
+                .iter()
+                .zip(vars)
+                .zip(x.iter().zip(&trial))
+                .map(|((g, var), (a, b))| g * var.difference(*a, *b))
+                .sum();
+            let small = vars.iter().zip(x.iter().zip(&trial)).all(|(var, (a, b))| {
+                var.difference(*a, *b).abs() <= 1e-10 * (var.upper - var.lower)
+            });
+            if small {
+                break;
+            }
+            let et = problem.evaluate(&trial, false)?;
+            if et.f <= e.f - 1e-4 * decrease {
+                accepted = Some((trial, et.f));
+                break;
+            }
+            alpha *= 0.5;
+        }
+        let Some((xn, fnew)) = accepted else {
+            break Termination::KuhnTucker;
+        };
+        let df = (e.f - fnew).abs();
+        x = xn;
+        e = problem.evaluate(&x, true)?;
+        if df <= 1e-14 * e.f.abs().max(1.0) {
+            break Termination::AbsoluteChange;
+        }
+    };
+    Ok(LocalOutcome {
+        f: e.f,
+        g: e.g,
+        iterations,
+        function_calls: counted.function_calls(),
+        gradient_calls: counted.gradient_calls(),
+        active_constraints: 0,
+        active_side_constraints: x
+            .iter()
+            .zip(vars)
+            .filter(|(v, var)| var.period.is_none() && (**v == var.lower || **v == var.upper))
+            .count(),
+        x,
+        termination,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optimize::testproblems;
+
+    #[test]
+    fn steepest_descent_reaches_known_minima() {
+        // Himmelblau from (0, 0) flows to the minimum (3, 2), f* = 0
+        // (Himmelblau 1972, p. 428).
+        let h = testproblems::himmelblau();
+        let o = steepest(&h, &[0.0, 0.0]).unwrap();
+        assert!(
+            o.f < 1e-12 && (o.x[0] - 3.0).abs() < 1e-6 && (o.x[1] - 2.0).abs() < 1e-6,
+            "{o:?}"
+        );
+        assert!(o.function_calls >= o.gradient_calls && o.gradient_calls > 0);
+        // The seam problem: from (-80, 80) the optimum (88, -85) lies across
+        // the +-90 seam (testproblems::seam doc); wrapping must find it.
+        let s = testproblems::seam();
+        let o = steepest(&s, &[-80.0, 80.0]).unwrap();
+        assert!(o.f < 1e-10, "{o:?}");
+        assert!(
+            (o.x[0] - 88.0).abs() < 1e-3 && (o.x[1] + 85.0).abs() < 1e-3,
+            "{o:?}"
+        );
+        // Constraints are refused with an input error.
+        let e = steepest(&crate::explore::problems::Hs22::new(), &[0.0, 0.0]).unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+    }
+}

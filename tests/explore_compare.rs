@@ -1,0 +1,164 @@
+//! Comparison (multistart + CMA-ES), evolution table and design-space map.
+
+mod explore_common;
+
+use explore_common::{column, ctx, study, table_without, temp_dir};
+use plyscape::explore::{self, DriveFlags};
+
+fn text(name: &str, problem: &str, extra: &str) -> String {
+    format!(
+        "[study]\nname = \"{name}\"\nseed = 4\n[problem]\nname = \"{problem}\"\n\
+         [multistart]\nsampler = \"sobol\"\nstarts = 16\n{extra}[compare]\n[map]\nresolution = 21\n"
+    )
+}
+
+#[test]
+fn compare_tables_are_identical_on_one_and_two_threads() {
+    let dir = temp_dir("cmp-threads");
+    let s = study("c", &text("c", "himmelblau", ""));
+    let (d1, d2) = (dir.join("t1"), dir.join("t2"));
+    explore::run_compare(&ctx(&s, &d1, 1, DriveFlags::default())).unwrap();
+    explore::run_compare(&ctx(&s, &d2, 2, DriveFlags::default())).unwrap();
+    for f in ["runs.csv", "optima.csv", "comparison.csv", "evolution.csv"] {
+        assert_eq!(
+            table_without(&d1.join("c").join(f), &["wall_seconds"]),
+            table_without(&d2.join("c").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn comparison_names_the_global_minimum() {
+    let dir = temp_dir("cmp-global");
+    // Himmelblau: four global minima, f* = 0 (Himmelblau 1972, p. 428).
+    let s = study("h", &text("h", "himmelblau", ""));
+    let rows = explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    let minima = [
+        [3.0, 2.0],
+        [-2.805118, 3.131312],
+        [-3.779310, -3.283186],
+        [3.584428, -1.848126],
+    ];
+    assert_eq!(rows.len(), 2);
+    for r in &rows {
+        assert!(r.best_f.abs() < 1e-6, "{r:?}");
+        assert!(
+            minima
+                .iter()
+                .any(|m| (m[0] - r.best_x[0]).abs() < 1e-3 && (m[1] - r.best_x[1]).abs() < 1e-3),
+            "{r:?}"
+        );
+        assert!(r.feasible);
+    }
+    let ms = &rows[0];
+    assert_eq!(ms.method, "multistart-mmfd");
+    assert_eq!(ms.distinct_optima, Some(4));
+    // CMA-ES gets the multistart's function calls as its budget and stops
+    // at the end of the generation that reaches it.
+    let t = table_without(&dir.join("h/comparison.csv"), &[]);
+    let calls: Vec<usize> = column(&t, "function_calls")
+        .iter()
+        .map(|c| c.parse().unwrap())
+        .collect();
+    assert!(calls[1] <= calls[0] + 64, "{calls:?}");
+    // The multistart's p_single_start is its best optimum's basin share,
+    // recomputed here from runs.csv.
+    let runs = table_without(&dir.join("h/runs.csv"), &[]);
+    let hits = column(&runs, "optimum")
+        .iter()
+        .filter(|o| *o == "0")
+        .count();
+    assert_eq!(ms.p_single_start, Some(hits as f64 / 16.0));
+
+    // Periodic2: the unique global minimum f = -5 at theta1 = +-90 (seam),
+    // theta2 = -30 (closed form, explore::problems::Periodic2).
+    let s = study("p", &text("p", "periodic2", ""));
+    let rows = explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    for r in &rows {
+        assert!((r.best_f + 5.0).abs() < 1e-6, "{r:?}");
+        assert!(
+            (r.best_x[0].abs() - 90.0).abs() < 1e-2 && (r.best_x[1] + 30.0).abs() < 1e-2,
+            "{r:?}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn evolution_table_and_map_match_direct_evaluation() {
+    let dir = temp_dir("cmp-map");
+    // HS 22: constrained, so the map has infeasible cells.
+    let s = study("m", &text("m", "hs22", ""));
+    explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    let slices = explore::run_map(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    assert_eq!(slices.len(), 1);
+    let p = explore::problem(&s).unwrap();
+    let map = table_without(&dir.join("m/map.csv"), &[]);
+    assert_eq!(map.len(), 1 + 21 * 21);
+    assert_eq!(map[0], ["x_x1", "x_x2", "f", "g1", "g2", "max_g"]);
+    for row in &map[1..] {
+        let x: Vec<f64> = row[..2].iter().map(|v| v.parse().unwrap()).collect();
+        let e = p.evaluate(&x, false).unwrap();
+        assert_eq!(row[2].parse::<f64>().unwrap(), e.f);
+        assert_eq!(row[5].parse::<f64>().unwrap(), e.max_g());
+    }
+    let svg = std::fs::read_to_string(dir.join("m/map.svg")).unwrap();
+    assert!(svg.contains("local optima") && svg.contains("CMA-ES best"));
+    // evolution.csv: one row per generation, the evaluations grow, every
+    // generation has a population mean.
+    let ev = table_without(&dir.join("m/evolution.csv"), &[]);
+    let best: Vec<f64> = column(&ev, "best_f")
+        .iter()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let calls: Vec<usize> = column(&ev, "function_calls")
+        .iter()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(best.len() > 5);
+    assert!(calls.windows(2).all(|w| w[0] < w[1]));
+    let mean = column(&ev, "mean_f");
+    assert!(mean.iter().all(|m| !m.is_empty()));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn more_than_two_variables_get_slices_through_the_base_design() {
+    let dir = temp_dir("cmp-slices");
+    let s = study(
+        "r",
+        "[study]\nname = \"r\"\n[problem]\nname = \"rosenbrock\"\ndimension = 4\n\
+         [map]\nresolution = 5\npairs = [[0, 1], [3, 2]]\n",
+    );
+    let slices = explore::run_map(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    assert_eq!(slices.len(), 2);
+    let p = explore::problem(&s).unwrap();
+    let centre: Vec<f64> = p
+        .variables()
+        .iter()
+        .map(|v| 0.5 * (v.lower + v.upper))
+        .collect();
+    // Slice (3, 2): x3 along the first axis, x2 along the second, x0 and x1
+    // at the box centre (no optima yet).
+    let t = table_without(&dir.join("r/map_3_2.csv"), &[]);
+    assert_eq!(t.len(), 1 + 25);
+    for row in &t[1..] {
+        let mut x = centre.clone();
+        x[3] = row[0].parse().unwrap();
+        x[2] = row[1].parse().unwrap();
+        assert_eq!(
+            row[2].parse::<f64>().unwrap(),
+            p.evaluate(&x, false).unwrap().f
+        );
+    }
+    assert!(dir.join("r/map_0_1.svg").exists());
+    let bad = study(
+        "b",
+        "[problem]\nname = \"rosenbrock\"\ndimension = 4\n[map]\npairs = [[0, 4]]\n",
+    );
+    let e = explore::run_map(&ctx(&bad, &dir, 1, DriveFlags::default())).unwrap_err();
+    assert!(e.to_string().contains("map.pairs[0]"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

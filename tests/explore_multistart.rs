@@ -1,0 +1,338 @@
+//! Multistart driver: known optima, reproducibility over threads, resume,
+//! shards, bad input.
+
+mod explore_common;
+
+use explore_common::{column, ctx, study, table_without, temp_dir};
+use plyscape::explore::multistart::Shard;
+use plyscape::explore::{self, DriveFlags};
+
+/// Local method used by these tests.
+const METHOD: &str = "mmfd";
+/// MMFD converged far tighter than DOT's defaults (DELOBJ = 1e-3), so the
+/// optima can be compared with the published minima to 1e-5.
+const TIGHT: &str = "[multistart.mmfd]\ndelobj = 1e-12\ndabobj = 1e-14\nkt_tolerance = 1e-10\nmax_iterations = 500\n";
+
+fn himmelblau(starts: usize, extra: &str) -> String {
+    format!(
+        "[study]\nname = \"h\"\nseed = 11\n[problem]\nname = \"himmelblau\"\n\
+         [multistart]\nmethod = \"{METHOD}\"\nsampler = \"lhs\"\nstarts = {starts}\n{extra}{TIGHT}"
+    )
+}
+
+/// Himmelblau's four minima (Himmelblau 1972, p. 428; f = 0 at each).
+const MINIMA: [[f64; 2]; 4] = [
+    [3.0, 2.0],
+    [-2.805118, 3.131312],
+    [-3.779310, -3.283186],
+    [3.584428, -1.848126],
+];
+
+#[test]
+fn himmelblau_finds_all_four_minima_with_their_basin_counts() {
+    let dir = temp_dir("ms-himmelblau");
+    let s = study("h", &himmelblau(40, ""));
+    let r = explore::run_multistart(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    assert_eq!(r.runs.len(), 40);
+    assert_eq!(r.optima.len(), 4, "{:#?}", r.optima);
+    // Each optimum is one of the known minima (to the 6 digits quoted).
+    let mut counts = [0usize; 4];
+    for o in &r.optima {
+        assert!(o.f.abs() < 1e-9, "f = {}", o.f);
+        let k = MINIMA
+            .iter()
+            .position(|m| (m[0] - o.x[0]).abs() < 1e-5 && (m[1] - o.x[1]).abs() < 1e-5)
+            .unwrap_or_else(|| panic!("{:?} is not a known minimum", o.x));
+        counts[k] = o.count;
+    }
+    // Basin counts: each run assigned to the nearest known minimum,
+    // counted independently of the clustering.
+    let mut direct = [0usize; 4];
+    for run in &r.runs {
+        let x = &run.result.as_ref().unwrap().x;
+        let k = (0..4)
+            .min_by(|&a, &b| {
+                let d = |m: &[f64; 2]| (m[0] - x[0]).hypot(m[1] - x[1]);
+                d(&MINIMA[a]).total_cmp(&d(&MINIMA[b]))
+            })
+            .unwrap();
+        direct[k] += 1;
+    }
+    assert_eq!(counts, direct);
+    assert!(direct.iter().all(|&c| c > 0));
+    let shares: f64 = r.optima.iter().map(|o| o.basin_share).sum();
+    assert!((shares - 1.0).abs() < 1e-12);
+    // optima.csv repeats the counts; runs.csv names each run's optimum.
+    let t = table_without(&dir.join("h/optima.csv"), &[]);
+    let csv_counts: Vec<usize> = column(&t, "count")
+        .iter()
+        .map(|c| c.parse().unwrap())
+        .collect();
+    assert_eq!(
+        csv_counts,
+        r.optima.iter().map(|o| o.count).collect::<Vec<_>>()
+    );
+    let runs = table_without(&dir.join("h/runs.csv"), &[]);
+    for (id, o) in r.optima.iter().enumerate() {
+        let n = column(&runs, "optimum")
+            .iter()
+            .filter(|v| **v == id.to_string())
+            .count();
+        assert_eq!(n, o.count);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn periodic_optima_merge_across_the_seam() {
+    let dir = temp_dir("ms-periodic");
+    let text = format!(
+        "[study]\nname = \"p\"\nseed = 5\n[problem]\nname = \"periodic2\"\n\
+         [multistart]\nmethod = \"{METHOD}\"\nsampler = \"sobol\"\nstarts = 64\n\
+         points = [[89.0, -30.0], [-89.0, -30.0]]\n{TIGHT}"
+    );
+    let s = study("p", &text);
+    let r = explore::run_multistart(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    // Closed-form landscape (Periodic2 doc): minima -5, -3, -1, 1.
+    let fs: Vec<f64> = r.optima.iter().map(|o| o.f).collect();
+    assert_eq!(r.optima.len(), 4, "{fs:?}");
+    for (f, e) in fs.iter().zip([-5.0, -3.0, -1.0, 1.0]) {
+        assert!((f - e).abs() < 1e-9, "{fs:?}");
+    }
+    // The global minimum sits on the seam theta1 = +-90: the two listed
+    // starts approach it from both sides and land in one optimum.
+    let best = &r.optima[0];
+    assert_eq!(r.runs[0].optimum, Some(0));
+    assert_eq!(r.runs[1].optimum, Some(0));
+    let x0 = r.runs[0].result.as_ref().unwrap().x[0];
+    let x1 = r.runs[1].result.as_ref().unwrap().x[0];
+    assert!((89.0..=90.0).contains(&x0.abs()) && (89.0..=90.0).contains(&x1.abs()));
+    assert!((best.x[1] + 30.0).abs() < 1e-3);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn one_and_two_threads_give_identical_tables() {
+    let dir = temp_dir("ms-threads");
+    let s = study("h", &himmelblau(24, ""));
+    let (d1, d2) = (dir.join("t1"), dir.join("t2"));
+    explore::run_multistart(&ctx(&s, &d1, 1, DriveFlags::default())).unwrap();
+    explore::run_multistart(&ctx(&s, &d2, 2, DriveFlags::default())).unwrap();
+    for f in ["runs.csv", "optima.csv"] {
+        assert_eq!(
+            table_without(&d1.join("h").join(f), &["wall_seconds"]),
+            table_without(&d2.join("h").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn resume_after_a_kill_gives_the_uninterrupted_tables() {
+    let dir = temp_dir("ms-resume");
+    let s = study("h", &himmelblau(20, ""));
+    let full = dir.join("full");
+    explore::run_multistart(&ctx(&s, &full, 2, DriveFlags::default())).unwrap();
+    let runs = std::fs::read_to_string(full.join("h/runs.csv")).unwrap();
+    let lines: Vec<&str> = runs.lines().collect();
+    // What a kill leaves: the header, some finished rows in completion
+    // order (here: an arbitrary subset, shuffled, optimum ids still empty),
+    // and half a line.
+    let part = dir.join("part");
+    std::fs::create_dir_all(part.join("h")).unwrap();
+    let mut text = format!("{}\n", lines[0]);
+    for k in [7, 2, 13, 1, 19, 4] {
+        let mut fields: Vec<&str> = lines[k + 1].split(',').collect();
+        *fields.last_mut().unwrap() = "";
+        text.push_str(&fields.join(","));
+        text.push('\n');
+    }
+    text.push_str(&lines[10][..lines[10].len() / 2]);
+    std::fs::write(part.join("h/runs.csv"), &text).unwrap();
+    let flags = DriveFlags {
+        resume: true,
+        ..Default::default()
+    };
+    let r = explore::run_multistart(&ctx(&s, &part, 1, flags)).unwrap();
+    assert_eq!(r.new_runs, 14, "6 rows kept, the torn one runs again");
+    for f in ["runs.csv", "optima.csv"] {
+        assert_eq!(
+            table_without(&full.join("h").join(f), &["wall_seconds"]),
+            table_without(&part.join("h").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    // A budget stops launching cleanly; resuming without it completes.
+    let budget = dir.join("budget");
+    let sb = study("h", &himmelblau(20, "max_evaluations = 300\n"));
+    let rb = explore::run_multistart(&ctx(&sb, &budget, 2, DriveFlags::default())).unwrap();
+    let k = rb.runs.len();
+    assert!(k < 20 && k > 0, "{k}");
+    let used_before_last: usize = rb.runs[..k - 1].iter().map(|r| r.function_calls).sum();
+    assert!(used_before_last < 300 && rb.function_calls >= 300);
+    explore::run_multistart(&ctx(&s, &budget, 2, flags)).unwrap();
+    for f in ["runs.csv", "optima.csv"] {
+        assert_eq!(
+            table_without(&full.join("h").join(f), &["wall_seconds"]),
+            table_without(&budget.join("h").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    // Resuming with a changed study is refused, not mixed.
+    let other = study("h", &himmelblau(20, "").replace("seed = 11", "seed = 12"));
+    let e = explore::run_multistart(&ctx(&other, &part, 1, flags)).unwrap_err();
+    assert!(e.to_string().contains("not a start of this study"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn merged_shards_equal_the_unsharded_run() {
+    let dir = temp_dir("ms-shards");
+    let s = study("h", &himmelblau(17, ""));
+    let full = dir.join("full");
+    explore::run_multistart(&ctx(&s, &full, 2, DriveFlags::default())).unwrap();
+    let sharded = dir.join("sharded");
+    let mut dirs = Vec::new();
+    for i in 0..3 {
+        let flags = DriveFlags {
+            resume: false,
+            shard: Shard { index: i, count: 3 },
+        };
+        let r = explore::run_multistart(&ctx(&s, &sharded, 1, flags)).unwrap();
+        assert_eq!(r.runs.len(), [6, 6, 5][i]);
+        dirs.push(sharded.join(format!("h/shard-{i}-of-3")));
+    }
+    // Incomplete set of shards is refused.
+    assert!(explore::merge(&dirs[..2], &sharded, true).is_err());
+    dirs.reverse();
+    explore::merge(&dirs, &sharded, true).unwrap();
+    // Compare is not sharded; after the merge, --resume runs nothing new.
+    let shard = DriveFlags {
+        resume: false,
+        shard: Shard { index: 0, count: 3 },
+    };
+    let e = explore::run_compare(&ctx(&s, &sharded, 1, shard)).unwrap_err();
+    assert!(e.to_string().contains("--shard"), "{e}");
+    let flags = DriveFlags {
+        resume: true,
+        ..Default::default()
+    };
+    assert_eq!(
+        explore::run_multistart(&ctx(&s, &sharded, 1, flags))
+            .unwrap()
+            .new_runs,
+        0
+    );
+    for f in ["runs.csv", "optima.csv"] {
+        assert_eq!(
+            table_without(&full.join("h").join(f), &["wall_seconds"]),
+            table_without(&sharded.join("h").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn wall_time_budget_stops_cleanly_and_resume_completes() {
+    let dir = temp_dir("ms-wall");
+    let costly = |extra: &str| {
+        format!(
+            "[study]\nname = \"w\"\nseed = 8\n[problem]\nname = \"himmelblau\"\ncost_ms = 1.0\n\
+             [multistart]\nstarts = 16\n{extra}"
+        )
+    };
+    let full = dir.join("full");
+    let s = study("w", &costly(""));
+    explore::run_multistart(&ctx(&s, &full, 2, DriveFlags::default())).unwrap();
+    let part = dir.join("part");
+    let sw = study("w", &costly("max_wall_seconds = 0.02\n"));
+    let r = explore::run_multistart(&ctx(&sw, &part, 1, DriveFlags::default())).unwrap();
+    assert!(
+        r.runs.len() < 16,
+        "{} runs in 20 ms at 1 ms per evaluation",
+        r.runs.len()
+    );
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(part.join("w/manifest.json")).unwrap())
+            .unwrap();
+    assert_eq!(m["commands"]["multistart"]["complete"], false);
+    let flags = DriveFlags {
+        resume: true,
+        ..Default::default()
+    };
+    let r2 = explore::run_multistart(&ctx(&s, &part, 2, flags)).unwrap();
+    assert_eq!(r2.new_runs, 16 - r.runs.len());
+    for f in ["runs.csv", "optima.csv"] {
+        assert_eq!(
+            table_without(&full.join("w").join(f), &["wall_seconds"]),
+            table_without(&part.join("w").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn error_of(text: &str) -> String {
+    let dir = temp_dir("ms-bad");
+    let s = match plyscape::study::Study::parse("bad.toml", text) {
+        Ok(s) => s,
+        Err(e) => return e.to_string(),
+    };
+    let e = explore::run_multistart(&ctx(&s, &dir, 1, DriveFlags::default()))
+        .expect_err("bad input must fail")
+        .to_string();
+    std::fs::remove_dir_all(&dir).unwrap();
+    e
+}
+
+#[test]
+fn bad_study_input_gets_a_clear_error() {
+    let base = "[problem]\nname = \"himmelblau\"\n[multistart]\nmethod = \"steepest\"\n";
+    let e = error_of(&format!("{base}sampler = \"halton\"\nstarts = 4\n"));
+    assert!(
+        e.contains("bad.toml")
+            && e.contains("multistart.sampler")
+            && e.contains("halton")
+            && e.contains("lhs, sobol, uniform"),
+        "{e}"
+    );
+    let e = error_of(&format!("{base}starts = 0\n"));
+    assert!(
+        e.contains("multistart.starts") && e.contains("at least one start"),
+        "{e}"
+    );
+    let e = error_of(
+        "[problem]\nname = \"himmelblau\"\nbounds = [[-5.0, 5.0], [3.0, -3.0]]\n\
+         [multistart]\nstarts = 4\n",
+    );
+    assert!(
+        e.contains("problem.bounds[1]") && e.contains("lower < upper"),
+        "{e}"
+    );
+    let e = error_of(&format!("[study]\nthreads = 0\n{base}starts = 4\n"));
+    assert!(e.contains("study.threads") && e.contains(">= 1"), "{e}");
+    let e = error_of(&format!("{base}starts = 4\npoints = [[9.0, 0.0]]\n"));
+    assert!(
+        e.contains("multistart.points[0][0]") && e.contains("[-5, 5]"),
+        "{e}"
+    );
+    let e = error_of(&format!("{base}starts = 4\nmethod = \"newton\"\n"));
+    assert!(e.contains("duplicate") || e.contains("method"), "{e}");
+    let e =
+        error_of("[problem]\nname = \"himmelblau\"\n[multistart]\nmethod = \"bfgs\"\nstarts = 4\n");
+    assert!(e.contains("multistart.method") && e.contains("mmfd"), "{e}");
+    let e = error_of(&format!("{base}starts = 4\nstrats = 5\n"));
+    assert!(e.contains("multistart") && e.contains("strats"), "{e}");
+    // --threads 0 on the command line.
+    let common = plyscape::cli::Common {
+        out: "results".into(),
+        threads: Some(0),
+        quiet: true,
+    };
+    let e = plyscape::cli::RunConfig::resolve(None, &common)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("--threads") && e.contains(">= 1"), "{e}");
+}

@@ -1,0 +1,75 @@
+//! The shipped analytic studies run end to end through `plyscape run`.
+
+mod explore_common;
+
+use explore_common::{column, table_without, temp_dir};
+use plyscape::cli::{run_study, RunConfig};
+use plyscape::study::Study;
+
+fn run(file: &str, out: &std::path::Path) -> Study {
+    let study = Study::load(file).unwrap();
+    let cfg = RunConfig {
+        study: study.clone(),
+        out: out.to_path_buf(),
+        threads: 2,
+        quiet: true,
+    };
+    run_study(&cfg).unwrap_or_else(|e| panic!("{file}: {e}"));
+    study
+}
+
+#[test]
+fn analytic_studies_run_and_find_their_known_optima() {
+    let dir = temp_dir("studies");
+    // Known optima: Himmelblau f* = 0 (Himmelblau 1972); HS 22 f* = 1 at
+    // (1, 1) (Hock & Schittkowski 1981); Periodic2 f* = -5 (closed form in
+    // explore::problems::Periodic2).
+    for (file, f_star, tol) in [
+        ("studies/himmelblau.toml", 0.0, 1e-6),
+        // MMFD may end with the active constraints violated by up to DOT's
+        // CTMIN = 3e-3, which lowers f by up to (λ1 + λ2) CTMIN = 4e-3 to
+        // first order (multipliers λ1 = λ2 = 2/3 at (1, 1), from
+        // ∇f + λ1 ∇g1 + λ2 ∇g2 = 0, derived here); 5e-3 allows second order.
+        ("studies/hs_constrained.toml", 1.0, 5e-3),
+        ("studies/periodic2.toml", -5.0, 1e-6),
+    ] {
+        let s = run(file, &dir);
+        let d = dir.join(s.name());
+        for f in [
+            "runs.csv",
+            "optima.csv",
+            "evolution.csv",
+            "comparison.csv",
+            "map.csv",
+            "map.svg",
+            "convergence.svg",
+            "manifest.json",
+        ] {
+            assert!(d.join(f).exists(), "{file}: {f}");
+        }
+        let t = table_without(&d.join("comparison.csv"), &[]);
+        for (m, f) in column(&t, "method").iter().zip(column(&t, "best_f")) {
+            let f: f64 = f.parse().unwrap();
+            assert!((f - f_star).abs() <= tol, "{file} {m}: f = {f}");
+        }
+        assert_eq!(column(&t, "feasible"), ["true", "true"], "{file}");
+        // The manifest keeps every step `plyscape run` did.
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("manifest.json")).unwrap())
+                .unwrap();
+        for c in ["multistart", "evolve", "map"] {
+            assert!(m["commands"][c].is_object(), "{file}: {c}");
+        }
+    }
+    // The timing studies are valid (they are run by hand: ~20 s each).
+    for file in [
+        "studies/multistart_cost.toml",
+        "studies/multistart_sleep.toml",
+    ] {
+        let s = Study::load(file).unwrap();
+        let p = plyscape::explore::problem(&s).unwrap();
+        let plan = plyscape::explore::multistart_plan(&s, p.as_ref()).unwrap();
+        assert_eq!(plan.starts.points.len(), 64);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
