@@ -56,7 +56,7 @@ use faer::Mat;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 use super::sign_normalize;
-use super::sparse::{spmv, Pencil};
+use super::sparse::{gmres_refine, spmv, Pencil};
 use super::Modes;
 use crate::error::{Error, Result};
 
@@ -275,6 +275,51 @@ fn setup_variable(
     }
 }
 
+/// Solve `Â X = B` where `Â` is `K − λ̄M` with the rows and columns marked
+/// in `is_r` replaced by the identity: one block solve with the (possibly
+/// regularised) `LDLᵀ`, then Krylov refinement per column to 1e-13.
+fn refined_solve(
+    pencil: &Pencil,
+    factor: &mut super::sparse::Factor<'_>,
+    lambda_bar: f64,
+    is_r: &[bool],
+    b: &Mat<f64>,
+) -> Result<Mat<f64>> {
+    let n = b.nrows();
+    let mass = pencil.mass();
+    let mut x = b.clone();
+    factor.solve_in_place(x.as_mut());
+    let apply = |v: &[f64], y: &mut [f64]| {
+        let vn: Vec<f64> = (0..n).map(|i| if is_r[i] { 0.0 } else { v[i] }).collect();
+        pencil.k_mul(&vn, y);
+        for i in 0..n {
+            y[i] = if is_r[i] {
+                v[i]
+            } else {
+                y[i] - lambda_bar * mass[i] * vn[i]
+            };
+        }
+    };
+    for j in 0..b.ncols() {
+        let bj: Vec<f64> = (0..n).map(|i| b[(i, j)]).collect();
+        let mut xj: Vec<f64> = (0..n).map(|i| x[(i, j)]).collect();
+        let res = gmres_refine(factor, &apply, &bj, &mut xj, 1e-13, 40);
+        if res.is_nan() || res > 1e-10 {
+            return Err(Error::numerical(
+                "modal::derivatives",
+                format!(
+                    "refined solve with K - lambda*M (lambda = {lambda_bar:e}) stalled at \
+                     relative residual {res:e}"
+                ),
+            ));
+        }
+        for i in 0..n {
+            x[(i, j)] = xj[i];
+        }
+    }
+    Ok(x)
+}
+
 /// Everything about one cluster that does not depend on the variable.
 struct ClusterSystem<'p> {
     pencil: &'p Pencil,
@@ -317,7 +362,7 @@ impl<'p> ClusterSystem<'p> {
                 }
             }
         }
-        factor.solve_in_place(y.as_mut());
+        let y = refined_solve(pencil, &mut factor, lambda_bar, &is_r, &y)?;
         let y1 = Mat::<f64>::from_fn(n, r, |i, j| if is_r[i] { 0.0 } else { y[(i, j)] });
         let y2 = Mat::<f64>::from_fn(n, r, |i, j| if is_r[i] { 0.0 } else { y[(i, r + j)] });
         let mut sys = ClusterSystem {
@@ -389,8 +434,8 @@ impl<'p> ClusterSystem<'p> {
         let (n, q, r) = (f.nrows(), f.ncols(), self.r);
         let mut is_r = vec![false; n];
         self.rows.iter().for_each(|&i| is_r[i] = true);
-        let mut z = Mat::<f64>::from_fn(n, q, |i, j| if is_r[i] { 0.0 } else { f[(i, j)] });
-        self.factor.solve_in_place(z.as_mut());
+        let z = Mat::<f64>::from_fn(n, q, |i, j| if is_r[i] { 0.0 } else { f[(i, j)] });
+        let mut z = refined_solve(self.pencil, &mut self.factor, self.lambda_bar, &is_r, &z)?;
         for j in 0..q {
             for i in 0..n {
                 if is_r[i] {
