@@ -66,17 +66,23 @@ fn apply_op(factor: &mut Factor<'_>, mass: &[f64], mut w: MatMut<'_, f64>) {
     factor.solve_in_place(w);
 }
 
-/// Orthogonalise the columns of `w` against `v` (M-inner product) twice;
-/// returns the summed coefficients `VᵀMW` (`v.ncols() × w.ncols()`).
-fn cgs2(v: MatRef<'_, f64>, mass: &[f64], mut w: MatMut<'_, f64>) -> Mat<f64> {
+/// Orthogonalise the columns of `w` against `v` (M-inner product):
+/// a first pass against the columns `local..` (where, in exact arithmetic,
+/// all the coupling of a Lanczos step lives: the last two blocks), then a
+/// second, full pass ("twice is enough"). `local = 0` gives classical
+/// Gram–Schmidt twice. Returns the summed coefficients `VᵀMW`
+/// (`v.ncols() × w.ncols()`).
+fn cgs2(v: MatRef<'_, f64>, mass: &[f64], mut w: MatMut<'_, f64>, local: usize) -> Mat<f64> {
     let (n, p) = (w.nrows(), w.ncols());
-    let mut total = Mat::<f64>::zeros(v.ncols(), p);
-    if v.ncols() == 0 {
+    let m = v.ncols();
+    let mut total = Mat::<f64>::zeros(m, p);
+    if m == 0 {
         return total;
     }
     let mut mw = Mat::<f64>::zeros(n, p);
-    let mut c = Mat::<f64>::zeros(v.ncols(), p);
-    for _ in 0..2 {
+    for from in [local.min(m), 0] {
+        let vs = v.subcols(from, m - from);
+        let mut c = Mat::<f64>::zeros(m - from, p);
         for j in 0..p {
             for i in 0..n {
                 mw[(i, j)] = mass[i] * w[(i, j)];
@@ -85,21 +91,20 @@ fn cgs2(v: MatRef<'_, f64>, mass: &[f64], mut w: MatMut<'_, f64>) -> Mat<f64> {
         matmul(
             c.as_mut(),
             Accum::Replace,
-            v.transpose(),
+            vs.transpose(),
             mw.as_ref(),
             1.0,
             Par::Seq,
         );
-        matmul(w.rb_mut(), Accum::Add, v, c.as_ref(), -1.0, Par::Seq);
+        matmul(w.rb_mut(), Accum::Add, vs, c.as_ref(), -1.0, Par::Seq);
         for j in 0..p {
-            for i in 0..v.ncols() {
-                total[(i, j)] += c[(i, j)];
+            for i in 0..m - from {
+                total[(from + i, j)] += c[(i, j)];
             }
         }
     }
     total
 }
-
 fn m_dot(mass: &[f64], a: &[f64], b: &[f64]) -> f64 {
     let mut s = 0.0;
     for i in 0..mass.len() {
@@ -157,7 +162,7 @@ fn fresh_block(
     // One application of Op damps the components of high modes.
     apply_op(factor, mass, x.as_mut());
     *solves += p;
-    cgs2(v, mass, x.as_mut());
+    cgs2(v, mass, x.as_mut(), 0);
     let norms: Vec<f64> = (0..p)
         .map(|c| {
             let col: Vec<f64> = (0..n).map(|i| x[(i, c)]).collect();
@@ -187,7 +192,7 @@ pub(crate) fn block_lanczos(
     let p = opts.block_size.clamp(1, n);
     let m_max = opts
         .max_basis
-        .unwrap_or(2 * want + 4 * p + 8)
+        .unwrap_or(3 * want + 4 * p + 8)
         .max(want + 2 * p)
         .min(n);
     let cap = m_max + p;
@@ -198,6 +203,9 @@ pub(crate) fn block_lanczos(
     let mut basis = 0usize;
     let mut dim = 0usize;
     let mut salt = 0usize;
+    // First basis column of the previous block: the first CGS pass runs
+    // against `local..dim` only (full after a restart or fresh block).
+    let mut local = 0usize;
     let mut q = fresh_block(v.as_ref().subcols(0, 0), mass, p, salt, factor, &mut solves);
     loop {
         // Place the block and apply the operator.
@@ -221,13 +229,22 @@ pub(crate) fn block_lanczos(
                 m_dot(mass, &col, &col).sqrt()
             })
             .collect();
-        let coef = cgs2(v.as_ref().subcols(0, dim), mass, w.as_mut());
+        let coef = cgs2(v.as_ref().subcols(0, dim), mass, w.as_mut(), local);
         for j in 0..pb {
             for i in 0..dim {
                 h[(i, start + j)] = coef[(i, j)];
             }
         }
         let (mut q_next, b) = block_qr(w.as_ref(), mass, &ref_norm);
+        let local_next = start;
+
+        // Rayleigh–Ritz only once the basis can hold the wanted pairs.
+        let exhausted = dim == n;
+        if dim < want && !exhausted && q_next.ncols() > 0 && dim + q_next.ncols() <= m_max {
+            q = q_next;
+            local = local_next;
+            continue;
+        }
 
         // Rayleigh–Ritz on the symmetric part (upper triangle is computed).
         let hs =
@@ -257,7 +274,6 @@ pub(crate) fn block_lanczos(
                 let th = eig.eigenvalues[c];
                 th > 0.0 && estimate(c) <= opts.tol * th
             });
-        let exhausted = dim == n;
         if converged || exhausted {
             if dim < want {
                 return Err(Error::numerical(
@@ -346,6 +362,7 @@ pub(crate) fn block_lanczos(
                 h[(j, j)] = eig.eigenvalues[c];
             }
             dim = keep;
+            local = 0;
         }
         q = q_next;
     }

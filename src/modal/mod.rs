@@ -79,7 +79,8 @@ pub struct ModalOptions {
     /// far below what a finite-difference check of derivatives can see.
     pub tol: f64,
     /// Largest basis dimension before a thick restart. Default
-    /// `2k + 4·block + 8` (the basis is `n × m` doubles).
+    /// `3(k+1) + 4·block + 8` (the basis is `n × m` doubles; clustered
+    /// spectra such as a square plate's need ~3k to avoid restarts).
     pub max_basis: Option<usize>,
     /// Restarts before giving up with a numerical error. Default 50.
     pub max_restarts: usize,
