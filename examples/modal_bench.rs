@@ -204,6 +204,8 @@ fn main() -> plyscape::Result<()> {
         "max_residual",
         "lambda_1",
         "lambda_14",
+        "wall_factor_ms",
+        "wall_lanczos_ms",
     ])
     .map_err(|e| plyscape::Error::csv(&path, e))?;
     for case in [laplace5(100), block9x3(58)] {
@@ -257,6 +259,9 @@ fn main() -> plyscape::Result<()> {
         if let Ok(v) = std::env::var("BENCH_BLOCK") {
             opts.block_size = v.parse().unwrap();
         }
+        if let Ok(v) = std::env::var("BENCH_TOL") {
+            opts.tol = v.parse().unwrap();
+        }
         if let Ok(v) = std::env::var("BENCH_BASIS") {
             opts.max_basis = Some(v.parse().unwrap());
         }
@@ -287,9 +292,10 @@ fn main() -> plyscape::Result<()> {
         let (ts, tm, tl, td) = (median(ts), median(tm), median(tl), median(td));
         let maxres = modes.residuals.iter().cloned().fold(0.0, f64::max);
         println!(
-            "{:9} n={:6} nnz(K)={:7} nnz(L)={:8} symbolic {:7.2} ms | 14 modes {:7.2} ms ({} solves, {} restarts, basis {}) | dλ {:6.2} ms | dλ+dX {:7.2} ms | modes+derivs {:7.2} ms | max res {:.1e}",
+            "{:9} n={:6} nnz(K)={:7} nnz(L)={:8} symbolic {:7.2} ms | 14 modes {:7.2} ms ({} solves, {} restarts, basis {}) | dλ {:6.2} ms | dλ+dX {:7.2} ms | modes+derivs {:7.2} ms | max res {:.1e} | last run wall: Cholesky {:.2} ms, Lanczos {:.2} ms",
             case.name, case.n, k.compute_nnz(), modes.stats.factor_nnz, ts, tm, modes.stats.solves,
-            modes.stats.restarts, modes.stats.basis, tl, td, tm + td, maxres
+            modes.stats.restarts, modes.stats.basis, tl, td, tm + td, maxres,
+            modes.stats.factor_seconds * 1e3, modes.stats.lanczos_seconds * 1e3
         );
         w.write_record([
             case.name.to_string(),
@@ -309,6 +315,8 @@ fn main() -> plyscape::Result<()> {
             format!("{maxres:e}"),
             format!("{:e}", modes.lambda[0]),
             format!("{:e}", modes.lambda[13]),
+            format!("{:.3}", modes.stats.factor_seconds * 1e3),
+            format!("{:.3}", modes.stats.lanczos_seconds * 1e3),
         ])
         .map_err(|e| plyscape::Error::csv(&path, e))?;
     }
