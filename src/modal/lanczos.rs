@@ -23,7 +23,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use faer::linalg::matmul::matmul;
-use faer::reborrow::ReborrowMut;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use nalgebra::{DMatrix, SymmetricEigen};
 
@@ -59,9 +59,13 @@ fn start_value(i: usize, c: usize) -> f64 {
 /// `W ← Op W = (K − σM)⁻¹ M W`.
 fn apply_op(factor: &mut Factor<'_>, mass: &[f64], mut w: MatMut<'_, f64>) {
     for c in 0..w.ncols() {
-        for (i, &m) in mass.iter().enumerate() {
-            w[(i, c)] *= m;
-        }
+        let col = w
+            .rb_mut()
+            .col_mut(c)
+            .try_as_col_major_mut()
+            .expect("column-major")
+            .as_slice_mut();
+        col.iter_mut().zip(mass).for_each(|(x, &m)| *x *= m);
     }
     factor.solve_in_place(w);
 }
@@ -84,8 +88,14 @@ fn cgs2(v: MatRef<'_, f64>, mass: &[f64], mut w: MatMut<'_, f64>, local: usize) 
         let vs = v.subcols(from, m - from);
         let mut c = Mat::<f64>::zeros(m - from, p);
         for j in 0..p {
+            let src = col_slice(w.rb(), j);
+            let dst = mw
+                .col_mut(j)
+                .try_as_col_major_mut()
+                .expect("column-major")
+                .as_slice_mut();
             for i in 0..n {
-                mw[(i, j)] = mass[i] * w[(i, j)];
+                dst[i] = mass[i] * src[i];
             }
         }
         matmul(
@@ -105,6 +115,14 @@ fn cgs2(v: MatRef<'_, f64>, mass: &[f64], mut w: MatMut<'_, f64>, local: usize) 
     }
     total
 }
+/// Column `j` of a column-major matrix as a slice.
+fn col_slice(m: MatRef<'_, f64>, j: usize) -> &[f64] {
+    m.col(j)
+        .try_as_col_major()
+        .expect("faer matrices are column-major")
+        .as_slice()
+}
+
 fn m_dot(mass: &[f64], a: &[f64], b: &[f64]) -> f64 {
     let mut s = 0.0;
     for i in 0..mass.len() {
@@ -123,14 +141,12 @@ fn block_qr(w: MatRef<'_, f64>, mass: &[f64], ref_norm: &[f64]) -> (Mat<f64>, Ma
     let mut q: Vec<Vec<f64>> = Vec::new();
     let mut b = Mat::<f64>::zeros(p, p);
     for c in 0..p {
-        let mut x: Vec<f64> = (0..n).map(|i| w[(i, c)]).collect();
+        let mut x: Vec<f64> = col_slice(w, c).to_vec();
         for _ in 0..2 {
             for (r, qr) in q.iter().enumerate() {
                 let h = m_dot(mass, qr, &x);
                 b[(r, c)] += h;
-                for i in 0..n {
-                    x[i] -= h * qr[i];
-                }
+                x.iter_mut().zip(qr).for_each(|(a, &b)| *a -= h * b);
             }
         }
         let nrm = m_dot(mass, &x, &x).sqrt();
@@ -142,7 +158,14 @@ fn block_qr(w: MatRef<'_, f64>, mass: &[f64], ref_norm: &[f64]) -> (Mat<f64>, Ma
         }
     }
     let qn = q.len();
-    let qm = Mat::<f64>::from_fn(n, qn, |i, j| q[j][i]);
+    let mut qm = Mat::<f64>::zeros(n, qn);
+    for (j, qj) in q.iter().enumerate() {
+        qm.col_mut(j)
+            .try_as_col_major_mut()
+            .expect("contiguous")
+            .as_slice_mut()
+            .copy_from_slice(qj);
+    }
     let bm = Mat::<f64>::from_fn(qn, p, |i, j| b[(i, j)]);
     (qm, bm)
 }
@@ -165,8 +188,8 @@ fn fresh_block(
     cgs2(v, mass, x.as_mut(), 0);
     let norms: Vec<f64> = (0..p)
         .map(|c| {
-            let col: Vec<f64> = (0..n).map(|i| x[(i, c)]).collect();
-            m_dot(mass, &col, &col).sqrt()
+            let col = col_slice(x.as_ref(), c);
+            m_dot(mass, col, col).sqrt()
         })
         .collect();
     // After orthogonalisation the reference is the column's own norm before
@@ -225,8 +248,8 @@ pub(crate) fn block_lanczos(
         solves += pb;
         let ref_norm: Vec<f64> = (0..pb)
             .map(|c| {
-                let col: Vec<f64> = (0..n).map(|i| w[(i, c)]).collect();
-                m_dot(mass, &col, &col).sqrt()
+                let col = col_slice(w.as_ref(), c);
+                m_dot(mass, col, col).sqrt()
             })
             .collect();
         let coef = cgs2(v.as_ref().subcols(0, dim), mass, w.as_mut(), local);
