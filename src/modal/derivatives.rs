@@ -62,6 +62,8 @@ use crate::error::{Error, Result};
 
 /// Derivatives of the stiffness with respect to one design variable θ_v.
 /// Both matrices are `n × n` in full symmetric storage on the reduced DOFs.
+/// First derivatives of modes need only the diagonal second derivative
+/// `∂²K/∂θ_v²`; the mixed `∂²K/∂θ_v∂θ_w` are not used.
 #[derive(Clone, Copy, Debug)]
 pub struct DesignDerivative<'a> {
     /// `∂K/∂θ_v` [N/m per rad].

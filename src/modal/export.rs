@@ -20,13 +20,13 @@ pub struct DofLabel {
 pub struct ModeShapeRow {
     /// Mode index (0 = lowest).
     pub mode: usize,
-    /// Natural frequency of the mode [Hz].
+    /// Natural frequency of the mode \[Hz\].
     pub frequency_hz: f64,
     /// FE node.
     pub node: usize,
     /// Component at the node.
     pub component: usize,
-    /// Mass-normalised amplitude [m/√kg or rad/√kg].
+    /// Mass-normalised amplitude \[m/√kg or rad/√kg\].
     pub value: f64,
 }
 

@@ -5,9 +5,11 @@
 //! `⟨x, y⟩ = Σ mᵢ xᵢ yᵢ`; its largest eigenvalues `θ = 1/(λ − σ)` belong to
 //! the eigenvalues λ of `K x = λ M x` nearest above σ. The basis `V`
 //! (`n × m`, `VᵀMV = I`) is built block by block; every new block `Op·Vⱼ`
-//! is orthogonalised against the whole basis twice (classical Gram–Schmidt,
-//! "CGS2"), and the coefficients are the columns of the projected matrix
-//! `H = VᵀM·Op·V`. Rayleigh–Ritz on `H` gives Ritz pairs `(θ, V y)` whose
+//! is orthogonalised first against the last two blocks (the three-term
+//! recurrence: all the coupling in exact arithmetic) and then against the
+//! whole basis (full reorthogonalisation; "twice is enough", classical
+//! Gram–Schmidt with GEMM kernels), and the summed coefficients are the
+//! columns of the projected matrix `H = VᵀM·Op·V`. Rayleigh–Ritz on `H` gives Ritz pairs `(θ, V y)` whose
 //! residual `‖Op V y − θ V y‖_M = ‖B y_last‖` (B: coupling to the next block)
 //! is known without extra solves. When the basis is full, the wanted Ritz
 //! vectors are kept and the iteration continues from the residual block

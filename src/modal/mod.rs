@@ -9,12 +9,13 @@
 //! `XᵀMX = I`, `XᵀKX = Λ` (the Λ of Eq. 6).
 //!
 //! # Method and why
-//! Block shift-invert Lanczos ([`lanczos`]) on one sparse Cholesky
+//! Block shift-invert Lanczos (module `lanczos`) on one sparse Cholesky
 //! factorization of `K − σM` (faer, AMD ordering):
 //! - shift-invert turns the lowest eigenvalues into the dominant ones, so a
 //!   basis of about `2k` vectors converges them to 1e-10 in a handful of
 //!   block steps, i.e. ~2k triangular solves on one factorization;
-//! - full M-reorthogonalisation (CGS2) keeps the basis orthonormal to
+//! - full M-reorthogonalisation (a local then a full classical
+//!   Gram–Schmidt pass) keeps the basis orthonormal to
 //!   rounding, so there are no spurious copies and the Ritz vectors are
 //!   M-orthonormal to machine precision; with `k ≲ 30` the `O(n m²)` cost of
 //!   reorthogonalisation is below that of the solves;
@@ -54,11 +55,11 @@
 //!   dominate the updated-mode cost; the fixed-mode approach avoids them.
 //!
 //! On a shared 2-core x86_64 VM (load ≈ 5, CPU time, one core), 10,000-DOF
-//! 5-point Laplacian (nnz(L) = 2.1e5): symbolic 4 ms, 14 modes 52–58 ms
+//! 5-point Laplacian (nnz(L) = 2.1e5): symbolic 4 ms, 14 modes 48–56 ms
 //! (numeric Cholesky ≈ 7–11 ms wall), `λ'` for 2 variables < 5 ms,
 //! `λ'` + `X'` for 2 variables 137–150 ms. A 10,092-DOF 3-DOF/node
 //! 9-point block grid (nnz(L) = 9.0e5, closer to a shell): symbolic 8 ms,
-//! 14 modes 105–122 ms, `λ'` + `X'` 280–295 ms. The targets of issue 2
+//! 14 modes 100–122 ms, `λ'` + `X'` 280–295 ms. The targets of issue 2
 //! (20 ms / 100 ms on the paper panel) are not reached on this loaded
 //! machine; see the branch report for what would cut the `k`
 //! factorizations (iterative Nelson solves preconditioned by the
@@ -134,10 +135,10 @@ pub struct ModalStats {
     pub basis: usize,
     /// Stored entries of the Cholesky factor.
     pub factor_nnz: usize,
-    /// Wall time of the numeric Cholesky factorization of `K − σM` [s].
+    /// Wall time of the numeric Cholesky factorization of `K − σM` \[s\].
     pub factor_seconds: f64,
     /// Wall time of the Lanczos iteration (solves, orthogonalisation,
-    /// Rayleigh–Ritz) [s].
+    /// Rayleigh–Ritz) \[s\].
     pub lanczos_seconds: f64,
 }
 
@@ -160,7 +161,7 @@ pub struct Modes {
 }
 
 impl Modes {
-    /// Natural frequencies `ω/(2π)` [Hz] (negative λ from rounding → 0).
+    /// Natural frequencies `ω/(2π)` \[Hz\] (negative λ from rounding → 0).
     pub fn frequencies_hz(&self) -> Vec<f64> {
         self.lambda
             .iter()
