@@ -56,10 +56,10 @@
 //!
 //! On a shared 2-core x86_64 VM (load ≈ 5, CPU time, one core), 10,000-DOF
 //! 5-point Laplacian (nnz(L) = 2.1e5): symbolic 4 ms, 14 modes 48–56 ms
-//! (numeric Cholesky ≈ 7–11 ms wall), `λ'` for 2 variables < 5 ms,
-//! `λ'` + `X'` for 2 variables 137–150 ms. A 10,092-DOF 3-DOF/node
+//! (numeric Cholesky ≈ 6–11 ms wall), `λ'` for 2 variables < 5 ms,
+//! `λ'` + `X'` for 2 variables 110–120 ms. A 10,092-DOF 3-DOF/node
 //! 9-point block grid (nnz(L) = 9.0e5, closer to a shell): symbolic 8 ms,
-//! 14 modes 100–122 ms, `λ'` + `X'` 280–295 ms. The targets of issue 2
+//! 14 modes 92–122 ms, `λ'` + `X'` ≈ 200 ms. The targets of issue 2
 //! (20 ms / 100 ms on the paper panel) are not reached on this loaded
 //! machine; see the branch report for what would cut the `k`
 //! factorizations (iterative Nelson solves preconditioned by the
