@@ -232,6 +232,22 @@ fn too_many_modes_is_input_error() {
     ));
 }
 
+/// Lower-triangle-only storage (not full symmetric) is refused.
+#[test]
+fn unsymmetric_storage_is_input_error() {
+    use faer::sparse::{SparseColMat, Triplet};
+    let t = [
+        Triplet::new(0usize, 0usize, 2.0),
+        Triplet::new(1, 1, 2.0),
+        Triplet::new(1, 0, -1.0),
+    ];
+    let k = SparseColMat::try_new_from_triplets(2, 2, &t).unwrap();
+    match ModalSolver::new(&k, &[1.0, 1.0]) {
+        Err(Error::Input { key, .. }) => assert_eq!(key, "stiffness[1, 0]"),
+        other => panic!("expected input error, got {:?}", other.err()),
+    }
+}
+
 #[test]
 fn bad_mass_is_input_error() {
     let n = 4;

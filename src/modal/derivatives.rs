@@ -28,9 +28,14 @@
 //! rows/columns at well-conditioned DOFs of `X_C` (complete pivoting) are
 //! replaced by the identity (same pattern: the symbolic factorization of
 //! the eigen-solver is reused), plus a `2r × 2r` Schur complement for the
-//! removed rows and the border. For a singleton this is exactly Nelson's
-//! method (the correction is zero in exact arithmetic and removes rounding
-//! otherwise). One factorization per cluster serves every design variable.
+//! removed rows and the border (`2r` extra solves per cluster). For a
+//! singleton the border is not needed — Nelson's reduced system is
+//! consistent — and `x' = z − x(xᵀMz)`. Every solve is refined by
+//! right-preconditioned GMRES on the exact matrix to a relative residual of
+//! 1e-13 (the unpivoted `LDLᵀ` of an indefinite matrix may meet a tiny pivot,
+//! e.g. a Sturm-sequence zero of a chain; such pivots are regularised and
+//! the refinement removes the rank-one error). One factorization per
+//! cluster serves every design variable.
 //!
 //! # What the caller gets
 //! Per variable a [`VariableDerivatives`]: `dlambda[i]`; in the updated-mode
@@ -329,7 +334,8 @@ struct ClusterSystem<'p> {
     r: usize,
     lambda_bar: f64,
     rows: Vec<usize>,
-    /// `M X_C`, `n × r`.
+    /// `X_C` and `M X_C`, `n × r`.
+    xc: Mat<f64>,
     mx: Mat<f64>,
     /// `A_NN⁻¹ (M X_C)_N` and `A_NN⁻¹ A_NR`, `n × r` each (zero on R).
     y1: Mat<f64>,
@@ -350,6 +356,22 @@ impl<'p> ClusterSystem<'p> {
         rows.iter().for_each(|&i| is_r[i] = true);
         let mut factor = pencil.factor_ldlt(lambda_bar, &rows)?;
         let mx = Mat::<f64>::from_fn(n, r, |i, j| mass[i] * xc[(i, j)]);
+        if r == 1 {
+            // Nelson: the system is consistent, no border needed.
+            return Ok(ClusterSystem {
+                pencil,
+                first,
+                r,
+                lambda_bar,
+                rows,
+                xc,
+                mx,
+                y1: Mat::<f64>::zeros(0, 0),
+                y2: Mat::<f64>::zeros(0, 0),
+                schur: DMatrix::<f64>::identity(1, 1).lu(),
+                factor,
+            });
+        }
         let mut y = Mat::<f64>::zeros(n, 2 * r);
         for l in 0..r {
             for i in 0..n {
@@ -373,6 +395,7 @@ impl<'p> ClusterSystem<'p> {
             r,
             lambda_bar,
             rows,
+            xc,
             mx,
             y1,
             y2,
@@ -444,6 +467,17 @@ impl<'p> ClusterSystem<'p> {
                     z[(i, j)] = 0.0;
                 }
             }
+        }
+        if r == 1 {
+            // Nelson (distinct eigenvalue): v = z − x (xᵀM z), so xᵀM v = 0
+            // (the normalisation coefficient c = −xᵀMz of Nelson 1976).
+            for j in 0..q {
+                let c: f64 = (0..n).map(|i| self.mx[(i, 0)] * z[(i, j)]).sum();
+                for i in 0..n {
+                    z[(i, j)] -= c * self.xc[(i, 0)];
+                }
+            }
+            return Ok(z);
         }
         let mut v = z.clone();
         for j in 0..q {

@@ -54,16 +54,22 @@
 //!   all variables) + `2r + r·n_vars` solves. These `k` factorizations
 //!   dominate the updated-mode cost; the fixed-mode approach avoids them.
 //!
-//! On a shared 2-core x86_64 VM (load ≈ 5, CPU time, one core), 10,000-DOF
-//! 5-point Laplacian (nnz(L) = 2.1e5): symbolic 4 ms, 14 modes 48–56 ms
-//! (numeric Cholesky ≈ 7–11 ms wall), `λ'` for 2 variables < 5 ms,
-//! `λ'` + `X'` for 2 variables 137–150 ms. A 10,092-DOF 3-DOF/node
-//! 9-point block grid (nnz(L) = 9.0e5, closer to a shell): symbolic 8 ms,
-//! 14 modes 100–122 ms, `λ'` + `X'` 280–295 ms. The targets of issue 2
-//! (20 ms / 100 ms on the paper panel) are not reached on this loaded
-//! machine; see the branch report for what would cut the `k`
-//! factorizations (iterative Nelson solves preconditioned by the
-//! shift-invert factor).
+//! On a shared 2-core x86_64 VM (one core; fastest wall time of 7 runs,
+//! which agreed with the CPU time), 10,000-DOF 5-point Laplacian
+//! (nnz(L) = 2.1e5): symbolic 4.7 ms, 14 modes 47 ms (numeric Cholesky
+//! 6.4 ms, 90 solves at ≈ 0.3 ms per column, orthogonalisation and
+//! Rayleigh–Ritz the rest), `λ'` for 2 variables < 4 ms, `λ'` + `X'` for 2
+//! variables 113 ms (14 `LDLᵀ` at ≈ 7 ms). A 10,092-DOF 3-DOF/node 9-point
+//! block grid (nnz(L) = 9.0e5, closer to a shell): symbolic 9.4 ms,
+//! 14 modes 91 ms, `λ'` + `X'` 199 ms. The targets of issue 2 (20 ms and
+//! 100 ms on the paper panel) are not reached on these matrices: the
+//! Lanczos solves (≈ 6 per wanted mode at tol 1e-10 on a clustered
+//! spectrum) and the `k` numeric `LDLᵀ` of the updated-mode derivatives
+//! dominate. Cheaper options, not implemented: `tol = 1e-8` (78 instead of
+//! 90 solves), block size 1 (58 solves, but multiple eigenvalues are then
+//! found only through rounding), and Nelson solves by deflated
+//! preconditioned CG on the shift-invert factor instead of `k`
+//! factorizations.
 //!
 //! # Principal types
 //! [`ModalSolver`] (pattern, symbolic factorization, reused across designs),

@@ -229,6 +229,28 @@ impl Pattern {
             diag_pos[j] = start + row_idx[start..].binary_search(&j).unwrap();
             col_ptr.push(row_idx.len());
         }
+        // Full symmetric storage is required (products use both triangles,
+        // the factorization reads the lower one): K_ij = K_ji to 1e-10·max|K|.
+        let tol = 1e-10 * k_max;
+        for j in 0..n {
+            for p in col_ptr[j]..col_ptr[j + 1] {
+                let i = row_idx[p];
+                if i <= j {
+                    continue;
+                }
+                let rows = &row_idx[col_ptr[i]..col_ptr[i + 1]];
+                let kji = rows
+                    .binary_search(&j)
+                    .map_or(0.0, |q| k_val[col_ptr[i] + q]);
+                if (k_val[p] - kji).abs() > tol {
+                    return Err(Error::input(
+                        format!("stiffness[{i}, {j}]"),
+                        k_val[p],
+                        format!("a symmetric matrix in full storage (stiffness[{j}, {i}] = {kji})"),
+                    ));
+                }
+            }
+        }
         Ok(Pattern {
             col_ptr,
             row_idx,
