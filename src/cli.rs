@@ -43,6 +43,14 @@ pub enum Command {
         #[command(flatten)]
         common: Common,
     },
+    /// Modes of the study's panels; modes.csv (+ mode_derivatives.csv,
+    /// mode_shapes.csv, convergence.csv when the study asks).
+    Modes {
+        /// Study file (TOML) with `[[panels]]` and `[modes]`.
+        study: PathBuf,
+        #[command(flatten)]
+        common: Common,
+    },
     /// Local optimizer from many start points; runs.csv, optima.csv.
     Multistart {
         /// Study file (TOML) with the sections `problem` and `multistart`.
@@ -150,6 +158,10 @@ pub fn execute(cli: Cli) -> Result<()> {
             let cfg = RunConfig::resolve(study.as_ref(), &common)?;
             run_study(&cfg)
         }
+        Command::Modes { study, common } => {
+            let cfg = RunConfig::resolve(Some(&study), &common)?;
+            run_modes_handler(&cfg)
+        }
         Command::Multistart {
             study,
             common,
@@ -220,7 +232,7 @@ fn run_map_handler(cfg: &RunConfig) -> Result<()> {
 }
 
 /// Sections that hold data other sections use; they do no work themselves.
-const DATA_SECTIONS: &[&str] = &["problem"];
+const DATA_SECTIONS: &[&str] = &["problem", "panels", "convergence"];
 
 /// A kind of work a study can ask for: the top-level section that asks for
 /// it, and the function that does it.
@@ -229,12 +241,18 @@ type Handler = fn(&RunConfig) -> Result<()>;
 /// Every section `plyscape run` knows, in the order the work is done.
 fn handlers() -> Vec<(&'static str, Handler)> {
     vec![
+        ("modes", run_modes_handler),
         ("multistart", run_multistart_handler),
         ("evolve", run_evolve_handler),
         ("compare", run_compare_handler),
         ("scaling", run_scaling_handler),
         ("map", run_map_handler),
     ]
+}
+
+/// The `[modes]` section: panel modal analysis.
+fn run_modes_handler(cfg: &RunConfig) -> Result<()> {
+    crate::panels::run_modes(&cfg.study, &cfg.out, cfg.quiet)
 }
 
 /// `plyscape run`: do every kind of work the study has a section for.

@@ -25,6 +25,7 @@
 //!   derivatives.
 //! - [`fe`]: panel mesh, laminated shell triangle, sparse assembly, supports.
 //! - [`modal`]: lowest modes, eigenvalue and eigenvector derivatives.
+//! - [`panels`]: the panel modal-analysis study (`plyscape modes`).
 //! - [`optimize`]: the evaluation interface, MMFD, CMA-ES.
 //! - [`explore`]: multistart, evolutionary comparison, maps, sharding.
 //! - [`report`]: CSV, SVG and terminal output (observers only).
@@ -47,6 +48,7 @@ pub mod fe;
 pub mod laminate;
 pub mod modal;
 pub mod optimize;
+pub mod panels;
 pub mod report;
 pub mod study;
 

@@ -1,0 +1,773 @@
+//! Panel modal analysis as a study: `[[panels]]` + `[modes]` (and optionally
+//! `[convergence]`) → `modes.csv`, `mode_derivatives.csv`, `mode_shapes.csv`,
+//! `convergence.csv`.
+//!
+//! This is the first link of the chain seen from the command line
+//! (`plyscape modes <study.toml>`): laminate → shell FE → reduced `K`, lumped
+//! `M` → lowest modes by shift-invert Lanczos → `dλ/dθ`, `dX/dθ` per design
+//! variable (paper §2.2, §3.1–3.2, §6.2).
+//!
+//! Panels that share mesh, lay-up and support share one modal analysis
+//! (computed once). Derivative matrices are assembled only when the study
+//! asks for derivatives, and `d²K/dθ²` only for the updated-mode approach
+//! (the adjacent-eigenvector method for repeated modes needs it).
+//!
+//! Each mode gets a label telling what it is: `kind` (flexural, in-plane or
+//! drilling, from where its kinetic energy `xᵀMx` sits) and, for flexural
+//! modes, the symmetry of the transverse deflection `w` under the mirrors
+//! x → −x and y → −y (`SS`, `SA`, `AS`, `AA`; first letter for x). A
+//! twisting mode (w ∝ xy) is `AA`; the first symmetric bending mode is `SS`.
+//! Where the mesh has no mirror nodes (an asymmetric set of attachment
+//! points) or the correlation is weak, the symmetry is `-`.
+
+use crate::error::{Error, Result};
+use crate::fe::{Derivatives, Panel, PanelSystem};
+use crate::modal::{
+    DerivativeOptions, DesignDerivative, ModalOptions, ModalSolver, ModeUpdate, Modes,
+    VariableDerivatives,
+};
+use crate::study::Study;
+use serde::Deserialize;
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+fn default_n_modes() -> usize {
+    14
+}
+fn default_update() -> String {
+    "updated".into()
+}
+fn default_repeats() -> usize {
+    5
+}
+
+/// The `[modes]` section.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModesSpec {
+    /// Lowest modes per panel (default 14, the paper's).
+    #[serde(default = "default_n_modes")]
+    pub n_modes: usize,
+    /// Write `mode_derivatives.csv` (default false).
+    #[serde(default)]
+    pub derivatives: bool,
+    /// "updated" (λ' and X', Eq. 18) or "fixed" (λ' only, Eq. 19).
+    #[serde(default = "default_update")]
+    pub update: String,
+    /// Write `mode_shapes.csv` (default false: it is large).
+    #[serde(default)]
+    pub mode_shapes: bool,
+    /// Reference frequencies [Hz] per panel name, printed beside ours
+    /// (e.g. the paper's Tables 2–3; cite the source in the study file).
+    #[serde(default)]
+    pub reference_hz: BTreeMap<String, Vec<f64>>,
+}
+
+/// The `[convergence]` section: the "what accuracy costs in time" table.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConvergenceSpec {
+    /// Name of the `[[panels]]` entry to refine (its `divisions` is ignored).
+    pub panel: String,
+    /// Mesh densities (cells along the length), ascending; the last one is
+    /// the reference for the error column.
+    pub divisions: Vec<usize>,
+    /// Timing repeats per density; the median is reported (default 5).
+    #[serde(default = "default_repeats")]
+    pub repeats: usize,
+}
+
+/// One computed mode, as written to `modes.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModeRow {
+    pub panel: String,
+    pub layup: String,
+    pub mode: usize,
+    pub frequency_hz: f64,
+    pub residual: f64,
+    pub kind: &'static str,
+    pub symmetry: &'static str,
+}
+
+/// The result of one panel's analysis.
+#[derive(Debug, Clone)]
+pub struct PanelModes {
+    /// Panel name.
+    pub panel: String,
+    /// Lay-up in degrees, e.g. `[0/90/90/0]`.
+    pub layup: String,
+    /// Reduced DOFs.
+    pub dofs: usize,
+    /// Eigen-solution.
+    pub modes: Modes,
+    /// One label pair (kind, symmetry) per mode.
+    pub labels: Vec<(&'static str, &'static str)>,
+    /// Derivatives per design variable (empty unless asked for).
+    pub derivatives: Vec<VariableDerivatives>,
+    /// Design-variable names, e.g. `theta[1,4]`.
+    pub variables: Vec<String>,
+    /// Wall times [s]: assembly, modes, derivatives.
+    pub seconds: [f64; 3],
+    /// Reduced DOF → (node, component 0..6 = u, v, w, θx, θy, θz).
+    pub dof_map: Vec<(usize, usize)>,
+    /// Node coordinates, panel frame [m].
+    pub nodes: Vec<[f64; 2]>,
+}
+
+impl ModesSpec {
+    fn update(&self) -> Result<ModeUpdate> {
+        match self.update.as_str() {
+            "updated" => Ok(ModeUpdate::Updated),
+            "fixed" => Ok(ModeUpdate::Fixed),
+            other => Err(Error::input(
+                "update",
+                format!("\"{other}\""),
+                "\"updated\" (eigenvalue and eigenvector derivatives) or \"fixed\" (eigenvalue derivatives only)",
+            )),
+        }
+    }
+}
+
+/// Lay-up as `[a/b/c]` in degrees (rounded to 0.01°).
+pub fn layup_label(panel: &Panel) -> String {
+    let a: Vec<String> = panel
+        .laminate
+        .angles()
+        .iter()
+        .map(|t| {
+            let d = (t.to_degrees() * 100.0).round() / 100.0;
+            format!("{}", d + 0.0)
+        })
+        .collect();
+    format!("[{}]", a.join("/"))
+}
+
+/// A panel prepared for repeated modal analyses: mesh, sparsity pattern,
+/// assembly buffers, symbolic factorization and mirror maps are built once
+/// ([`PanelAnalysis::new`]); each [`PanelAnalysis::run`] for a lay-up then
+/// costs one assembly, one numeric factorization, the Lanczos iteration and
+/// (if asked) the derivatives. This is the shape an optimization loop uses.
+pub struct PanelAnalysis {
+    panel: Panel,
+    model: crate::fe::PanelModel,
+    sys: PanelSystem,
+    solver: ModalSolver,
+    want: Option<ModeUpdate>,
+    mirrors: [Option<Vec<usize>>; 2],
+    /// Wall time of the set-up [s].
+    pub setup_seconds: f64,
+}
+
+impl PanelAnalysis {
+    /// Build everything that does not depend on the ply angles. `want`:
+    /// which derivatives later runs compute (none, fixed-mode λ', or
+    /// updated-mode λ' and X'); only those matrices are ever assembled.
+    pub fn new(panel: &Panel, want: Option<ModeUpdate>) -> Result<PanelAnalysis> {
+        let t0 = Instant::now();
+        let level = match want {
+            None => Derivatives::None,
+            Some(ModeUpdate::Fixed) => Derivatives::First,
+            Some(ModeUpdate::Updated) => Derivatives::Second,
+        };
+        let model = panel.model()?;
+        let sys = model.assemble(&panel.laminate, &panel.design, level)?;
+        let solver = ModalSolver::new(&sys.k, &sys.m_diag)?;
+        let mirrors = [
+            mirror_map(&panel.mesh.nodes, [-1.0, 1.0]),
+            mirror_map(&panel.mesh.nodes, [1.0, -1.0]),
+        ];
+        Ok(PanelAnalysis {
+            panel: panel.clone(),
+            model,
+            sys,
+            solver,
+            want,
+            mirrors,
+            setup_seconds: t0.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Modes (and derivatives) for `laminate` (same ply count as the
+    /// panel's; ply angles may differ).
+    pub fn run(&mut self, laminate: &crate::laminate::Laminate, n_modes: usize) -> Result<PanelModes> {
+        let t0 = Instant::now();
+        self.model
+            .assemble_into(laminate, &self.panel.design, &mut self.sys)?;
+        self.solver.set_stiffness(&self.sys.k)?;
+        let t1 = Instant::now();
+        let modes = self.solver.solve(&ModalOptions::new(n_modes))?;
+        let t2 = Instant::now();
+        let sys = &self.sys;
+        let derivatives = match self.want {
+            None => Vec::new(),
+            Some(update) => {
+                let vars: Vec<DesignDerivative<'_>> = (0..sys.dk.len())
+                    .map(|v| DesignDerivative {
+                        dk: &sys.dk[v],
+                        d2k: sys.d2k.get(v),
+                    })
+                    .collect();
+                let opts = DerivativeOptions {
+                    update,
+                    ..DerivativeOptions::default()
+                };
+                self.solver.derivatives(&modes, &vars, &opts)?
+            }
+        };
+        let t3 = Instant::now();
+        let labels = (0..modes.lambda.len())
+            .map(|j| label_mode(sys, &self.mirrors, &modes, j))
+            .collect();
+        let variables = self
+            .panel
+            .design
+            .groups()
+            .iter()
+            .map(|g| {
+                let plies: Vec<String> = g.iter().map(|k| (k + 1).to_string()).collect();
+                format!("theta[{}]", plies.join(","))
+            })
+            .collect();
+        let mut with_layup = self.panel.clone();
+        with_layup.laminate = laminate.clone();
+        Ok(PanelModes {
+            panel: self.panel.name.clone(),
+            layup: layup_label(&with_layup),
+            dofs: sys.m_diag.len(),
+            modes,
+            labels,
+            derivatives,
+            variables,
+            seconds: [
+                (t1 - t0).as_secs_f64(),
+                (t2 - t1).as_secs_f64(),
+                (t3 - t2).as_secs_f64(),
+            ],
+            dof_map: sys.dof_map.clone(),
+            nodes: self.panel.mesh.nodes.clone(),
+        })
+    }
+}
+
+/// Analyse one panel once (set-up + one run).
+pub fn analyse_panel(
+    panel: &Panel,
+    n_modes: usize,
+    want: Option<ModeUpdate>,
+) -> Result<PanelModes> {
+    PanelAnalysis::new(panel, want)?.run(&panel.laminate, n_modes)
+}
+
+/// For every node, the node at its mirror image `(sx·x, sy·y)`, or `None`
+/// if some node has no mirror (then symmetry is not labelled). Hashed on a
+/// grid of 1e-9 of the panel size, checking neighbouring cells so rounding
+/// at a cell edge cannot miss a node.
+fn mirror_map(nodes: &[[f64; 2]], s: [f64; 2]) -> Option<Vec<usize>> {
+    let size = nodes
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
+    let h = 1e-9 * size.max(f64::MIN_POSITIVE);
+    let key = |p: [f64; 2]| ((p[0] / h).round() as i64, (p[1] / h).round() as i64);
+    let index: HashMap<(i64, i64), usize> =
+        nodes.iter().enumerate().map(|(i, &p)| (key(p), i)).collect();
+    nodes
+        .iter()
+        .map(|&p| {
+            let (kx, ky) = key([s[0] * p[0], s[1] * p[1]]);
+            (-1..=1)
+                .flat_map(|dx| (-1..=1).map(move |dy| (kx + dx, ky + dy)))
+                .find_map(|k| index.get(&k).copied())
+        })
+        .collect()
+}
+
+/// Kind (where the kinetic energy sits) and symmetry of mode `j`.
+fn label_mode(
+    sys: &PanelSystem,
+    mirrors: &[Option<Vec<usize>>; 2],
+    modes: &Modes,
+    j: usize,
+) -> (&'static str, &'static str) {
+    // Energy share per component class: u, v in-plane; w, θx, θy flexural;
+    // θz drilling (the small drilling inertia makes it visible).
+    let mut e = [0.0f64; 3];
+    let mut w = vec![0.0f64; sys.nodes.len()];
+    for (i, &(node, comp)) in sys.dof_map.iter().enumerate() {
+        let x = modes.modes[(i, j)];
+        let class = match comp {
+            0 | 1 => 0,
+            2..=4 => 1,
+            _ => 2,
+        };
+        e[class] += sys.m_diag[i] * x * x;
+        if comp == 2 {
+            w[node] = x;
+        }
+    }
+    let total: f64 = e.iter().sum();
+    let kind = if e[1] >= 0.5 * total {
+        "flexural"
+    } else if e[0] >= e[2] {
+        "in-plane"
+    } else {
+        "drilling"
+    };
+    if kind != "flexural" {
+        return (kind, "-");
+    }
+    // Correlation of w with its mirror image: +1 symmetric, −1 antisymmetric.
+    let letter = |map: &Option<Vec<usize>>| {
+        let map = map.as_ref()?;
+        let (mut c, mut n) = (0.0, 0.0);
+        for (a, &b) in map.iter().enumerate() {
+            c += w[a] * w[b];
+            n += w[a] * w[a];
+        }
+        match c / n {
+            r if r > 0.9 => Some('S'),
+            r if r < -0.9 => Some('A'),
+            _ => None,
+        }
+    };
+    let symmetry = match (letter(&mirrors[0]), letter(&mirrors[1])) {
+        (Some('S'), Some('S')) => "SS",
+        (Some('S'), Some('A')) => "SA",
+        (Some('A'), Some('S')) => "AS",
+        (Some('A'), Some('A')) => "AA",
+        _ => "-",
+    };
+    (kind, symmetry)
+}
+
+/// `df/dθ` [Hz/deg] from `dλ/dθ` [rad²/s² per rad] at `λ`: f = √λ/(2π),
+/// df/dλ = 1/(4π√λ), and 1 rad = 180/π deg.
+pub fn dfreq_hz_per_deg(lambda: f64, dlambda_per_rad: f64) -> f64 {
+    if lambda <= 0.0 {
+        return 0.0;
+    }
+    dlambda_per_rad / (4.0 * std::f64::consts::PI * lambda.sqrt()) * (std::f64::consts::PI / 180.0)
+}
+
+/// Prefix the place of a numerical error with the panel name.
+fn in_panel(e: Error, panel: &str) -> Error {
+    match e {
+        Error::Numerical {
+            place,
+            time,
+            detail,
+        } => Error::Numerical {
+            place: format!("panel {panel}: {place}"),
+            time,
+            detail,
+        },
+        other => other,
+    }
+}
+
+/// Run the modal analysis of every panel of the study, sharing analyses of
+/// identical panels. Returns one result per panel, in file order.
+pub fn analyse_study(study: &Study, spec: &ModesSpec) -> Result<Vec<PanelModes>> {
+    let panels = crate::fe::panels_from_study(study)?;
+    if panels.is_empty() {
+        return Err(study.error("panels", "(missing)", "at least one [[panels]] entry"));
+    }
+    let want = if spec.derivatives {
+        Some(spec.update().map_err(study.locate("modes"))?)
+    } else {
+        None
+    };
+    for name in spec.reference_hz.keys() {
+        if !panels.iter().any(|p| &p.name == name) {
+            return Err(study.error(
+                format!("modes.reference_hz.{name}"),
+                format!("\"{name}\""),
+                "the name of a [[panels]] entry",
+            ));
+        }
+    }
+    let mut out: Vec<PanelModes> = Vec::with_capacity(panels.len());
+    for (i, p) in panels.iter().enumerate() {
+        // Same mesh, lay-up, design map and support: reuse (compute once).
+        let twin = panels[..i].iter().position(|q| {
+            q.mesh == p.mesh && q.laminate == p.laminate && q.support == p.support && q.design == p.design
+        });
+        let r = match twin {
+            Some(k) => {
+                let mut r = out[k].clone();
+                r.panel = p.name.clone();
+                r.seconds = [0.0; 3];
+                r
+            }
+            None => analyse_panel(p, spec.n_modes, want).map_err(|e| {
+                in_panel(e, &p.name).in_file(&study.path, &format!("panels[{i}]"))
+            })?,
+        };
+        out.push(r);
+    }
+    Ok(out)
+}
+
+/// Rows of `modes.csv`.
+pub fn mode_rows(results: &[PanelModes]) -> Vec<ModeRow> {
+    let mut rows = Vec::new();
+    for r in results {
+        for (j, f) in r.modes.frequencies_hz().into_iter().enumerate() {
+            rows.push(ModeRow {
+                panel: r.panel.clone(),
+                layup: r.layup.clone(),
+                mode: j + 1,
+                frequency_hz: f,
+                residual: r.modes.residuals[j],
+                kind: r.labels[j].0,
+                symmetry: r.labels[j].1,
+            });
+        }
+    }
+    rows
+}
+
+fn csv_writer(path: &Path) -> Result<csv::Writer<std::fs::File>> {
+    csv::Writer::from_path(path).map_err(|e| Error::csv(path, e))
+}
+
+fn write_row<I, S>(w: &mut csv::Writer<std::fs::File>, path: &Path, rec: I) -> Result<()>
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<[u8]>,
+{
+    w.write_record(rec).map_err(|e| Error::csv(path, e))
+}
+
+/// Write `modes.csv`, and `mode_derivatives.csv` when the spec asks for it.
+/// Returns the files written.
+pub fn write_results(dir: &Path, results: &[PanelModes], spec: &ModesSpec) -> Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    let path = dir.join("modes.csv");
+    let mut w = csv_writer(&path)?;
+    write_row(
+        &mut w,
+        &path,
+        [
+            "panel", "layup", "mode", "frequency_hz", "reference_hz", "residual", "kind",
+            "symmetry",
+        ],
+    )?;
+    for row in mode_rows(results) {
+        let reference = spec
+            .reference_hz
+            .get(&row.panel)
+            .and_then(|v| v.get(row.mode - 1))
+            .map(|f| f.to_string())
+            .unwrap_or_default();
+        write_row(
+            &mut w,
+            &path,
+            [
+                row.panel,
+                row.layup,
+                row.mode.to_string(),
+                format!("{:.6}", row.frequency_hz),
+                reference,
+                format!("{:.2e}", row.residual),
+                row.kind.to_string(),
+                row.symmetry.to_string(),
+            ],
+        )?;
+    }
+    w.flush().map_err(|e| Error::io(&path, e))?;
+    files.push(path);
+
+    if spec.derivatives {
+        let path = dir.join("mode_derivatives.csv");
+        let mut w = csv_writer(&path)?;
+        write_row(
+            &mut w,
+            &path,
+            [
+                "panel",
+                "mode",
+                "variable",
+                "dlambda_per_rad",
+                "dfreq_hz_per_deg",
+                "cluster_size",
+            ],
+        )?;
+        for r in results {
+            for (v, d) in r.derivatives.iter().enumerate() {
+                for (j, &dl) in d.dlambda.iter().enumerate() {
+                    let cluster = d
+                        .clusters
+                        .iter()
+                        .find(|c| j >= c.first && j < c.first + c.len)
+                        .map_or(1, |c| c.len);
+                    write_row(
+                        &mut w,
+                        &path,
+                        [
+                            r.panel.clone(),
+                            (j + 1).to_string(),
+                            r.variables[v].clone(),
+                            format!("{dl:.9e}"),
+                            format!("{:.9e}", dfreq_hz_per_deg(r.modes.lambda[j], dl)),
+                            cluster.to_string(),
+                        ],
+                    )?;
+                }
+            }
+        }
+        w.flush().map_err(|e| Error::io(&path, e))?;
+        files.push(path);
+    }
+    Ok(files)
+}
+
+/// Write `mode_shapes.csv`: panel, mode, node, x, y, component, value.
+pub fn write_mode_shapes(dir: &Path, results: &[PanelModes]) -> Result<PathBuf> {
+    let path = dir.join("mode_shapes.csv");
+    let mut w = csv_writer(&path)?;
+    write_row(
+        &mut w,
+        &path,
+        ["panel", "mode", "node", "x_m", "y_m", "component", "value"],
+    )?;
+    for r in results {
+        for j in 0..r.modes.lambda.len() {
+            for (i, &(node, comp)) in r.dof_map.iter().enumerate() {
+                let [x, y] = r.nodes[node];
+                write_row(
+                    &mut w,
+                    &path,
+                    [
+                        r.panel.clone(),
+                        (j + 1).to_string(),
+                        node.to_string(),
+                        format!("{x:.6}"),
+                        format!("{y:.6}"),
+                        comp.to_string(),
+                        format!("{:.9e}", r.modes.modes[(i, j)]),
+                    ],
+                )?;
+            }
+        }
+    }
+    w.flush().map_err(|e| Error::io(&path, e))?;
+    Ok(path)
+}
+
+/// Print the frequency table, with reference columns where given.
+pub fn print_table(results: &[PanelModes], spec: &ModesSpec) {
+    for r in results {
+        println!(
+            "{} {} ({} DOF; assembly {:.1} ms, modes {:.1} ms, derivatives {:.1} ms)",
+            r.panel,
+            r.layup,
+            r.dofs,
+            1e3 * r.seconds[0],
+            1e3 * r.seconds[1],
+            1e3 * r.seconds[2]
+        );
+        let reference = spec.reference_hz.get(&r.panel);
+        println!(
+            "  mode  f [Hz]     {}kind      symmetry",
+            if reference.is_some() { "ref [Hz]  ratio  " } else { "" }
+        );
+        for (j, f) in r.modes.frequencies_hz().iter().enumerate() {
+            let refcol = match reference.and_then(|v| v.get(j)) {
+                Some(fr) => format!("{fr:<9.3} {:<6.3} ", f / fr),
+                None if reference.is_some() => format!("{:<17}", ""),
+                None => String::new(),
+            };
+            println!(
+                "  {:>4}  {:<9.4}  {refcol}{:<9} {}",
+                j + 1,
+                f,
+                r.labels[j].0,
+                r.labels[j].1
+            );
+        }
+    }
+}
+
+/// One row of `convergence.csv`.
+#[derive(Debug, Clone)]
+pub struct ConvergenceRow {
+    pub divisions: usize,
+    pub dofs: usize,
+    /// First flexural mode with symmetry SS [Hz].
+    pub symmetric_hz: Option<f64>,
+    /// First flexural mode with symmetry AA (twisting) [Hz].
+    pub twisting_hz: Option<f64>,
+    /// Median wall times per design [s] (set-up excluded): assembly +
+    /// modes; assembly with derivative matrices + modes + derivatives for
+    /// every design variable.
+    pub modes_seconds: f64,
+    pub with_derivatives_seconds: f64,
+    /// Median split of the second timing [s]: assembly, modes, derivatives.
+    pub split_seconds: [f64; 3],
+    /// One-off set-up with derivative matrices (mesh, pattern, symbolic
+    /// factorization) [s].
+    pub setup_seconds: f64,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn first_with(r: &PanelModes, symmetry: &str) -> Option<f64> {
+    let f = r.modes.frequencies_hz();
+    r.labels
+        .iter()
+        .position(|&(k, s)| k == "flexural" && s == symmetry)
+        .map(|j| f[j])
+}
+
+/// The convergence-and-cost table for one panel over mesh densities.
+pub fn convergence(study: &Study, spec: &ConvergenceSpec, n_modes: usize) -> Result<Vec<ConvergenceRow>> {
+    let specs: Vec<crate::fe::PanelSpec> = study.section("panels")?.unwrap_or_default();
+    let Some(i) = specs.iter().position(|p| p.name == spec.panel) else {
+        return Err(study.error(
+            "convergence.panel",
+            format!("\"{}\"", spec.panel),
+            "the name of a [[panels]] entry",
+        ));
+    };
+    if spec.divisions.is_empty() || spec.divisions.windows(2).any(|w| w[0] >= w[1]) {
+        return Err(study.error(
+            "convergence.divisions",
+            format!("{:?}", spec.divisions),
+            "a non-empty, strictly ascending list of mesh densities",
+        ));
+    }
+    if spec.repeats == 0 {
+        return Err(study.error("convergence.repeats", 0, "at least 1"));
+    }
+    let mut rows = Vec::new();
+    for &d in &spec.divisions {
+        let mut s = specs[i].clone();
+        s.divisions = d;
+        let panel = s
+            .resolve()
+            .map_err(study.locate(&format!("panels[{i}]")))?;
+        let mut plain_a = PanelAnalysis::new(&panel, None)?;
+        let mut full_a = PanelAnalysis::new(&panel, Some(ModeUpdate::Updated))?;
+        let mut plain = Vec::new();
+        let mut full = Vec::new();
+        let mut splits = [Vec::new(), Vec::new(), Vec::new()];
+        let mut last = None;
+        for _ in 0..spec.repeats {
+            let t = Instant::now();
+            let r = plain_a.run(&panel.laminate, n_modes)?;
+            plain.push(t.elapsed().as_secs_f64());
+            let t = Instant::now();
+            let rd = full_a.run(&panel.laminate, n_modes)?;
+            full.push(t.elapsed().as_secs_f64());
+            for (k, s) in splits.iter_mut().enumerate() {
+                s.push(rd.seconds[k]);
+            }
+            last = Some(r);
+        }
+        let r = last.expect("repeats >= 1");
+        rows.push(ConvergenceRow {
+            divisions: d,
+            dofs: r.dofs,
+            symmetric_hz: first_with(&r, "SS"),
+            twisting_hz: first_with(&r, "AA"),
+            modes_seconds: median(plain),
+            with_derivatives_seconds: median(full),
+            split_seconds: splits.map(median),
+            setup_seconds: full_a.setup_seconds,
+        });
+    }
+    Ok(rows)
+}
+
+/// Write `convergence.csv` (errors relative to the finest mesh).
+pub fn write_convergence(dir: &Path, rows: &[ConvergenceRow]) -> Result<PathBuf> {
+    let path = dir.join("convergence.csv");
+    let mut w = csv_writer(&path)?;
+    write_row(
+        &mut w,
+        &path,
+        [
+            "divisions",
+            "dofs",
+            "symmetric_hz",
+            "symmetric_error",
+            "twisting_hz",
+            "twisting_error",
+            "modes_ms",
+            "modes_and_derivatives_ms",
+            "assembly_ms",
+            "eigen_ms",
+            "derivatives_ms",
+            "setup_ms",
+        ],
+    )?;
+    let fin = rows.last();
+    let err = |v: Option<f64>, r: Option<f64>| match (v, r) {
+        (Some(v), Some(r)) => format!("{:.3e}", (v - r).abs() / r),
+        _ => String::new(),
+    };
+    let opt = |v: Option<f64>| v.map(|v| format!("{v:.6}")).unwrap_or_default();
+    for row in rows {
+        write_row(
+            &mut w,
+            &path,
+            [
+                row.divisions.to_string(),
+                row.dofs.to_string(),
+                opt(row.symmetric_hz),
+                err(row.symmetric_hz, fin.and_then(|f| f.symmetric_hz)),
+                opt(row.twisting_hz),
+                err(row.twisting_hz, fin.and_then(|f| f.twisting_hz)),
+                format!("{:.2}", 1e3 * row.modes_seconds),
+                format!("{:.2}", 1e3 * row.with_derivatives_seconds),
+                format!("{:.2}", 1e3 * row.split_seconds[0]),
+                format!("{:.2}", 1e3 * row.split_seconds[1]),
+                format!("{:.2}", 1e3 * row.split_seconds[2]),
+                format!("{:.2}", 1e3 * row.setup_seconds),
+            ],
+        )?;
+    }
+    w.flush().map_err(|e| Error::io(&path, e))?;
+    Ok(path)
+}
+
+/// `plyscape modes` / the `[modes]` handler of `plyscape run`.
+pub fn run_modes(study: &Study, out_root: &Path, quiet: bool) -> Result<()> {
+    let spec: ModesSpec = study.require_section("modes", "what modal analysis to run")?;
+    let results = analyse_study(study, &spec)?;
+    let dir = study.output_dir(out_root)?;
+    let mut files = write_results(&dir, &results, &spec)?;
+    if spec.mode_shapes {
+        files.push(write_mode_shapes(&dir, &results)?);
+    }
+    if let Some(conv) = study.section::<ConvergenceSpec>("convergence")? {
+        let rows = convergence(study, &conv, spec.n_modes)?;
+        files.push(write_convergence(&dir, &rows)?);
+        if !quiet {
+            println!("mesh convergence of {} (median of {} runs):", conv.panel, conv.repeats);
+            println!("  div   DOF     f_SS [Hz]  f_AA [Hz]  modes [ms]  +derivs [ms]");
+            for r in &rows {
+                println!(
+                    "  {:>4}  {:>6}  {:<9}  {:<9}  {:>9.2}  {:>11.2}",
+                    r.divisions,
+                    r.dofs,
+                    r.symmetric_hz.map_or("-".into(), |f| format!("{f:.4}")),
+                    r.twisting_hz.map_or("-".into(), |f| format!("{f:.4}")),
+                    1e3 * r.modes_seconds,
+                    1e3 * r.with_derivatives_seconds
+                );
+            }
+        }
+    }
+    if !quiet {
+        print_table(&results, &spec);
+        for f in &files {
+            println!("wrote {}", f.display());
+        }
+    }
+    Ok(())
+}
