@@ -1,0 +1,685 @@
+//! Eigenvalue and eigenvector derivatives (paper §3.1, Eqs. 17–19).
+//!
+//! For a design variable `θ` with `K' = ∂K/∂θ`, `K'' = ∂²K/∂θ²` and `M' = 0`
+//! (lumped mass independent of ply angles):
+//!
+//! - **Eigenvalues**: `λᵢ' = xᵢᵀ K' xᵢ` (mass-normalised `xᵢ`).
+//! - **Clusters.** Consecutive eigenvalues with relative gap
+//!   `(λᵢ₊₁ − λᵢ)/max(|λᵢ|, |λᵢ₊₁|, |σ|) < cluster_tol` form a cluster `C`
+//!   of size `r`. A singleton is a distinct eigenvalue.
+//! - **Distinct (Nelson 1976).** `xᵢ' = vᵢ + cᵢxᵢ` with
+//!   `(K − λᵢM) vᵢ = −(K' − λᵢ'M) xᵢ`, made nonsingular by replacing the row
+//!   and column of the largest |xᵢ| entry by the identity, and
+//!   `cᵢ = −xᵢᵀMvᵢ` (normalisation `xᵀMx = 1`).
+//! - **Repeated / nearly repeated (adjacent eigenvectors, Ojalvo 1987,
+//!   Dailey 1989).** In a cluster the eigenvectors are not unique; the
+//!   differentiable ("adjacent") ones are `Ψ = X_C Γ`, where `Γ` (`r × r`,
+//!   orthogonal) diagonalises `D = X_CᵀK'X_C = Γ diag(λ') Γᵀ`; the
+//!   eigenvalue derivatives are the eigenvalues of `D` (ascending). Then
+//!   `ψⱼ' = vⱼ + Σ_l cⱼₗ ψₗ` where `vⱼ` solves the bordered system
+//!   `(K − λ̄M) vⱼ + M X_C μ = −(K' − λⱼ'M) ψⱼ`, `X_CᵀM vⱼ = 0`
+//!   (λ̄ the cluster mean), `cⱼⱼ = 0` and, from the second derivative of the
+//!   eigenproblem premultiplied by `ψₗᵀ`,
+//!   `cⱼₗ = (2ψₗᵀK'vⱼ + ψₗᵀK''ψⱼ) / (2(λⱼ' − λₗ'))` for `l ≠ j`.
+//!   When `λⱼ' = λₗ'` too, the adjacent vectors are not determined by first
+//!   derivatives; then `cⱼₗ = 0` (documented limitation).
+//!
+//! The bordered system is solved with one `LDLᵀ` of `K − λ̄M` whose `r`
+//! rows/columns at well-conditioned DOFs of `X_C` (complete pivoting) are
+//! replaced by the identity (same pattern: the symbolic factorization of
+//! the eigen-solver is reused), plus a `2r × 2r` Schur complement for the
+//! removed rows and the border (`2r` extra solves per cluster). For a
+//! singleton the border is not needed — Nelson's reduced system is
+//! consistent — and `x' = z − x(xᵀMz)`. Every solve is refined by
+//! right-preconditioned GMRES on the exact matrix to a relative residual of
+//! 1e-13 (the unpivoted `LDLᵀ` of an indefinite matrix may meet a tiny pivot,
+//! e.g. a Sturm-sequence zero of a chain; such pivots are regularised and
+//! the refinement removes the rank-one error). One factorization per
+//! cluster serves every design variable.
+//!
+//! # What the caller gets
+//! Per variable a [`VariableDerivatives`]: `dlambda[i]`; in the updated-mode
+//! approach `dmodes` (`n × k`); and for each cluster of size ≥ 2 the
+//! rotation `Γ`: for those columns, `dlambda` and `dmodes` refer to the
+//! adjacent vectors `X_C Γ` (see [`VariableDerivatives::adjacent_modes`]),
+//! not to the columns of `X`. For nearly repeated eigenvalues this treats
+//! the cluster as degenerate: the result is the derivative of the smooth
+//! branches with an error of the order of the relative gap (< `cluster_tol`),
+//! instead of Nelson's exact but ill-conditioned derivative of the sorted
+//! modes (which blows up as 1/gap when two modes cross).
+//!
+//! # Threshold
+//! `cluster_tol` default 1e-6: above it Nelson is exact and its
+//! conditioning (~1/gap) costs at most ~6 digits; below it the adjacent
+//! method's O(gap) error is below 1e-6 relative.
+
+// Index loops mirror the formulas in these numeric kernels.
+#![allow(clippy::needless_range_loop)]
+
+use faer::sparse::SparseColMat;
+use faer::Mat;
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+
+use super::sign_normalize;
+use super::sparse::{gmres_refine, spmv, Pencil};
+use super::Modes;
+use crate::error::{Error, Result};
+
+/// Derivatives of the stiffness with respect to one design variable θ_v.
+/// Both matrices are `n × n` in full symmetric storage on the reduced DOFs.
+/// First derivatives of modes need only the diagonal second derivative
+/// `∂²K/∂θ_v²`; the mixed `∂²K/∂θ_v∂θ_w` are not used.
+#[derive(Clone, Copy, Debug)]
+pub struct DesignDerivative<'a> {
+    /// `∂K/∂θ_v` [N/m per rad].
+    pub dk: &'a SparseColMat<usize, f64>,
+    /// `∂²K/∂θ_v²`; needed only for the eigenvector derivatives of repeated
+    /// clusters (adjacent-eigenvector method).
+    pub d2k: Option<&'a SparseColMat<usize, f64>>,
+}
+
+/// Which approach of §3.1 (Haftka and Gürdal) is used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModeUpdate {
+    /// Fixed-mode approach (Eq. 19): eigenvectors kept, only `λ'`.
+    Fixed,
+    /// Updated-mode approach (Eq. 18): `λ'` and `X'`.
+    Updated,
+}
+
+/// Options of [`super::ModalSolver::derivatives`].
+#[derive(Clone, Debug)]
+pub struct DerivativeOptions {
+    /// Fixed or updated modes. Default [`ModeUpdate::Updated`].
+    pub update: ModeUpdate,
+    /// Relative eigenvalue gap below which modes form a cluster. Default
+    /// 1e-6 (see the module doc).
+    pub cluster_tol: f64,
+}
+
+impl Default for DerivativeOptions {
+    fn default() -> Self {
+        DerivativeOptions {
+            update: ModeUpdate::Updated,
+            cluster_tol: 1e-6,
+        }
+    }
+}
+
+/// A cluster of repeated or nearly repeated eigenvalues and the rotation to
+/// its adjacent eigenvectors for one design variable.
+#[derive(Clone, Debug)]
+pub struct Cluster {
+    /// Index of the first mode of the cluster.
+    pub first: usize,
+    /// Number of modes in the cluster (≥ 2).
+    pub len: usize,
+    /// `Γ` (`len × len`, orthogonal): adjacent vectors `Ψ = X[:, first..first+len] Γ`.
+    pub rotation: Mat<f64>,
+}
+
+/// Derivatives with respect to one design variable.
+#[derive(Clone, Debug)]
+pub struct VariableDerivatives {
+    /// `dλᵢ/dθ` [rad²/s² per rad], length `k`.
+    pub dlambda: Vec<f64>,
+    /// `dX/dθ`, `n × k`, updated-mode approach only.
+    pub dmodes: Option<Mat<f64>>,
+    /// Clusters of size ≥ 2 with their rotations (empty when all distinct).
+    pub clusters: Vec<Cluster>,
+}
+
+impl VariableDerivatives {
+    /// The modes these derivatives refer to: `X` with each cluster's
+    /// columns replaced by its adjacent vectors `X_C Γ`.
+    pub fn adjacent_modes(&self, modes: &Mat<f64>) -> Mat<f64> {
+        let mut out = modes.clone();
+        for c in &self.clusters {
+            for j in 0..c.len {
+                for i in 0..modes.nrows() {
+                    let mut s = 0.0;
+                    for l in 0..c.len {
+                        s += modes[(i, c.first + l)] * c.rotation[(l, j)];
+                    }
+                    out[(i, c.first + j)] = s;
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Group consecutive eigenvalues into clusters: `(first, len)`.
+fn find_clusters(lambda: &[f64], shift: f64, tol: f64) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut first = 0;
+    for i in 1..=lambda.len() {
+        if i == lambda.len() || !close(lambda[i - 1], lambda[i], shift, tol) {
+            out.push((first, i - first));
+            first = i;
+        }
+    }
+    out
+}
+
+fn close(a: f64, b: f64, shift: f64, tol: f64) -> bool {
+    let scale = a.abs().max(b.abs()).max(shift.abs()).max(f64::MIN_POSITIVE);
+    (b - a).abs() < tol * scale
+}
+
+/// Rows of `x` (`n × r`) chosen by Gaussian elimination with complete
+/// pivoting: the `r × r` submatrix on them is well conditioned.
+fn pivot_rows(x: &Mat<f64>) -> Vec<usize> {
+    let (n, r) = (x.nrows(), x.ncols());
+    let mut a = x.clone();
+    let mut rows = Vec::with_capacity(r);
+    let mut cols_left: Vec<usize> = (0..r).collect();
+    for _ in 0..r {
+        let (mut bi, mut bc, mut bv) = (0, 0, -1.0);
+        for (ci, &c) in cols_left.iter().enumerate() {
+            for i in 0..n {
+                if a[(i, c)].abs() > bv {
+                    (bi, bc, bv) = (i, ci, a[(i, c)].abs());
+                }
+            }
+        }
+        let c = cols_left.remove(bc);
+        rows.push(bi);
+        let piv = a[(bi, c)];
+        for &o in &cols_left {
+            let f = a[(bi, o)] / piv;
+            for i in 0..n {
+                a[(i, o)] -= f * a[(i, c)];
+            }
+        }
+    }
+    rows
+}
+
+fn check_matrix(key: String, a: &SparseColMat<usize, f64>, n: usize) -> Result<()> {
+    if a.nrows() != n || a.ncols() != n {
+        return Err(Error::input(
+            key,
+            format!("{} x {} matrix", a.nrows(), a.ncols()),
+            format!("a {n} x {n} matrix on the reduced DOFs"),
+        ));
+    }
+    Ok(())
+}
+
+/// Per-variable eigenvalue derivatives and cluster rotations.
+struct VarSetup {
+    /// `K'X`, `n × k`.
+    kpx: Mat<f64>,
+    /// Rotation per cluster (identity 1×1 for singletons).
+    gamma: Vec<DMatrix<f64>>,
+    dlambda: Vec<f64>,
+}
+
+fn setup_variable(
+    modes: &Mat<f64>,
+    dk: &SparseColMat<usize, f64>,
+    clusters: &[(usize, usize)],
+) -> VarSetup {
+    let (n, k) = (modes.nrows(), modes.ncols());
+    let mut kpx = Mat::<f64>::zeros(n, k);
+    let mut x = vec![0.0; n];
+    let mut y = vec![0.0; n];
+    for j in 0..k {
+        for (i, xi) in x.iter_mut().enumerate() {
+            *xi = modes[(i, j)];
+        }
+        spmv(dk, &x, &mut y);
+        for (i, &yi) in y.iter().enumerate() {
+            kpx[(i, j)] = yi;
+        }
+    }
+    let mut dlambda = vec![0.0; k];
+    let mut gamma = Vec::with_capacity(clusters.len());
+    for &(first, r) in clusters {
+        let d = DMatrix::<f64>::from_fn(r, r, |a, b| {
+            let mut s = 0.0;
+            for i in 0..n {
+                s += modes[(i, first + a)] * kpx[(i, first + b)];
+            }
+            s
+        });
+        if r == 1 {
+            dlambda[first] = d[(0, 0)];
+            gamma.push(DMatrix::identity(1, 1));
+            continue;
+        }
+        let d = (&d + d.transpose()) * 0.5;
+        let eig = SymmetricEigen::new(d);
+        let mut order: Vec<usize> = (0..r).collect();
+        order.sort_by(|&a, &b| {
+            eig.eigenvalues[a]
+                .total_cmp(&eig.eigenvalues[b])
+                .then(a.cmp(&b))
+        });
+        let mut g = DMatrix::<f64>::from_fn(r, r, |a, b| eig.eigenvectors[(a, order[b])]);
+        for (j, &o) in order.iter().enumerate() {
+            dlambda[first + j] = eig.eigenvalues[o];
+            // Sign convention on the adjacent vector ψⱼ = X_C γⱼ.
+            let mut psi: Vec<f64> = (0..n)
+                .map(|i| (0..r).map(|l| modes[(i, first + l)] * g[(l, j)]).sum())
+                .collect();
+            let before = psi.iter().position(|v| *v != 0.0).map(|p| psi[p]);
+            sign_normalize(&mut psi);
+            let after = psi.iter().position(|v| *v != 0.0).map(|p| psi[p]);
+            if before.zip(after).is_some_and(|(b, a)| b != a) {
+                for l in 0..r {
+                    g[(l, j)] = -g[(l, j)];
+                }
+            }
+        }
+        gamma.push(g);
+    }
+    VarSetup {
+        kpx,
+        gamma,
+        dlambda,
+    }
+}
+
+/// Solve `Â X = B` where `Â` is `K − λ̄M` with the rows and columns marked
+/// in `is_r` replaced by the identity: one block solve with the (possibly
+/// regularised) `LDLᵀ`, then Krylov refinement per column to 1e-13.
+fn refined_solve(
+    pencil: &Pencil,
+    factor: &mut super::sparse::Factor<'_>,
+    lambda_bar: f64,
+    is_r: &[bool],
+    b: &Mat<f64>,
+) -> Result<Mat<f64>> {
+    let n = b.nrows();
+    let mass = pencil.mass();
+    let mut x = b.clone();
+    factor.solve_in_place(x.as_mut());
+    let apply = |v: &[f64], y: &mut [f64]| {
+        let vn: Vec<f64> = (0..n).map(|i| if is_r[i] { 0.0 } else { v[i] }).collect();
+        pencil.k_mul(&vn, y);
+        for i in 0..n {
+            y[i] = if is_r[i] {
+                v[i]
+            } else {
+                y[i] - lambda_bar * mass[i] * vn[i]
+            };
+        }
+    };
+    for j in 0..b.ncols() {
+        let bj: Vec<f64> = (0..n).map(|i| b[(i, j)]).collect();
+        let mut xj: Vec<f64> = (0..n).map(|i| x[(i, j)]).collect();
+        let res = gmres_refine(factor, &apply, &bj, &mut xj, 1e-13, 40);
+        if res.is_nan() || res > 1e-10 {
+            return Err(Error::numerical(
+                "modal::derivatives",
+                format!(
+                    "refined solve with K - lambda*M (lambda = {lambda_bar:e}) stalled at \
+                     relative residual {res:e}"
+                ),
+            ));
+        }
+        for i in 0..n {
+            x[(i, j)] = xj[i];
+        }
+    }
+    Ok(x)
+}
+
+/// Everything about one cluster that does not depend on the variable.
+struct ClusterSystem<'p> {
+    pencil: &'p Pencil,
+    first: usize,
+    r: usize,
+    lambda_bar: f64,
+    rows: Vec<usize>,
+    /// `X_C` and `M X_C`, `n × r`.
+    xc: Mat<f64>,
+    mx: Mat<f64>,
+    /// `A_NN⁻¹ (M X_C)_N` and `A_NN⁻¹ A_NR`, `n × r` each (zero on R).
+    y1: Mat<f64>,
+    y2: Mat<f64>,
+    /// LU of the `2r × 2r` Schur complement.
+    schur: nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    factor: super::sparse::Factor<'p>,
+}
+
+impl<'p> ClusterSystem<'p> {
+    fn new(pencil: &'p Pencil, modes: &Modes, first: usize, r: usize) -> Result<Self> {
+        let n = pencil.n();
+        let mass = pencil.mass();
+        let lambda_bar = modes.lambda[first..first + r].iter().sum::<f64>() / r as f64;
+        let xc = Mat::<f64>::from_fn(n, r, |i, j| modes.modes[(i, first + j)]);
+        let rows = pivot_rows(&xc);
+        let mut is_r = vec![false; n];
+        rows.iter().for_each(|&i| is_r[i] = true);
+        let mut factor = pencil.factor_ldlt(lambda_bar, &rows)?;
+        let mx = Mat::<f64>::from_fn(n, r, |i, j| mass[i] * xc[(i, j)]);
+        if r == 1 {
+            // Nelson: the system is consistent, no border needed.
+            return Ok(ClusterSystem {
+                pencil,
+                first,
+                r,
+                lambda_bar,
+                rows,
+                xc,
+                mx,
+                y1: Mat::<f64>::zeros(0, 0),
+                y2: Mat::<f64>::zeros(0, 0),
+                schur: DMatrix::<f64>::identity(1, 1).lu(),
+                factor,
+            });
+        }
+        let mut y = Mat::<f64>::zeros(n, 2 * r);
+        for l in 0..r {
+            for i in 0..n {
+                if !is_r[i] {
+                    y[(i, l)] = mx[(i, l)];
+                }
+            }
+            let (ri, rv) = pencil.k_col(rows[l]);
+            for (&i, &v) in ri.iter().zip(rv) {
+                if !is_r[i] {
+                    y[(i, r + l)] = v;
+                }
+            }
+        }
+        let y = refined_solve(pencil, &mut factor, lambda_bar, &is_r, &y)?;
+        let y1 = Mat::<f64>::from_fn(n, r, |i, j| if is_r[i] { 0.0 } else { y[(i, j)] });
+        let y2 = Mat::<f64>::from_fn(n, r, |i, j| if is_r[i] { 0.0 } else { y[(i, r + j)] });
+        let mut sys = ClusterSystem {
+            pencil,
+            first,
+            r,
+            lambda_bar,
+            rows,
+            xc,
+            mx,
+            y1,
+            y2,
+            schur: DMatrix::<f64>::identity(1, 1).lu(),
+            factor,
+        };
+        let mut s = DMatrix::<f64>::zeros(2 * r, 2 * r);
+        for l in 0..r {
+            let a_y1 = sys.a_rn(&sys.y1, l);
+            let a_y2 = sys.a_rn(&sys.y2, l);
+            let mt_y1 = sys.mx_t(&sys.y1, l);
+            let mt_y2 = sys.mx_t(&sys.y2, l);
+            for a in 0..r {
+                // Removed rows: [(MX)_R − A_RN Y1] μ + [A_RR − A_RN Y2] s.
+                s[(a, l)] = sys.mx[(sys.rows[a], l)] - a_y1[a];
+                s[(a, r + l)] = sys.a_rr(a, l) - a_y2[a];
+                // Border: −[(MX)_Nᵀ Y1] μ + [(MX)_Rᵀ − (MX)_Nᵀ Y2] s = −(MX)_Nᵀ z0.
+                s[(r + a, l)] = -mt_y1[a];
+                s[(r + a, r + l)] = sys.mx[(sys.rows[l], a)] - mt_y2[a];
+            }
+        }
+        sys.schur = s.lu();
+        Ok(sys)
+    }
+
+    /// `(A_RN z)_a` for column `col` of `z` (zero on R): row R_a of K.
+    fn a_rn(&self, z: &Mat<f64>, col: usize) -> Vec<f64> {
+        self.rows
+            .iter()
+            .map(|&ra| {
+                let (ri, rv) = self.pencil.k_col(ra);
+                ri.iter().zip(rv).map(|(&i, &v)| v * z[(i, col)]).sum()
+            })
+            .collect()
+    }
+
+    /// `((M X_C)ᵀ z)_a` for column `col` of `z`.
+    fn mx_t(&self, z: &Mat<f64>, col: usize) -> Vec<f64> {
+        (0..self.r)
+            .map(|a| (0..z.nrows()).map(|i| self.mx[(i, a)] * z[(i, col)]).sum())
+            .collect()
+    }
+
+    /// `A[R_a, R_l] = K[R_a, R_l] − λ̄ M δ_al`.
+    fn a_rr(&self, a: usize, l: usize) -> f64 {
+        let (ri, rv) = self.pencil.k_col(self.rows[l]);
+        let kv = ri
+            .iter()
+            .position(|&i| i == self.rows[a])
+            .map_or(0.0, |p| rv[p]);
+        if a == l {
+            kv - self.lambda_bar * self.pencil.mass()[self.rows[a]]
+        } else {
+            kv
+        }
+    }
+
+    /// Solve the bordered system for the columns of `f` (`n × q`); returns
+    /// `v` (`n × q`) with `X_CᵀM v = 0`.
+    fn solve(&mut self, f: &Mat<f64>) -> Result<Mat<f64>> {
+        let (n, q, r) = (f.nrows(), f.ncols(), self.r);
+        let mut is_r = vec![false; n];
+        self.rows.iter().for_each(|&i| is_r[i] = true);
+        let z = Mat::<f64>::from_fn(n, q, |i, j| if is_r[i] { 0.0 } else { f[(i, j)] });
+        let mut z = refined_solve(self.pencil, &mut self.factor, self.lambda_bar, &is_r, &z)?;
+        for j in 0..q {
+            for i in 0..n {
+                if is_r[i] {
+                    z[(i, j)] = 0.0;
+                }
+            }
+        }
+        if r == 1 {
+            // Nelson (distinct eigenvalue): v = z − x (xᵀM z), so xᵀM v = 0
+            // (the normalisation coefficient c = −xᵀMz of Nelson 1976).
+            for j in 0..q {
+                let c: f64 = (0..n).map(|i| self.mx[(i, 0)] * z[(i, j)]).sum();
+                for i in 0..n {
+                    z[(i, j)] -= c * self.xc[(i, 0)];
+                }
+            }
+            return Ok(z);
+        }
+        let mut v = z.clone();
+        for j in 0..q {
+            let a_z = self.a_rn(&z, j);
+            let mt_z = self.mx_t(&z, j);
+            let rhs = DVector::<f64>::from_fn(2 * r, |a, _| {
+                if a < r {
+                    f[(self.rows[a], j)] - a_z[a]
+                } else {
+                    -mt_z[a - r]
+                }
+            });
+            let sol = self.schur.solve(&rhs).ok_or_else(|| {
+                Error::numerical(
+                    "modal::derivatives",
+                    format!(
+                        "singular bordered system for cluster of modes {}..{} at lambda = {:e}",
+                        self.first,
+                        self.first + r,
+                        self.lambda_bar
+                    ),
+                )
+            })?;
+            for i in 0..n {
+                let mut s = 0.0;
+                for l in 0..r {
+                    s += self.y1[(i, l)] * sol[l] + self.y2[(i, l)] * sol[r + l];
+                }
+                v[(i, j)] -= s;
+            }
+            for (l, &rl) in self.rows.iter().enumerate() {
+                v[(rl, j)] = sol[r + l];
+            }
+        }
+        Ok(v)
+    }
+}
+
+/// See the module doc.
+pub(crate) fn compute(
+    pencil: &Pencil,
+    modes: &Modes,
+    vars: &[DesignDerivative<'_>],
+    opts: &DerivativeOptions,
+) -> Result<Vec<VariableDerivatives>> {
+    let n = pencil.n();
+    let k = modes.lambda.len();
+    if modes.modes.nrows() != n || modes.modes.ncols() != k {
+        return Err(Error::input(
+            "modes",
+            format!(
+                "{} x {} mode matrix",
+                modes.modes.nrows(),
+                modes.modes.ncols()
+            ),
+            format!("{n} x {k} (modes of this solver)"),
+        ));
+    }
+    crate::error::require_positive("cluster_tol", opts.cluster_tol)?;
+    for (v, d) in vars.iter().enumerate() {
+        check_matrix(format!("dk[{v}]"), d.dk, n)?;
+        if let Some(d2) = d.d2k {
+            check_matrix(format!("d2k[{v}]"), d2, n)?;
+        }
+    }
+    let clusters = find_clusters(&modes.lambda, modes.shift, opts.cluster_tol);
+    if let (Some(next), Some(&last)) = (modes.next_lambda, modes.lambda.last()) {
+        if close(last, next, modes.shift, opts.cluster_tol) {
+            return Err(Error::input(
+                "n_modes",
+                k,
+                format!(
+                    "a mode count that does not split a repeated eigenvalue: lambda[{}] = {last:e} \
+                     and lambda[{k}] = {next:e} are closer than cluster_tol = {:e}",
+                    k - 1,
+                    opts.cluster_tol
+                ),
+            ));
+        }
+    }
+    let setups: Vec<VarSetup> = vars
+        .iter()
+        .map(|d| setup_variable(&modes.modes, d.dk, &clusters))
+        .collect();
+    let mut out: Vec<VariableDerivatives> = setups
+        .iter()
+        .map(|s| VariableDerivatives {
+            dlambda: s.dlambda.clone(),
+            dmodes: None,
+            clusters: clusters
+                .iter()
+                .zip(&s.gamma)
+                .filter(|((_, r), _)| *r > 1)
+                .map(|(&(first, len), g)| Cluster {
+                    first,
+                    len,
+                    rotation: Mat::<f64>::from_fn(len, len, |i, j| g[(i, j)]),
+                })
+                .collect(),
+        })
+        .collect();
+    if opts.update == ModeUpdate::Fixed || vars.is_empty() {
+        return Ok(out);
+    }
+    for o in out.iter_mut() {
+        o.dmodes = Some(Mat::<f64>::zeros(n, k));
+    }
+    let mass = pencil.mass();
+    for (ci, &(first, r)) in clusters.iter().enumerate() {
+        if r > 1 {
+            if let Some(v) = vars.iter().position(|d| d.d2k.is_none()) {
+                return Err(Error::input(
+                    format!("d2k[{v}]"),
+                    "none",
+                    format!(
+                        "the second stiffness derivative: modes {first}..{} form a repeated \
+                         cluster, whose eigenvector derivatives need K''",
+                        first + r
+                    ),
+                ));
+            }
+        }
+        let mut sys = ClusterSystem::new(pencil, modes, first, r)?;
+        // Right-hand sides −(K' − λⱼ'M) ψⱼ for every variable and cluster member.
+        let nv = vars.len();
+        let mut f = Mat::<f64>::zeros(n, nv * r);
+        let mut psi_all: Vec<Mat<f64>> = Vec::with_capacity(nv);
+        let mut kpsi_all: Vec<Mat<f64>> = Vec::with_capacity(nv);
+        for (v, s) in setups.iter().enumerate() {
+            let g = &s.gamma[ci];
+            let psi = Mat::<f64>::from_fn(n, r, |i, j| {
+                (0..r)
+                    .map(|l| modes.modes[(i, first + l)] * g[(l, j)])
+                    .sum()
+            });
+            let kpsi = Mat::<f64>::from_fn(n, r, |i, j| {
+                (0..r).map(|l| s.kpx[(i, first + l)] * g[(l, j)]).sum()
+            });
+            for j in 0..r {
+                let dl = s.dlambda[first + j];
+                for i in 0..n {
+                    f[(i, v * r + j)] = -(kpsi[(i, j)] - dl * mass[i] * psi[(i, j)]);
+                }
+            }
+            psi_all.push(psi);
+            kpsi_all.push(kpsi);
+        }
+        let vsol = sys.solve(&f)?;
+        for (v, d) in vars.iter().enumerate() {
+            let psi = &psi_all[v];
+            let kpsi = &kpsi_all[v];
+            let dl = &setups[v].dlambda[first..first + r];
+            // In-cluster coefficients (adjacent-eigenvector method).
+            let mut c = DMatrix::<f64>::zeros(r, r);
+            if r > 1 {
+                let d2k = d.d2k.expect("checked above");
+                let dscale = dl.iter().fold(0.0f64, |a, &x| a.max(x.abs()));
+                let mut x = vec![0.0; n];
+                let mut y = vec![0.0; n];
+                for j in 0..r {
+                    for (i, xi) in x.iter_mut().enumerate() {
+                        *xi = psi[(i, j)];
+                    }
+                    spmv(d2k, &x, &mut y);
+                    for l in 0..r {
+                        if l == j {
+                            continue;
+                        }
+                        let gap = dl[j] - dl[l];
+                        if gap.abs() <= 1e-10 * dscale.max(f64::MIN_POSITIVE) {
+                            continue;
+                        }
+                        let mut t1 = 0.0;
+                        let mut t2 = 0.0;
+                        for i in 0..n {
+                            t1 += kpsi[(i, l)] * vsol[(i, v * r + j)];
+                            t2 += psi[(i, l)] * y[i];
+                        }
+                        c[(j, l)] = (2.0 * t1 + t2) / (2.0 * gap);
+                    }
+                }
+            }
+            let dm = out[v].dmodes.as_mut().expect("allocated above");
+            for j in 0..r {
+                for i in 0..n {
+                    let mut s = vsol[(i, v * r + j)];
+                    for l in 0..r {
+                        s += c[(j, l)] * psi[(i, l)];
+                    }
+                    if !s.is_finite() {
+                        return Err(Error::numerical(
+                            "modal::derivatives",
+                            format!(
+                                "non-finite eigenvector derivative, mode {}, DOF {i}",
+                                first + j
+                            ),
+                        ));
+                    }
+                    dm[(i, first + j)] = s;
+                }
+            }
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,540 @@
+//! Sparse symmetric storage for the pencil `K − s·M` and its factorizations.
+//!
+//! Every matrix the modal code factors has the pattern of `K` plus the
+//! diagonal (the lumped mass is diagonal): `K − σM` for shift-invert and
+//! `K − λᵢM` (with some rows and columns replaced by the identity) for the
+//! eigenvector derivatives. [`Pencil`] stores that one pattern, computes the
+//! fill-reducing ordering and the symbolic Cholesky structure once (faer,
+//! AMD ordering), and every numeric factorization reuses it.
+
+// Index loops mirror the formulas in these numeric kernels.
+#![allow(clippy::needless_range_loop)]
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
+use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
+use faer::reborrow::ReborrowMut;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky,
+    SymmetricOrdering,
+};
+use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, Mat, MatMut, Par, Side};
+
+use crate::error::{Error, Result};
+
+/// Which triangular factorization a [`Factor`] holds.
+enum Kind {
+    /// `LLᵀ` of a positive definite matrix (the shift-invert operator).
+    Llt,
+    /// `LDLᵀ` without pivoting of an indefinite matrix (Nelson systems).
+    Ldlt,
+}
+
+/// Right-preconditioned GMRES on `A x = b` with the factorization `F ≈ A`
+/// as preconditioner ("Krylov iterative refinement"). When `F = A` exactly
+/// it stops after the residual check; each regularised pivot of `F` (a
+/// rank-one difference) costs about one iteration. Modifies `x` (start:
+/// `F⁻¹b`, end: the refined solution). Returns the relative residual.
+pub(crate) fn gmres_refine(
+    factor: &mut Factor<'_>,
+    apply_a: &dyn Fn(&[f64], &mut [f64]),
+    b: &[f64],
+    x: &mut [f64],
+    tol: f64,
+    max_iter: usize,
+) -> f64 {
+    let n = b.len();
+    let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
+    let bn = norm(b).max(f64::MIN_POSITIVE);
+    let mut ax = vec![0.0; n];
+    apply_a(x, &mut ax);
+    let r: Vec<f64> = (0..n).map(|i| b[i] - ax[i]).collect();
+    let beta = norm(&r);
+    if beta <= tol * bn {
+        return beta / bn;
+    }
+    let mut basis: Vec<Vec<f64>> = vec![r.iter().map(|v| v / beta).collect()];
+    let mut zs: Vec<Vec<f64>> = Vec::new();
+    // Hessenberg columns after Givens rotations (upper triangular R).
+    let mut rmat: Vec<Vec<f64>> = Vec::new();
+    let mut cs: Vec<(f64, f64)> = Vec::new();
+    let mut g = vec![beta];
+    let mut res = beta;
+    for j in 0..max_iter {
+        let mut z = Mat::<f64>::from_fn(n, 1, |i, _| basis[j][i]);
+        factor.solve_in_place(z.as_mut());
+        let z: Vec<f64> = (0..n).map(|i| z[(i, 0)]).collect();
+        let mut w = vec![0.0; n];
+        apply_a(&z, &mut w);
+        let mut h = vec![0.0; j + 2];
+        for _ in 0..2 {
+            for (i, v) in basis.iter().enumerate() {
+                let c: f64 = v.iter().zip(&w).map(|(a, b)| a * b).sum();
+                h[i] += c;
+                w.iter_mut().zip(v).for_each(|(a, b)| *a -= c * b);
+            }
+        }
+        h[j + 1] = norm(&w);
+        for (i, &(c, s)) in cs.iter().enumerate() {
+            let (a, b) = (h[i], h[i + 1]);
+            h[i] = c * a + s * b;
+            h[i + 1] = -s * a + c * b;
+        }
+        let d = (h[j] * h[j] + h[j + 1] * h[j + 1]).sqrt();
+        let (c, s) = if d > 0.0 {
+            (h[j] / d, h[j + 1] / d)
+        } else {
+            (1.0, 0.0)
+        };
+        h[j] = d;
+        let gj = g[j];
+        g[j] = c * gj;
+        g.push(-s * gj);
+        cs.push((c, s));
+        res = g[j + 1].abs();
+        let hn = h[j + 1];
+        h.truncate(j + 1);
+        rmat.push(h);
+        zs.push(z);
+        if res <= tol * bn || hn == 0.0 {
+            break;
+        }
+        basis.push(w.iter().map(|v| v / hn).collect());
+    }
+    // Back substitution R y = g, x += Z y.
+    let m = rmat.len();
+    let mut y = vec![0.0; m];
+    for i in (0..m).rev() {
+        let mut t = g[i];
+        for k in i + 1..m {
+            t -= rmat[k][i] * y[k];
+        }
+        y[i] = t / rmat[i][i];
+    }
+    for (k, z) in zs.iter().enumerate() {
+        x.iter_mut().zip(z).for_each(|(a, b)| *a += y[k] * b);
+    }
+    res / bn
+}
+
+/// A numeric factorization on the shared symbolic structure.
+pub(crate) struct Factor<'a> {
+    symbolic: &'a SymbolicCholesky<usize>,
+    values: Vec<f64>,
+    kind: Kind,
+    buf: MemBuffer,
+}
+
+impl Factor<'_> {
+    /// Solve `A X = B` in place for the `n × r` block `rhs` (any `r`;
+    /// solved in chunks of [`MAX_RHS`] columns).
+    pub(crate) fn solve_in_place(&mut self, mut rhs: MatMut<'_, f64>) {
+        let r = rhs.ncols();
+        let mut c = 0;
+        while c < r {
+            let w = (r - c).min(MAX_RHS);
+            self.solve_chunk(rhs.rb_mut().subcols_mut(c, w));
+            c += w;
+        }
+    }
+
+    fn solve_chunk(&mut self, rhs: MatMut<'_, f64>) {
+        let stack = MemStack::new(&mut self.buf);
+        match self.kind {
+            Kind::Llt => LltRef::new(self.symbolic, &self.values).solve_in_place_with_conj(
+                Conj::No,
+                rhs,
+                Par::Seq,
+                stack,
+            ),
+            Kind::Ldlt => LdltRef::new(self.symbolic, &self.values).solve_in_place_with_conj(
+                Conj::No,
+                rhs,
+                Par::Seq,
+                stack,
+            ),
+        }
+    }
+}
+
+/// `K` (full symmetric CSC storage) on the pattern of `K` ∪ diagonal, with
+/// the diagonal mass, and the symbolic Cholesky structure of that pattern.
+pub(crate) struct Pencil {
+    n: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// Values of `K` on the pattern (zero where only the diagonal was added).
+    k_val: Vec<f64>,
+    /// Position of the diagonal entry of each column in `row_idx`.
+    diag_pos: Vec<usize>,
+    /// Lumped mass, length `n`.
+    mass: Vec<f64>,
+    symbolic: SymbolicCholesky<usize>,
+    /// Largest |K_ij|, used to scale pivot reports.
+    k_max: f64,
+}
+
+/// CSC pattern of `K` ∪ diagonal with the values of `K`.
+struct Pattern {
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    k_val: Vec<f64>,
+    diag_pos: Vec<usize>,
+    k_max: f64,
+}
+
+impl Pattern {
+    fn build(k: &SparseColMat<usize, f64>) -> Result<Self> {
+        let kr = k.as_ref();
+        let n = k.nrows();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::with_capacity(kr.compute_nnz() + n);
+        let mut k_val = Vec::with_capacity(kr.compute_nnz() + n);
+        let mut diag_pos = vec![0; n];
+        let mut k_max = 0.0f64;
+        col_ptr.push(0);
+        let mut col: Vec<(usize, f64)> = Vec::new();
+        for j in 0..n {
+            col.clear();
+            let rows = kr.row_idx_of_col_raw(j);
+            let vals = kr.val_of_col(j);
+            let mut has_diag = false;
+            for (&i, &v) in rows.iter().zip(vals) {
+                if !v.is_finite() {
+                    return Err(Error::input(
+                        format!("stiffness[{i}, {j}]"),
+                        v,
+                        "a finite number",
+                    ));
+                }
+                k_max = k_max.max(v.abs());
+                has_diag |= i == j;
+                col.push((i, v));
+            }
+            if !has_diag {
+                col.push((j, 0.0));
+            }
+            col.sort_by_key(|&(i, _)| i);
+            // Merge duplicates (summed, as in triplet assembly).
+            let start = row_idx.len();
+            for &(i, v) in &col {
+                if row_idx.len() > start && *row_idx.last().unwrap() == i {
+                    *k_val.last_mut().unwrap() += v;
+                } else {
+                    row_idx.push(i);
+                    k_val.push(v);
+                }
+            }
+            diag_pos[j] = start + row_idx[start..].binary_search(&j).unwrap();
+            col_ptr.push(row_idx.len());
+        }
+        // Full symmetric storage is required (products use both triangles,
+        // the factorization reads the lower one): K_ij = K_ji to 1e-10·max|K|.
+        let tol = 1e-10 * k_max;
+        for j in 0..n {
+            for p in col_ptr[j]..col_ptr[j + 1] {
+                let i = row_idx[p];
+                if i <= j {
+                    continue;
+                }
+                let rows = &row_idx[col_ptr[i]..col_ptr[i + 1]];
+                let kji = rows
+                    .binary_search(&j)
+                    .map_or(0.0, |q| k_val[col_ptr[i] + q]);
+                if (k_val[p] - kji).abs() > tol {
+                    return Err(Error::input(
+                        format!("stiffness[{i}, {j}]"),
+                        k_val[p],
+                        format!("a symmetric matrix in full storage (stiffness[{j}, {i}] = {kji})"),
+                    ));
+                }
+            }
+        }
+        Ok(Pattern {
+            col_ptr,
+            row_idx,
+            k_val,
+            diag_pos,
+            k_max,
+        })
+    }
+}
+
+/// Maximum number of right-hand sides solved at once (scratch size).
+pub(crate) const MAX_RHS: usize = 64;
+
+impl Pencil {
+    /// Build the pattern `K ∪ diag`, check sizes and values, and compute the
+    /// AMD ordering and symbolic factorization once.
+    pub(crate) fn new(k: &SparseColMat<usize, f64>, mass: &[f64]) -> Result<Self> {
+        let n = k.nrows();
+        if k.ncols() != n {
+            return Err(Error::input(
+                "stiffness",
+                format!("{} x {} matrix", k.nrows(), k.ncols()),
+                "a square matrix",
+            ));
+        }
+        if n == 0 {
+            return Err(Error::input(
+                "stiffness",
+                "0 x 0 matrix",
+                "at least one DOF",
+            ));
+        }
+        if mass.len() != n {
+            return Err(Error::input(
+                "mass",
+                format!("{} entries", mass.len()),
+                format!("{n} entries (one per DOF of the stiffness matrix)"),
+            ));
+        }
+        for (i, &m) in mass.iter().enumerate() {
+            if !(m.is_finite() && m > 0.0) {
+                return Err(Error::input(
+                    format!("mass[{i}]"),
+                    m,
+                    "a finite lumped mass > 0",
+                ));
+            }
+        }
+        let pat = Pattern::build(k)?;
+        let Pattern {
+            col_ptr,
+            row_idx,
+            k_val,
+            diag_pos,
+            k_max,
+        } = pat;
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let symbolic = factorize_symbolic_cholesky(
+            sym,
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| Error::numerical("modal::Pencil", format!("symbolic factorization: {e:?}")))?;
+        Ok(Pencil {
+            n,
+            col_ptr,
+            row_idx,
+            k_val,
+            diag_pos,
+            mass: mass.to_vec(),
+            symbolic,
+            k_max,
+        })
+    }
+
+    /// Replace `K` by a matrix of the same size; the symbolic structure is
+    /// kept when the pattern is unchanged and rebuilt otherwise.
+    pub(crate) fn set_stiffness(&mut self, k: &SparseColMat<usize, f64>) -> Result<()> {
+        if k.nrows() != self.n || k.ncols() != self.n {
+            return Err(Error::input(
+                "stiffness",
+                format!("{} x {} matrix", k.nrows(), k.ncols()),
+                format!("a {0} x {0} matrix (same DOFs as before)", self.n),
+            ));
+        }
+        let pat = Pattern::build(k)?;
+        if pat.col_ptr == self.col_ptr && pat.row_idx == self.row_idx {
+            self.k_val = pat.k_val;
+            self.k_max = pat.k_max;
+            Ok(())
+        } else {
+            let mass = std::mem::take(&mut self.mass);
+            *self = Pencil::new(k, &mass)?;
+            Ok(())
+        }
+    }
+
+    /// Column `j` of `K` (rows, values); by symmetry also row `j`.
+    pub(crate) fn k_col(&self, j: usize) -> (&[usize], &[f64]) {
+        let r = self.col_ptr[j]..self.col_ptr[j + 1];
+        (&self.row_idx[r.clone()], &self.k_val[r])
+    }
+
+    /// Number of DOFs.
+    pub(crate) fn n(&self) -> usize {
+        self.n
+    }
+
+    /// The lumped mass (length `n`).
+    pub(crate) fn mass(&self) -> &[f64] {
+        &self.mass
+    }
+
+    /// Number of stored nonzeros of `L` (for reports).
+    pub(crate) fn factor_nnz(&self) -> usize {
+        self.symbolic.len_val()
+    }
+
+    /// `y = K x` (full symmetric storage, so a plain CSC product).
+    pub(crate) fn k_mul(&self, x: &[f64], y: &mut [f64]) {
+        y.iter_mut().for_each(|v| *v = 0.0);
+        for j in 0..self.n {
+            let xj = x[j];
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                y[self.row_idx[p]] += self.k_val[p] * xj;
+            }
+        }
+    }
+
+    /// Values of `K − s·M` on the pattern, with the rows and columns listed
+    /// in `fixed` replaced by those of the identity.
+    fn shifted_values(&self, s: f64, fixed: &[usize]) -> Vec<f64> {
+        let mut val = self.k_val.clone();
+        for j in 0..self.n {
+            val[self.diag_pos[j]] -= s * self.mass[j];
+        }
+        if !fixed.is_empty() {
+            let mut is_fixed = vec![false; self.n];
+            for &f in fixed {
+                is_fixed[f] = true;
+            }
+            for j in 0..self.n {
+                for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                    let i = self.row_idx[p];
+                    if is_fixed[i] || is_fixed[j] {
+                        val[p] = if i == j { 1.0 } else { 0.0 };
+                    }
+                }
+            }
+        }
+        val
+    }
+
+    fn scratch(&self, llt: bool) -> MemBuffer {
+        let fac = if llt {
+            self.symbolic
+                .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+        } else {
+            self.symbolic
+                .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
+        };
+        let solve = self
+            .symbolic
+            .solve_in_place_scratch::<f64>(MAX_RHS, Par::Seq);
+        MemBuffer::new(fac.or(solve))
+    }
+
+    /// Cholesky `LLᵀ` of `K − σM`. Fails with [`Error::Numerical`] naming
+    /// the shift and the pivot (original DOF index) when the matrix is not
+    /// positive definite, i.e. when σ is not below the lowest eigenvalue.
+    pub(crate) fn factor_llt(&self, sigma: f64) -> Result<Factor<'_>> {
+        let a = self.shifted_values(sigma, &[]);
+        let mut buf = self.scratch(true);
+        let mut values = vec![0.0; self.symbolic.len_val()];
+        let sym = SymbolicSparseColMatRef::new_checked(
+            self.n,
+            self.n,
+            &self.col_ptr,
+            None,
+            &self.row_idx,
+        );
+        let res = self.symbolic.factorize_numeric_llt(
+            &mut values,
+            SparseColMatRef::new(sym, &a),
+            Side::Lower,
+            LltRegularization::default(),
+            Par::Seq,
+            MemStack::new(&mut buf),
+            Default::default(),
+        );
+        match res {
+            Ok(_) => Ok(Factor {
+                symbolic: &self.symbolic,
+                values,
+                kind: Kind::Llt,
+                buf,
+            }),
+            Err(LltError::NonPositivePivot { index }) => {
+                let dof = self.original_dof(index);
+                Err(Error::numerical(
+                    "modal::shift_invert",
+                    format!(
+                        "Cholesky factorization of K - sigma*M failed: non-positive pivot at \
+                         elimination step {index} (DOF {dof}) with shift sigma = {sigma:e} \
+                         (|K|max = {:e}); the shift must lie below the lowest eigenvalue \
+                         (use a negative shift for free-free structures)",
+                        self.k_max
+                    ),
+                ))
+            }
+        }
+    }
+
+    /// `LDLᵀ` (no pivoting) of `K − λM` with the rows and columns `fixed`
+    /// replaced by the identity (Nelson's trick keeps the pattern, so the
+    /// symbolic structure is reused).
+    pub(crate) fn factor_ldlt(&self, lambda: f64, fixed: &[usize]) -> Result<Factor<'_>> {
+        let a = self.shifted_values(lambda, fixed);
+        let mut buf = self.scratch(false);
+        let mut values = vec![0.0; self.symbolic.len_val()];
+        let sym = SymbolicSparseColMatRef::new_checked(
+            self.n,
+            self.n,
+            &self.col_ptr,
+            None,
+            &self.row_idx,
+        );
+        // Pivots below 1e-10·max|Aᵢᵢ| (zero pivots of the unpivoted LDLᵀ of
+        // an indefinite matrix, e.g. a Sturm-sequence zero) are replaced by
+        // ±1e-2·max|Aᵢᵢ|: a rank-one change per pivot, which the Krylov
+        // refinement of `solve_refined` removes in one iteration each.
+        let dmax = (0..self.n)
+            .map(|j| a[self.diag_pos[j]].abs())
+            .fold(0.0f64, f64::max)
+            .max(f64::MIN_POSITIVE);
+        let reg = LdltRegularization {
+            dynamic_regularization_signs: None,
+            dynamic_regularization_delta: 1e-2 * dmax,
+            dynamic_regularization_epsilon: 1e-10 * dmax,
+        };
+        let res = self.symbolic.factorize_numeric_ldlt(
+            &mut values,
+            SparseColMatRef::new(sym, &a),
+            Side::Lower,
+            reg,
+            Par::Seq,
+            MemStack::new(&mut buf),
+            Default::default(),
+        );
+        match res {
+            Ok(_) => Ok(Factor {
+                symbolic: &self.symbolic,
+                values,
+                kind: Kind::Ldlt,
+                buf,
+            }),
+            Err(LdltError::ZeroPivot { index }) => Err(Error::numerical(
+                "modal::derivatives",
+                format!(
+                    "LDLT factorization of K - lambda*M (lambda = {lambda:e}, fixed DOFs \
+                     {fixed:?}) hit a zero pivot at elimination step {index} (DOF {})",
+                    self.original_dof(index)
+                ),
+            )),
+        }
+    }
+
+    /// Original DOF of elimination step `index` (AMD permutation).
+    fn original_dof(&self, index: usize) -> usize {
+        match self.symbolic.perm() {
+            Some(p) => p.arrays().0.get(index).copied().unwrap_or(index),
+            None => index,
+        }
+    }
+}
+
+/// `y = A x` for a sparse matrix in full symmetric storage.
+pub(crate) fn spmv(a: &SparseColMat<usize, f64>, x: &[f64], y: &mut [f64]) {
+    y.iter_mut().for_each(|v| *v = 0.0);
+    let ar = a.as_ref();
+    for (j, &xj) in x.iter().enumerate().take(a.ncols()) {
+        for (&i, &v) in ar.row_idx_of_col_raw(j).iter().zip(ar.val_of_col(j)) {
+            y[i] += v * xj;
+        }
+    }
+}
