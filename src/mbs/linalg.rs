@@ -1,0 +1,235 @@
+//! Small generic kernels: rotations from Euler parameters and a
+//! rank-revealing (diagonally pivoted) Cholesky factorization.
+//!
+//! Everything is generic over `T: RealField + Copy` so that the same code runs
+//! on `f64` and on `num_dual::Dual64` (exact Jacobian-vector products).
+//! Pivot decisions compare values, which for dual numbers compares the real
+//! parts: the derivative follows the same branch as the value.
+
+use nalgebra::{Matrix3, RealField, Vector3};
+
+/// `f64` constant converted into the scalar type `T`.
+#[inline]
+pub fn cst<T: RealField + Copy>(x: f64) -> T {
+    nalgebra::convert(x)
+}
+
+/// Rotation matrix `A(p)` of the Euler parameters `p = (e0, e1, e2, e3)`
+/// (Nikravesh, *Computer-Aided Analysis of Mechanical Systems*, Eq. 6.19),
+/// computed from the normalized `p / |p|` so that a drift of `|p|` never
+/// changes the physics. Maps body-frame vectors to global ones.
+pub fn rotation<T: RealField + Copy>(p: &[T]) -> Matrix3<T> {
+    let n2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3];
+    let inv = T::one() / n2;
+    let (e0, e1, e2, e3) = (p[0], p[1], p[2], p[3]);
+    let two = cst::<T>(2.0);
+    Matrix3::new(
+        (e0 * e0 + e1 * e1 - e2 * e2 - e3 * e3) * inv,
+        two * (e1 * e2 - e0 * e3) * inv,
+        two * (e1 * e3 + e0 * e2) * inv,
+        two * (e1 * e2 + e0 * e3) * inv,
+        (e0 * e0 - e1 * e1 + e2 * e2 - e3 * e3) * inv,
+        two * (e2 * e3 - e0 * e1) * inv,
+        two * (e1 * e3 - e0 * e2) * inv,
+        two * (e2 * e3 + e0 * e1) * inv,
+        (e0 * e0 - e1 * e1 - e2 * e2 + e3 * e3) * inv,
+    )
+}
+
+/// Time derivative of the Euler parameters for a body-frame angular
+/// velocity `w`: `ṗ = ½ p ⊗ (0, w)` (4 components). It is orthogonal to `p`,
+/// so `|p|` is an invariant of the exact flow, and the normalized `p̂`
+/// rotates with exactly `w` whatever `|p|` is.
+pub fn euler_rate<T: RealField + Copy>(p: &[T], w: &Vector3<T>) -> [T; 4] {
+    let h = cst::<T>(0.5);
+    let e = Vector3::new(p[1], p[2], p[3]);
+    let v = (w * p[0] + e.cross(w)) * h;
+    [-(e.dot(w)) * h, v[0], v[1], v[2]]
+}
+
+/// Euler parameters of a proper rotation matrix (Shepperd's method,
+/// numerically safe for every angle). `f64` only (set-up code).
+pub fn euler_from_rotation(a: &Matrix3<f64>) -> [f64; 4] {
+    let q = nalgebra::UnitQuaternion::from_matrix(a);
+    [q.w, q.i, q.j, q.k]
+}
+
+/// Outcome of [`pivoted_cholesky`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Factored {
+    /// Numerical rank (number of pivots accepted).
+    pub rank: usize,
+}
+
+/// In-place diagonally pivoted Cholesky factorization of the symmetric
+/// positive semi-definite `n × n` matrix `a` (row-major, only the lower
+/// triangle is read), after unit-diagonal scaling `Â = S A S`,
+/// `S = diag(1/√a_kk)`.
+///
+/// Pivot `k` takes the largest remaining Schur diagonal; it is accepted
+/// while that diagonal exceeds `tol` (relative to the unit diagonal of Â),
+/// so linearly dependent rows are left out and counted (`n − rank`).
+/// On return `perm[..rank]` lists the accepted rows, `a` holds the factor
+/// `L` of `Â[perm, perm]` in its lower triangle and `scale` holds `S`.
+/// Cost `O(n·rank²/2)`.
+pub fn pivoted_cholesky<T: RealField + Copy>(
+    a: &mut [T],
+    n: usize,
+    perm: &mut Vec<usize>,
+    scale: &mut Vec<T>,
+    tol: f64,
+) -> Factored {
+    perm.clear();
+    perm.extend(0..n);
+    scale.clear();
+    let tol = cst::<T>(tol);
+    for k in 0..n {
+        let d = a[k * n + k];
+        let s = if d > T::zero() {
+            T::one() / d.sqrt()
+        } else {
+            T::zero()
+        };
+        scale.push(s);
+    }
+    // Scale (full symmetric storage is kept in the lower triangle).
+    for i in 0..n {
+        for j in 0..=i {
+            a[i * n + j] = a[i * n + j] * scale[i] * scale[j];
+        }
+    }
+    // Work on the permuted matrix through the index map `perm`; entries
+    // are addressed as lower-triangle (max, min) of the original indices.
+    let idx = |i: usize, j: usize| if i >= j { i * n + j } else { j * n + i };
+    let mut rank = 0;
+    for k in 0..n {
+        // Choose the pivot: largest remaining diagonal.
+        let mut best = k;
+        let mut best_val = a[idx(perm[k], perm[k])];
+        for (c, &p) in perm.iter().enumerate().skip(k + 1) {
+            let v = a[idx(p, p)];
+            if v > best_val {
+                best = c;
+                best_val = v;
+            }
+        }
+        if best_val <= tol {
+            break;
+        }
+        perm.swap(k, best);
+        let pk = perm[k];
+        let lkk = best_val.sqrt();
+        a[idx(pk, pk)] = lkk;
+        // Column k below the pivot.
+        for &pi in perm.iter().skip(k + 1) {
+            let v = a[idx(pi, pk)] / lkk;
+            a[idx(pi, pk)] = v;
+        }
+        // Schur complement update of the remaining lower triangle.
+        for r in k + 1..n {
+            let pr = perm[r];
+            let lr = a[idx(pr, pk)];
+            for &pc in perm.iter().take(r + 1).skip(k + 1) {
+                let lc = a[idx(pc, pk)];
+                let e = idx(pr, pc);
+                a[e] -= lr * lc;
+            }
+        }
+        rank = k + 1;
+    }
+    Factored { rank }
+}
+
+/// Solve `A x = b` with the factor of [`pivoted_cholesky`]: the accepted
+/// rows are solved exactly, the left-out (dependent) rows get `x = 0`.
+/// When `b` lies in the range of `A` (a consistent redundant system) this is
+/// an exact solution; `A⁺`-type uniqueness is not needed because the
+/// accelerations `M⁻¹Gᵀx` are the same for every solution. `b` is
+/// overwritten by `x`; `tmp` is scratch of length `n`.
+pub fn pivoted_solve<T: RealField + Copy>(
+    l: &[T],
+    n: usize,
+    perm: &[usize],
+    scale: &[T],
+    rank: usize,
+    b: &mut [T],
+    tmp: &mut Vec<T>,
+) {
+    let idx = |i: usize, j: usize| if i >= j { i * n + j } else { j * n + i };
+    tmp.clear();
+    tmp.extend(perm.iter().take(rank).map(|&p| b[p] * scale[p]));
+    // Forward: L y = b̂.
+    for k in 0..rank {
+        let mut s = tmp[k];
+        for c in 0..k {
+            s -= l[idx(perm[k], perm[c])] * tmp[c];
+        }
+        tmp[k] = s / l[idx(perm[k], perm[k])];
+    }
+    // Backward: Lᵀ z = y.
+    for k in (0..rank).rev() {
+        let mut s = tmp[k];
+        for r in k + 1..rank {
+            s -= l[idx(perm[r], perm[k])] * tmp[r];
+        }
+        tmp[k] = s / l[idx(perm[k], perm[k])];
+    }
+    for v in b.iter_mut() {
+        *v = T::zero();
+    }
+    for k in 0..rank {
+        b[perm[k]] = tmp[k] * scale[perm[k]];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pivoted_cholesky_detects_dependent_rows_and_solves() {
+        // A = G Gᵀ with G 4×3 whose 4th row = row0 + row1 (rank 3):
+        // identity construction, closed form derived in this test.
+        let g = [
+            [1.0, 2.0, 0.5],
+            [0.0, 1.0, -1.0],
+            [3.0, 0.0, 1.0],
+            [1.0, 3.0, -0.5],
+        ];
+        let n = 4;
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                a[i * n + j] = (0..3).map(|k| g[i][k] * g[j][k]).sum();
+            }
+        }
+        let a0 = a.clone();
+        let x_true = [0.3, -1.2, 0.7, 0.0];
+        let mut b: Vec<f64> = (0..n)
+            .map(|i| (0..n).map(|j| a0[i * n + j] * x_true[j]).sum())
+            .collect();
+        let (mut perm, mut scale, mut tmp) = (vec![], vec![], vec![]);
+        let f = pivoted_cholesky(&mut a, n, &mut perm, &mut scale, 1e-10);
+        assert_eq!(f.rank, 3);
+        let b0 = b.clone();
+        pivoted_solve(&a, n, &perm, &scale, f.rank, &mut b, &mut tmp);
+        // Residual A x − b vanishes (consistent right-hand side).
+        for i in 0..n {
+            let r: f64 = (0..n).map(|j| a0[i * n + j] * b[j]).sum::<f64>() - b0[i];
+            assert!(r.abs() < 1e-12, "row {i} residual {r}");
+        }
+    }
+
+    #[test]
+    fn rotation_is_orthonormal_and_matches_quaternion() {
+        // Reference: nalgebra's UnitQuaternion::to_rotation_matrix.
+        let p = [0.3, -0.5, 0.7, 0.2];
+        let a = rotation(&p);
+        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            p[0], p[1], p[2], p[3],
+        ));
+        let r = q.to_rotation_matrix().into_inner();
+        assert!((a - r).norm() < 1e-14);
+        assert!((a.transpose() * a - Matrix3::identity()).norm() < 1e-14);
+    }
+}
