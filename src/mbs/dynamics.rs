@@ -182,12 +182,13 @@ impl System {
                     None => (pos, frame),
                     Some(b) => {
                         let body = &self.model.bodies[b];
-                        let a = nalgebra::UnitQuaternion::from_quaternion(
-                            nalgebra::Quaternion::new(body.p0[0], body.p0[1], body.p0[2], body.p0[3]),
-                        )
-                        .to_rotation_matrix()
-                        .into_inner()
-                        .map(cst::<T>);
+                        let a =
+                            nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                                body.p0[0], body.p0[1], body.p0[2], body.p0[3],
+                            ))
+                            .to_rotation_matrix()
+                            .into_inner()
+                            .map(cst::<T>);
                         (body.r0.map(cst::<T>) + a * pos, a * frame)
                     }
                 };
@@ -285,14 +286,7 @@ impl System {
             let k = &ws.kin[s];
             let jw = body.inertia.map(cst::<T>) * k.wb;
             let gyro = -k.wb.cross(&jw);
-            ws.q.push([
-                T::zero(),
-                T::zero(),
-                T::zero(),
-                gyro[0],
-                gyro[1],
-                gyro[2],
-            ]);
+            ws.q.push([T::zero(), T::zero(), T::zero(), gyro[0], gyro[1], gyro[2]]);
         }
         for force in &self.model.forces {
             match force {
@@ -334,7 +328,8 @@ impl System {
                     let mut m = cst::<T>(*damping) * thd;
                     if let Some(law) = law {
                         let seg = law.segment(th.to_subset().unwrap_or(f64::NAN));
-                        m += cst::<T>(seg.value) + cst::<T>(seg.slope) * (cst::<T>(seg.anchor) - th);
+                        m +=
+                            cst::<T>(seg.value) + cst::<T>(seg.slope) * (cst::<T>(seg.anchor) - th);
                     }
                     let axis: Vector3<T> = mi.frame.column(2).into();
                     let tau = axis * (-m);
@@ -401,10 +396,7 @@ impl System {
             .iter()
             .map(|&b| {
                 let body = &self.model.bodies[b];
-                (
-                    cst::<T>(1.0 / body.mass),
-                    body.inv_inertia.map(cst::<T>),
-                )
+                (cst::<T>(1.0 / body.mass), body.inv_inertia.map(cst::<T>))
             })
             .collect();
         let apply_minv = |s: usize, x: &[T; 6]| -> [T; 6] {
@@ -412,7 +404,11 @@ impl System {
             let w = *ij * Vector3::new(x[3], x[4], x[5]);
             [x[0] * *im, x[1] * *im, x[2] * *im, w[0], w[1], w[2]]
         };
-        let mq: Vec<[T; 6]> = ws.q.iter().enumerate().map(|(s, q)| apply_minv(s, q)).collect();
+        let mq: Vec<[T; 6]> =
+            ws.q.iter()
+                .enumerate()
+                .map(|(s, q)| apply_minv(s, q))
+                .collect();
         // Rows touching each body, with M⁻¹ dᵀ.
         let nb = self.nb();
         let mut by_body: Vec<Vec<(usize, [T; 6], [T; 6])>> = vec![Vec::new(); nb];
@@ -487,7 +483,11 @@ pub fn angle_of<T: RealField + Copy>(mi: &MarkerKin<T>, mj: &MarkerKin<T>) -> (T
 }
 
 /// Block of a row for a marker: `(slot, [∂/∂ṙ, ∂/∂ω_global])`.
-fn block<T: RealField + Copy>(mk: &MarkerKin<T>, dr: Vector3<T>, dw: Vector3<T>) -> (Option<usize>, [T; 6]) {
+fn block<T: RealField + Copy>(
+    mk: &MarkerKin<T>,
+    dr: Vector3<T>,
+    dw: Vector3<T>,
+) -> (Option<usize>, [T; 6]) {
     (mk.slot, [dr[0], dr[1], dr[2], dw[0], dw[1], dw[2]])
 }
 
@@ -502,10 +502,7 @@ fn point_row<T: RealField + Copy>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, k: usize
         phi: mi.x[k] - mj.x[k],
         phidot: T::zero(),
         gamma: -(ci[k] - cj[k]),
-        blocks: [
-            block(mi, e, mi.s.cross(&e)),
-            block(mj, -e, -mj.s.cross(&e)),
-        ],
+        blocks: [block(mi, e, mi.s.cross(&e)), block(mj, -e, -mj.s.cross(&e))],
     }
 }
 

@@ -66,12 +66,14 @@ pub struct Factored {
 /// triangle is read), after unit-diagonal scaling `Â = S A S`,
 /// `S = diag(1/√a_kk)`.
 ///
-/// Pivot `k` takes the largest remaining Schur diagonal; it is accepted
-/// while that diagonal exceeds `tol` (relative to the unit diagonal of Â),
-/// so linearly dependent rows are left out and counted (`n − rank`).
-/// On return `perm[..rank]` lists the accepted rows, `a` holds the factor
-/// `L` of `Â[perm, perm]` in its lower triangle and `scale` holds `S`.
-/// Cost `O(n·rank²/2)`.
+/// Pivot `k` takes the largest remaining Schur diagonal (rows and columns
+/// are swapped in place, as LAPACK `dpstrf` does); it is accepted while that
+/// diagonal exceeds `tol` (relative to the unit diagonal of Â), so linearly
+/// dependent rows are left out and counted (`n − rank`). On return
+/// `perm[k]` is the original row at position `k` (`perm[..rank]` are the
+/// accepted rows), the lower triangle of `a` holds the factor `L` of
+/// `Â[perm, perm]` and `scale` holds `S` (original order).
+/// Cost `≈ n·rank²/2` multiply-adds, contiguous inner loops.
 pub fn pivoted_cholesky<T: RealField + Copy>(
     a: &mut [T],
     n: usize,
@@ -92,47 +94,45 @@ pub fn pivoted_cholesky<T: RealField + Copy>(
         };
         scale.push(s);
     }
-    // Scale (full symmetric storage is kept in the lower triangle).
     for i in 0..n {
-        for j in 0..=i {
-            a[i * n + j] = a[i * n + j] * scale[i] * scale[j];
+        let si = scale[i];
+        let row = &mut a[i * n..i * n + i + 1];
+        for (j, v) in row.iter_mut().enumerate() {
+            *v = *v * si * scale[j];
         }
     }
-    // Work on the permuted matrix through the index map `perm`; entries
-    // are addressed as lower-triangle (max, min) of the original indices.
-    let idx = |i: usize, j: usize| if i >= j { i * n + j } else { j * n + i };
+    let mut col = vec![T::zero(); n];
     let mut rank = 0;
     for k in 0..n {
-        // Choose the pivot: largest remaining diagonal.
         let mut best = k;
-        let mut best_val = a[idx(perm[k], perm[k])];
-        for (c, &p) in perm.iter().enumerate().skip(k + 1) {
-            let v = a[idx(p, p)];
+        let mut best_val = a[k * n + k];
+        for c in k + 1..n {
+            let v = a[c * n + c];
             if v > best_val {
                 best = c;
                 best_val = v;
             }
         }
-        if best_val <= tol {
+        if !(best_val > tol) {
             break;
         }
-        perm.swap(k, best);
-        let pk = perm[k];
-        let lkk = best_val.sqrt();
-        a[idx(pk, pk)] = lkk;
-        // Column k below the pivot.
-        for &pi in perm.iter().skip(k + 1) {
-            let v = a[idx(pi, pk)] / lkk;
-            a[idx(pi, pk)] = v;
+        if best != k {
+            swap_sym(a, n, k, best);
+            perm.swap(k, best);
         }
-        // Schur complement update of the remaining lower triangle.
+        let lkk = best_val.sqrt();
+        a[k * n + k] = lkk;
+        let inv = T::one() / lkk;
         for r in k + 1..n {
-            let pr = perm[r];
-            let lr = a[idx(pr, pk)];
-            for &pc in perm.iter().take(r + 1).skip(k + 1) {
-                let lc = a[idx(pc, pk)];
-                let e = idx(pr, pc);
-                a[e] -= lr * lc;
+            let v = a[r * n + k] * inv;
+            a[r * n + k] = v;
+            col[r] = v;
+        }
+        for r in k + 1..n {
+            let lr = col[r];
+            let row = &mut a[r * n + k + 1..r * n + r + 1];
+            for (x, &lc) in row.iter_mut().zip(&col[k + 1..r + 1]) {
+                *x -= lr * lc;
             }
         }
         rank = k + 1;
@@ -140,12 +140,25 @@ pub fn pivoted_cholesky<T: RealField + Copy>(
     Factored { rank }
 }
 
+/// Symmetric swap of rows/columns `k < p` in lower-triangle storage.
+fn swap_sym<T: Copy>(a: &mut [T], n: usize, k: usize, p: usize) {
+    for c in 0..k {
+        a.swap(k * n + c, p * n + c);
+    }
+    a.swap(k * n + k, p * n + p);
+    for i in k + 1..p {
+        a.swap(i * n + k, p * n + i);
+    }
+    for i in p + 1..n {
+        a.swap(i * n + k, i * n + p);
+    }
+}
+
 /// Solve `A x = b` with the factor of [`pivoted_cholesky`]: the accepted
 /// rows are solved exactly, the left-out (dependent) rows get `x = 0`.
 /// When `b` lies in the range of `A` (a consistent redundant system) this is
-/// an exact solution; `A⁺`-type uniqueness is not needed because the
-/// accelerations `M⁻¹Gᵀx` are the same for every solution. `b` is
-/// overwritten by `x`; `tmp` is scratch of length `n`.
+/// an exact solution, and the accelerations `M⁻¹Gᵀx` are the same for every
+/// solution. `b` is overwritten by `x`; `tmp` is scratch.
 pub fn pivoted_solve<T: RealField + Copy>(
     l: &[T],
     n: usize,
@@ -155,24 +168,22 @@ pub fn pivoted_solve<T: RealField + Copy>(
     b: &mut [T],
     tmp: &mut Vec<T>,
 ) {
-    let idx = |i: usize, j: usize| if i >= j { i * n + j } else { j * n + i };
     tmp.clear();
     tmp.extend(perm.iter().take(rank).map(|&p| b[p] * scale[p]));
-    // Forward: L y = b̂.
     for k in 0..rank {
+        let row = &l[k * n..k * n + k];
         let mut s = tmp[k];
-        for c in 0..k {
-            s -= l[idx(perm[k], perm[c])] * tmp[c];
+        for (x, y) in row.iter().zip(tmp.iter()) {
+            s -= *x * *y;
         }
-        tmp[k] = s / l[idx(perm[k], perm[k])];
+        tmp[k] = s / l[k * n + k];
     }
-    // Backward: Lᵀ z = y.
     for k in (0..rank).rev() {
         let mut s = tmp[k];
         for r in k + 1..rank {
-            s -= l[idx(perm[r], perm[k])] * tmp[r];
+            s -= l[r * n + k] * tmp[r];
         }
-        tmp[k] = s / l[idx(perm[k], perm[k])];
+        tmp[k] = s / l[k * n + k];
     }
     for v in b.iter_mut() {
         *v = T::zero();

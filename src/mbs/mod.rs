@@ -29,6 +29,7 @@ pub mod dynamics;
 pub mod linalg;
 pub mod model;
 pub mod scene;
+pub mod simulate;
 
 pub use analysis::{Projection, Reaction};
 pub use dynamics::{System, Workspace};
