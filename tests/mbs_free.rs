@@ -58,8 +58,8 @@ fn dzhanibekov_flips_and_conserves_invariants() {
         // The intermediate-axis spin is unstable: ω_y changes sign (flip).
         assert!(min_wy < -4.0, "{method:?}: no flip, min ω_y = {min_wy}");
         // Invariants to the integrator tolerance (rtol 1e-8 over ~5 flips).
-        assert!(de < 1e-5, "{method:?}: energy drift {de:e}");
-        assert!(dh < 1e-5, "{method:?}: momentum drift {dh:e}");
+        assert!(de < 3e-6, "{method:?}: energy drift {de:e}");
+        assert!(dh < 3e-6, "{method:?}: momentum drift {dh:e}");
         println!("{method:?}: energy {de:.2e}, momentum {dh:.2e}");
     }
 }
