@@ -77,6 +77,9 @@ fn scene_text(method: Method, rtol: f64) -> String {
     let [be, th, ga, ph, de, om, ep] = Q0;
     let p = [RR * be.cos(), RR * be.sin()]; // crank end P (joint K1–K2)
     let pe = [p[0] - D * (be + th).cos(), p[1] - D * (be + th).sin()]; // point E
+                                                                       // The test set's constraints g1, g2 (E seen from B on K3) hold at Q0.
+    let eb = [XB + SS * ga.sin(), YB - SS * ga.cos()];
+    assert!((eb[0] - pe[0]).hypot(eb[1] - pe[1]) < 1e-12);
     let g = [XA + ZT * de.cos(), YA + ZT * de.sin()]; // joint K5–K4
     let h = [XA + U * ep.sin(), YA - U * ep.cos()]; // joint K7–K6
                                                     // Centres of mass. Distances reproduce the test set's mass matrix:

@@ -24,10 +24,17 @@ use super::model::{Force, JointKind, Model};
 use nalgebra::{Matrix3, RealField, Vector3};
 use std::cell::Cell;
 
-/// Relative pivot threshold of the constraint-space factorization (on the
-/// unit-diagonal scaled matrix): exact dependencies give ~1e-15, while
-/// genuine pivots of well-posed mechanisms are > 1e-6.
-pub const RANK_TOL: f64 = 1e-9;
+/// Relative pivot threshold for counting the rank of the constraint-space
+/// matrix (unit-diagonal scaled): exact dependencies give ~1e-15 (+ the
+/// regularisation), genuine pivots of the test mechanisms are > 1e-4.
+pub const RANK_TOL: f64 = 1e-8;
+
+/// Tikhonov regularisation of the scaled constraint-space matrix: keeps
+/// the multipliers (and so the accelerations) smooth where the rank
+/// changes (singular configurations such as a parallelogram four-bar
+/// passing its flat position). It perturbs the accelerations of a
+/// well-conditioned mechanism by a relative `O(1e-12/σ²_min)`.
+pub const RANK_REG: f64 = 1e-12;
 
 /// One constraint row: value, velocity residual, `γ` and up to two
 /// body blocks `(slot, [∂/∂ṙ; ∂/∂ω'])`.
@@ -433,10 +440,25 @@ impl System {
                 }
             }
         }
-        let f = pivoted_cholesky(&mut ws.a, m, &mut ws.perm, &mut ws.scale, RANK_TOL);
+        let f = pivoted_cholesky(
+            &mut ws.a,
+            m,
+            &mut ws.perm,
+            &mut ws.scale,
+            RANK_TOL,
+            RANK_REG,
+        );
         ws.rank = f.rank;
         let mut lam = std::mem::take(&mut ws.rhs);
-        pivoted_solve(&ws.a, m, &ws.perm, &ws.scale, f.rank, &mut lam, &mut ws.tmp);
+        pivoted_solve(
+            &ws.a,
+            m,
+            &ws.perm,
+            &ws.scale,
+            f.accepted,
+            &mut lam,
+            &mut ws.tmp,
+        );
         let mut acc = mq;
         for (s, list) in by_body.iter().enumerate() {
             for (r, _, w) in list {

@@ -57,8 +57,10 @@ pub fn euler_from_rotation(a: &Matrix3<f64>) -> [f64; 4] {
 /// Outcome of [`pivoted_cholesky`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Factored {
-    /// Numerical rank (number of pivots accepted).
+    /// Numerical rank: pivots whose Schur diagonal exceeds `tol`.
     pub rank: usize,
+    /// Pivots factored (all of them when `reg > 0`, else `rank`).
+    pub accepted: usize,
 }
 
 /// In-place diagonally pivoted Cholesky factorization of the symmetric
@@ -67,9 +69,15 @@ pub struct Factored {
 /// `S = diag(1/√a_kk)`.
 ///
 /// Pivot `k` takes the largest remaining Schur diagonal (rows and columns
-/// are swapped in place, as LAPACK `dpstrf` does); it is accepted while that
-/// diagonal exceeds `tol` (relative to the unit diagonal of Â), so linearly
-/// dependent rows are left out and counted (`n − rank`). On return
+/// are swapped in place, as LAPACK `dpstrf` does); pivots above `tol`
+/// (relative to the unit diagonal of Â) count towards the rank, so linearly
+/// dependent rows are detected and counted (`n − rank`).
+///
+/// With `reg = 0` the dependent rows are left out (truncated solve). With
+/// `reg > 0` the factored matrix is `Â + reg·I` (Tikhonov regularisation):
+/// every pivot is kept, the solution is a smooth function of the matrix
+/// even where its rank changes (singular configurations), and dependent
+/// rows share their multipliers in the minimum-norm way. On return
 /// `perm[k]` is the original row at position `k` (`perm[..rank]` are the
 /// accepted rows), the lower triangle of `a` holds the factor `L` of
 /// `Â[perm, perm]` and `scale` holds `S` (original order).
@@ -80,11 +88,13 @@ pub fn pivoted_cholesky<T: RealField + Copy>(
     perm: &mut Vec<usize>,
     scale: &mut Vec<T>,
     tol: f64,
+    reg: f64,
 ) -> Factored {
     perm.clear();
     perm.extend(0..n);
     scale.clear();
     let tol = cst::<T>(tol);
+    let regt = cst::<T>(reg);
     for k in 0..n {
         let d = a[k * n + k];
         let s = if d > T::zero() {
@@ -100,9 +110,11 @@ pub fn pivoted_cholesky<T: RealField + Copy>(
         for (j, v) in row.iter_mut().enumerate() {
             *v = *v * si * scale[j];
         }
+        row[i] += regt;
     }
     let mut col = vec![T::zero(); n];
     let mut rank = 0;
+    let mut accepted = 0;
     for k in 0..n {
         let mut best = k;
         let mut best_val = a[k * n + k];
@@ -113,7 +125,9 @@ pub fn pivoted_cholesky<T: RealField + Copy>(
                 best_val = v;
             }
         }
-        if !(best_val > tol) {
+        if best_val - regt > tol {
+            rank += 1;
+        } else if reg <= 0.0 || !(best_val > T::zero()) {
             break;
         }
         if best != k {
@@ -135,9 +149,9 @@ pub fn pivoted_cholesky<T: RealField + Copy>(
                 *x -= lr * lc;
             }
         }
-        rank = k + 1;
+        accepted = k + 1;
     }
-    Factored { rank }
+    Factored { rank, accepted }
 }
 
 /// Symmetric swap of rows/columns `k < p` in lower-triangle storage.
@@ -154,8 +168,9 @@ fn swap_sym<T: Copy>(a: &mut [T], n: usize, k: usize, p: usize) {
     }
 }
 
-/// Solve `A x = b` with the factor of [`pivoted_cholesky`]: the accepted
-/// rows are solved exactly, the left-out (dependent) rows get `x = 0`.
+/// Solve `A x = b` with the factor of [`pivoted_cholesky`] (`rank` =
+/// [`Factored::accepted`]): the accepted rows are solved exactly, the
+/// left-out (dependent) rows get `x = 0`.
 /// When `b` lies in the range of `A` (a consistent redundant system) this is
 /// an exact solution, and the accelerations `M⁻¹Gᵀx` are the same for every
 /// solution. `b` is overwritten by `x`; `tmp` is scratch.
@@ -220,10 +235,10 @@ mod tests {
             .map(|i| (0..n).map(|j| a0[i * n + j] * x_true[j]).sum())
             .collect();
         let (mut perm, mut scale, mut tmp) = (vec![], vec![], vec![]);
-        let f = pivoted_cholesky(&mut a, n, &mut perm, &mut scale, 1e-10);
+        let f = pivoted_cholesky(&mut a, n, &mut perm, &mut scale, 1e-10, 0.0);
         assert_eq!(f.rank, 3);
         let b0 = b.clone();
-        pivoted_solve(&a, n, &perm, &scale, f.rank, &mut b, &mut tmp);
+        pivoted_solve(&a, n, &perm, &scale, f.accepted, &mut b, &mut tmp);
         // Residual A x − b vanishes (consistent right-hand side).
         for i in 0..n {
             let r: f64 = (0..n).map(|j| a0[i * n + j] * b[j]).sum::<f64>() - b0[i];
