@@ -93,7 +93,7 @@ impl System {
         let before = before.unwrap_or(0.0);
         if after > 1e-9 {
             return Err(Error::input(
-                "initial state",
+                "joints",
                 format!("max |Φ| = {after:.3e} after projection (was {before:.3e})"),
                 "initial positions that satisfy the joints (consistent redundant constraints)",
             ));
@@ -269,6 +269,7 @@ impl<T: nalgebra::RealField + Copy> Workspace<T> {
             scale: Vec::new(),
             tmp: Vec::new(),
             kin: Vec::new(),
+            by_body: Vec::new(),
             q: Vec::new(),
             rank: 0,
         }

@@ -46,6 +46,9 @@ pub struct Row<T: RealField + Copy> {
     pub blocks: [(Option<usize>, [T; 6]); 2],
 }
 
+/// A row's block on one body: `(row index, d, M⁻¹ d)`.
+pub type RowBlock<T> = (usize, [T; 6], [T; 6]);
+
 /// Scratch storage reused across evaluations (one per scalar type).
 #[derive(Debug, Clone)]
 pub struct Workspace<T: RealField + Copy> {
@@ -56,6 +59,8 @@ pub struct Workspace<T: RealField + Copy> {
     pub(crate) scale: Vec<T>,
     pub(crate) tmp: Vec<T>,
     pub kin: Vec<BodyKin<T>>,
+    /// Per moving body: the rows touching it as `(row, d, M⁻¹d)`.
+    pub(crate) by_body: Vec<Vec<RowBlock<T>>>,
     pub q: Vec<[T; 6]>,
     /// Rank of the last factorization.
     pub rank: usize,
@@ -418,7 +423,11 @@ impl System {
                 .collect();
         // Rows touching each body, with M⁻¹ dᵀ.
         let nb = self.nb();
-        let mut by_body: Vec<Vec<(usize, [T; 6], [T; 6])>> = vec![Vec::new(); nb];
+        let mut by_body = std::mem::take(&mut ws.by_body);
+        by_body.resize_with(nb, Vec::new);
+        for list in by_body.iter_mut() {
+            list.clear();
+        }
         ws.rhs.clear();
         for (r, row) in ws.rows.iter().enumerate() {
             let mut b = row.gamma;
@@ -468,6 +477,7 @@ impl System {
             }
         }
         ws.rhs = lam;
+        ws.by_body = by_body;
         acc
     }
 }

@@ -127,7 +127,9 @@ pub fn pivoted_cholesky<T: RealField + Copy>(
         }
         if best_val - regt > tol {
             rank += 1;
-        } else if reg <= 0.0 || !(best_val > T::zero()) {
+        } else if reg <= 0.0
+            || best_val.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater)
+        {
             break;
         }
         if best != k {

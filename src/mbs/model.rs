@@ -177,7 +177,7 @@ impl PiecewiseLaw {
         }
         for (k, s) in segments.iter().enumerate() {
             let finite = [s.value, s.slope, s.anchor].iter().all(|v| v.is_finite());
-            if !(s.lower < s.upper) || !finite {
+            if s.lower.partial_cmp(&s.upper) != Some(std::cmp::Ordering::Less) || !finite {
                 return Err(Error::input(
                     format!("{key}[{k}]"),
                     format!("{s:?}"),

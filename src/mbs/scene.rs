@@ -458,9 +458,6 @@ impl SceneSpec {
                     damping,
                     length,
                 } => {
-                    if !has("springs") {
-                        continue;
-                    }
                     let find = |key: String, name: &str| {
                         model.marker(name).ok_or_else(|| {
                             Error::input(key, name, "the name of a marker in scene.markers")
@@ -490,6 +487,9 @@ impl SceneSpec {
                             "a point distinct from marker_i",
                         ));
                     }
+                    if !has("springs") {
+                        continue;
+                    }
                     let c = if has("damping") { *damping } else { 0.0 };
                     model.forces.push(Force::SpringDamper {
                         i,
@@ -504,14 +504,14 @@ impl SceneSpec {
                     force,
                     torque,
                 } => {
-                    if !has("loads") {
-                        continue;
-                    }
                     let b = find_body(format!("{key}.body"), body, &model)?.ok_or_else(|| {
                         Error::input(format!("{key}.body"), body, "a body (not ground)")
                     })?;
                     let force = finite3(format!("{key}.force"), *force)?;
                     let torque = finite3(format!("{key}.torque"), *torque)?;
+                    if !has("loads") {
+                        continue;
+                    }
                     model.forces.push(Force::BodyLoad {
                         body: b,
                         force,
