@@ -3,6 +3,7 @@
 //! constraint violation.
 
 use super::dynamics::{angle_of, System, Workspace};
+use super::linalg::Scalar;
 use super::model::{Force, JointKind};
 use crate::error::{Error, Result};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -258,7 +259,7 @@ impl System {
     }
 }
 
-impl<T: nalgebra::RealField + Copy> Workspace<T> {
+impl<T: Scalar> Workspace<T> {
     /// An empty workspace (buffers grow on first use).
     pub fn empty() -> Self {
         Workspace {
@@ -270,6 +271,9 @@ impl<T: nalgebra::RealField + Copy> Workspace<T> {
             tmp: Vec::new(),
             kin: Vec::new(),
             by_body: Vec::new(),
+            inv_order: Vec::new(),
+            col: Vec::new(),
+            nz: Vec::new(),
             q: Vec::new(),
             rank: 0,
         }

@@ -19,9 +19,11 @@
 //! Everything is generic over the scalar `T` so that `num_dual::Dual64`
 //! gives exact Jacobian-vector products of the right-hand side.
 
-use super::linalg::{cst, euler_rate, pivoted_cholesky, pivoted_solve, rotation};
+use super::linalg::{
+    cst, euler_rate, min_degree_order, ordered_cholesky, pivoted_solve, rotation, Scalar,
+};
 use super::model::{Force, JointKind, Model};
-use nalgebra::{Matrix3, RealField, Vector3};
+use nalgebra::{Matrix3, Vector3};
 use std::cell::Cell;
 
 /// Relative pivot threshold for counting the rank of the constraint-space
@@ -39,7 +41,7 @@ pub const RANK_REG: f64 = 1e-12;
 /// One constraint row: value, velocity residual, `γ` and up to two
 /// body blocks `(slot, [∂/∂ṙ; ∂/∂ω'])`.
 #[derive(Debug, Clone, Copy)]
-pub struct Row<T: RealField + Copy> {
+pub struct Row<T: Scalar> {
     pub phi: T,
     pub phidot: T,
     pub gamma: T,
@@ -51,7 +53,7 @@ pub type RowBlock<T> = (usize, [T; 6], [T; 6]);
 
 /// Scratch storage reused across evaluations (one per scalar type).
 #[derive(Debug, Clone)]
-pub struct Workspace<T: RealField + Copy> {
+pub struct Workspace<T: Scalar> {
     pub rows: Vec<Row<T>>,
     pub a: Vec<T>,
     pub rhs: Vec<T>,
@@ -61,6 +63,10 @@ pub struct Workspace<T: RealField + Copy> {
     pub kin: Vec<BodyKin<T>>,
     /// Per moving body: the rows touching it as `(row, d, M⁻¹d)`.
     pub(crate) by_body: Vec<Vec<RowBlock<T>>>,
+    /// Position of each row in the fill-reducing order.
+    pub(crate) inv_order: Vec<usize>,
+    pub(crate) col: Vec<T>,
+    pub(crate) nz: Vec<usize>,
     pub q: Vec<[T; 6]>,
     /// Rank of the last factorization.
     pub rank: usize,
@@ -68,7 +74,7 @@ pub struct Workspace<T: RealField + Copy> {
 
 /// Kinematics of one body at the current state.
 #[derive(Debug, Clone, Copy)]
-pub struct BodyKin<T: RealField + Copy> {
+pub struct BodyKin<T: Scalar> {
     pub r: Vector3<T>,
     pub a: Matrix3<T>,
     pub v: Vector3<T>,
@@ -80,7 +86,7 @@ pub struct BodyKin<T: RealField + Copy> {
 
 /// Global kinematics of a marker.
 #[derive(Debug, Clone, Copy)]
-pub struct MarkerKin<T: RealField + Copy> {
+pub struct MarkerKin<T: Scalar> {
     pub slot: Option<usize>,
     /// Global position.
     pub x: Vector3<T>,
@@ -165,7 +171,7 @@ impl System {
     }
 
     /// Body kinematics for every moving body.
-    pub fn body_kin<T: RealField + Copy>(&self, y: &[T], out: &mut Vec<BodyKin<T>>) {
+    pub fn body_kin<T: Scalar>(&self, y: &[T], out: &mut Vec<BodyKin<T>>) {
         out.clear();
         let vo = self.voff();
         for s in 0..self.nb() {
@@ -182,7 +188,7 @@ impl System {
     }
 
     /// Global kinematics of marker `m`.
-    pub fn marker_kin<T: RealField + Copy>(&self, kin: &[BodyKin<T>], m: usize) -> MarkerKin<T> {
+    pub fn marker_kin<T: Scalar>(&self, kin: &[BodyKin<T>], m: usize) -> MarkerKin<T> {
         let mk = &self.model.markers[m];
         let pos = mk.pos.map(cst::<T>);
         let frame = mk.frame.map(cst::<T>);
@@ -229,7 +235,7 @@ impl System {
     }
 
     /// Relative angle `θ` of joint `jt` and its rate `θ̇ = z_i·(ω_j − ω_i)`.
-    pub fn joint_angle<T: RealField + Copy>(&self, kin: &[BodyKin<T>], jt: usize) -> (T, T) {
+    pub fn joint_angle<T: Scalar>(&self, kin: &[BodyKin<T>], jt: usize) -> (T, T) {
         let joint = &self.model.joints[jt];
         let mi = self.marker_kin(kin, joint.i);
         let mj = self.marker_kin(kin, joint.j);
@@ -237,7 +243,7 @@ impl System {
     }
 
     /// Assemble all constraint rows at time `t` into `ws.rows`.
-    pub fn constraints<T: RealField + Copy>(&self, t: f64, ws: &mut Workspace<T>) {
+    pub fn constraints<T: Scalar>(&self, t: f64, ws: &mut Workspace<T>) {
         ws.rows.clear();
         let alpha = self.model.baumgarte;
         for joint in &self.model.joints {
@@ -291,7 +297,7 @@ impl System {
 
     /// Applied generalized forces `Q = [f, n' − ω'×J'ω']` per moving body
     /// at time `t` (into `ws.q`).
-    pub(crate) fn applied<T: RealField + Copy>(&self, ws: &mut Workspace<T>) {
+    pub(crate) fn applied<T: Scalar>(&self, ws: &mut Workspace<T>) {
         ws.q.clear();
         for (s, &b) in self.moving.iter().enumerate() {
             let body = &self.model.bodies[b];
@@ -375,7 +381,7 @@ impl System {
     /// Right-hand side `ẏ = f(t, y)`; also leaves the multipliers in
     /// `ws.rhs` (length = number of equations) and the rank in `ws.rank`.
     /// `t` is a plain `f64`: time never carries a derivative here.
-    pub fn rhs<T: RealField + Copy>(&self, t: f64, y: &[T], dy: &mut [T], ws: &mut Workspace<T>) {
+    pub fn rhs<T: Scalar>(&self, t: f64, y: &[T], dy: &mut [T], ws: &mut Workspace<T>) {
         self.counters.rhs.set(self.counters.rhs.get() + 1);
         let nb = self.nb();
         let vo = self.voff();
@@ -401,7 +407,7 @@ impl System {
 
     /// Solve for the multipliers and accelerations with the rows and
     /// applied forces in `ws`. Returns `v̇` per body; `ws.rhs` = λ.
-    pub(crate) fn solve<T: RealField + Copy>(&self, ws: &mut Workspace<T>) -> Vec<[T; 6]> {
+    pub(crate) fn solve<T: Scalar>(&self, ws: &mut Workspace<T>) -> Vec<[T; 6]> {
         let m = ws.rows.len();
         let minv: Vec<(T, Matrix3<T>)> = self
             .moving
@@ -439,26 +445,52 @@ impl System {
             }
             ws.rhs.push(b);
         }
+        // Fill-reducing order, computed once per workspace (the row
+        // structure of a system never changes).
+        if ws.inv_order.len() != m {
+            let mut edges = Vec::new();
+            for list in &by_body {
+                for (x, (r, _, _)) in list.iter().enumerate() {
+                    for (c, _, _) in list.iter().take(x) {
+                        edges.push((*r, *c));
+                    }
+                }
+            }
+            let order = min_degree_order(m, &edges);
+            ws.inv_order = vec![0; m];
+            for (k, &r) in order.iter().enumerate() {
+                ws.inv_order[r] = k;
+            }
+            ws.perm = (0..m).collect();
+        }
+        let inv = &ws.inv_order;
         ws.a.clear();
         ws.a.resize(m * m, T::zero());
         for list in &by_body {
             for (x, (r, d, _)) in list.iter().enumerate() {
                 for (c, _, w) in list.iter().take(x + 1) {
-                    let (hi, lo) = if r >= c { (*r, *c) } else { (*c, *r) };
+                    let (pr, pc) = (inv[*r], inv[*c]);
+                    let (hi, lo) = if pr >= pc { (pr, pc) } else { (pc, pr) };
                     ws.a[hi * m + lo] += dot6(d, w);
                 }
             }
         }
-        let f = pivoted_cholesky(
+        let f = ordered_cholesky(
             &mut ws.a,
             m,
-            &mut ws.perm,
             &mut ws.scale,
-            RANK_TOL,
-            RANK_REG,
+            (RANK_TOL, RANK_REG),
+            &mut ws.col,
+            &mut ws.nz,
         );
         ws.rank = f.rank;
         let mut lam = std::mem::take(&mut ws.rhs);
+        ws.tmp.clear();
+        ws.tmp.resize(m, T::zero());
+        for r in 0..m {
+            ws.tmp[inv[r]] = lam[r];
+        }
+        std::mem::swap(&mut lam, &mut ws.tmp);
         pivoted_solve(
             &ws.a,
             m,
@@ -468,6 +500,9 @@ impl System {
             &mut lam,
             &mut ws.tmp,
         );
+        ws.tmp.clear();
+        ws.tmp.extend((0..m).map(|r| lam[inv[r]]));
+        std::mem::swap(&mut lam, &mut ws.tmp);
         let mut acc = mq;
         for (s, list) in by_body.iter().enumerate() {
             for (r, _, w) in list {
@@ -482,11 +517,11 @@ impl System {
     }
 }
 
-fn dot6<T: RealField + Copy>(a: &[T; 6], b: &[T; 6]) -> T {
+fn dot6<T: Scalar>(a: &[T; 6], b: &[T; 6]) -> T {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
 }
 
-fn apply_torque<T: RealField + Copy>(ws: &mut Workspace<T>, slot: Option<usize>, tau: &Vector3<T>) {
+fn apply_torque<T: Scalar>(ws: &mut Workspace<T>, slot: Option<usize>, tau: &Vector3<T>) {
     if let Some(s) = slot {
         let tb = ws.kin[s].a.transpose() * tau;
         for c in 0..3 {
@@ -495,7 +530,7 @@ fn apply_torque<T: RealField + Copy>(ws: &mut Workspace<T>, slot: Option<usize>,
     }
 }
 
-fn apply_force<T: RealField + Copy>(ws: &mut Workspace<T>, mk: &MarkerKin<T>, f: &Vector3<T>) {
+fn apply_force<T: Scalar>(ws: &mut Workspace<T>, mk: &MarkerKin<T>, f: &Vector3<T>) {
     if let Some(s) = mk.slot {
         let tb = ws.kin[s].a.transpose() * mk.s.cross(f);
         for c in 0..3 {
@@ -506,7 +541,7 @@ fn apply_force<T: RealField + Copy>(ws: &mut Workspace<T>, mk: &MarkerKin<T>, f:
 }
 
 /// `θ = atan2(z_i·(x_i × x_j), x_i·x_j)` and `θ̇ = z_i·(ω_j − ω_i)`.
-pub fn angle_of<T: RealField + Copy>(mi: &MarkerKin<T>, mj: &MarkerKin<T>) -> (T, T) {
+pub fn angle_of<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>) -> (T, T) {
     let xi: Vector3<T> = mi.frame.column(0).into();
     let zi: Vector3<T> = mi.frame.column(2).into();
     let xj: Vector3<T> = mj.frame.column(0).into();
@@ -515,17 +550,13 @@ pub fn angle_of<T: RealField + Copy>(mi: &MarkerKin<T>, mj: &MarkerKin<T>) -> (T
 }
 
 /// Block of a row for a marker: `(slot, [∂/∂ṙ, ∂/∂ω_global])`.
-fn block<T: RealField + Copy>(
-    mk: &MarkerKin<T>,
-    dr: Vector3<T>,
-    dw: Vector3<T>,
-) -> (Option<usize>, [T; 6]) {
+fn block<T: Scalar>(mk: &MarkerKin<T>, dr: Vector3<T>, dw: Vector3<T>) -> (Option<usize>, [T; 6]) {
     (mk.slot, [dr[0], dr[1], dr[2], dw[0], dw[1], dw[2]])
 }
 
 /// Component `k` of `x_i − x_j = 0`. Velocity: `ṙ + ω × s`, so the ω
 /// block is `e_kᵀ(−s̃) = (s × e_k)ᵀ`; `γ = −e_k·(ω_i×(ω_i×s_i) − ω_j×(ω_j×s_j))`.
-fn point_row<T: RealField + Copy>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, k: usize) -> Row<T> {
+fn point_row<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, k: usize) -> Row<T> {
     let mut e = Vector3::zeros();
     e[k] = T::one();
     let ci = mi.w.cross(&mi.w.cross(&mi.s));
@@ -541,7 +572,7 @@ fn point_row<T: RealField + Copy>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, k: usize
 /// `a·b = 0` with `a` fixed in body i and `b` in body j:
 /// `d/dt(a·b) = ω_i·(a×b) + ω_j·(b×a)`,
 /// `γ = −[b·(ω_i×(ω_i×a)) + 2(ω_i×a)·(ω_j×b) + a·(ω_j×(ω_j×b))]`.
-fn dot_row<T: RealField + Copy>(
+fn dot_row<T: Scalar>(
     mi: &MarkerKin<T>,
     mj: &MarkerKin<T>,
     a: &Vector3<T>,
@@ -564,11 +595,7 @@ fn dot_row<T: RealField + Copy>(
 
 /// Prescribed angle `θ − f(t) = 0` (wrapped to (−π, π]):
 /// `θ̇ = z_i·(ω_j − ω_i)`, `γ = f̈ − (ω_i×z_i)·(ω_j − ω_i)`, `ν = ḟ`.
-fn angle_row<T: RealField + Copy>(
-    mi: &MarkerKin<T>,
-    mj: &MarkerKin<T>,
-    drive: (f64, f64, f64),
-) -> Row<T> {
+fn angle_row<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, drive: (f64, f64, f64)) -> Row<T> {
     let (th, _) = angle_of(mi, mj);
     let zi: Vector3<T> = mi.frame.column(2).into();
     let mut d = th - cst::<T>(drive.0);
