@@ -11,10 +11,14 @@
 //! stabilisation: `G v̇ = γ − 2αΦ̇ − α²Φ`. Because `M` is block diagonal,
 //! `v̇ = M⁻¹(Q + Gᵀλ)` and `λ` solves the constraint-space system
 //! `(G M⁻¹ Gᵀ) λ = γ − 2αΦ̇ − α²Φ − G M⁻¹ Q`, which is formed from the
-//! sparse rows of `G` (each row touches at most two bodies) and factored by
-//! a diagonally pivoted Cholesky: redundant equations are detected and
-//! counted, and the accelerations stay unique (they do not depend on how
-//! the multipliers of dependent rows are split).
+//! sparse rows of `G` (each row touches at most two bodies), permuted once
+//! into a minimum-degree order (the SAR factor keeps 595 of 2145 entries)
+//! and factored by Cholesky after unit-diagonal scaling and a `1e-12`
+//! Tikhonov shift ([`RANK_REG`]). Redundant equations give pivots at the
+//! shift level and are counted ([`RANK_TOL`]); their multipliers take the
+//! minimum-norm split, and the accelerations, which do not depend on that
+//! split, stay unique. One factorization per evaluation; the dual-number
+//! evaluation differentiates the same factorization (no finite differences).
 //!
 //! Everything is generic over the scalar `T` so that `num_dual::Dual64`
 //! gives exact Jacobian-vector products of the right-hand side.

@@ -11,8 +11,10 @@
 //! `y = [r, p, ṙ, ω']` by solving for accelerations and multipliers
 //! ([`dynamics`]). The mass matrix is block diagonal, so only the
 //! constraint-space matrix `G M⁻¹ Gᵀ` (size = number of equations) is
-//! factored, by a diagonally pivoted Cholesky that detects redundant
-//! equations. Drift is controlled by Baumgarte stabilisation (critically
+//! formed, from the sparse rows of `G`, and factored by a Cholesky in a
+//! minimum-degree order with a tiny Tikhonov shift: redundant equations are
+//! detected and counted from the pivots, the accelerations stay unique, and
+//! the solution stays smooth where the rank changes. Drift is controlled by Baumgarte stabilisation (critically
 //! damped, rate `α` from the scene), which keeps the state an ordinary ODE
 //! for any integrator (BDF, explicit and SDIRK Runge–Kutta), unlike
 //! projection, which would have to restart multistep histories.
