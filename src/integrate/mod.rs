@@ -12,7 +12,7 @@
 //! at the requested times, handed to an observer.
 
 use crate::error::{Error, Result};
-use crate::mbs::{System, Workspace};
+use crate::mbs::{Param, System, Workspace};
 use diffsol::{FaerLU, FaerMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason, Vector};
 use num_dual::Dual64;
 use std::cell::RefCell;
@@ -155,7 +155,7 @@ pub fn integrate(
         .build()
         .map_err(|e| Error::numerical("integrate: problem set-up", e.to_string()))?;
     let start = Instant::now();
-    let mut observe = |t: f64, y: &[f64]| {
+    let mut observe = |t: f64, y: &[f64], _s: &[f64]| {
         let t0 = Instant::now();
         let r = observe(t, y);
         observer_time.set(observer_time.get() + t0.elapsed().as_secs_f64());
@@ -166,19 +166,19 @@ pub fn integrate(
             let s = problem
                 .bdf::<FaerLU<f64>>()
                 .map_err(|e| Error::numerical("integrate: bdf set-up", e.to_string()))?;
-            drive(s, opts, &mut observe)?
+            drive(s, opts, 0, &mut observe)?
         }
         Method::Esdirk34 => {
             let s = problem
                 .esdirk34::<FaerLU<f64>>()
                 .map_err(|e| Error::numerical("integrate: esdirk34 set-up", e.to_string()))?;
-            drive(s, opts, &mut observe)?
+            drive(s, opts, 0, &mut observe)?
         }
         Method::Tsit45 => {
             let s = problem
                 .tsit45()
                 .map_err(|e| Error::numerical("integrate: tsit45 set-up", e.to_string()))?;
-            drive(s, opts, &mut observe)?
+            drive(s, opts, 0, &mut observe)?
         }
     };
     stats.wall = start.elapsed().as_secs_f64() - observer_time.get();
@@ -188,11 +188,128 @@ pub fn integrate(
     Ok(stats)
 }
 
-/// Step a solver through the output times.
+/// Integrate `sys` from `y0` together with the forward sensitivities of
+/// the state with respect to `params` (direct differentiation, paper Eqs.
+/// 12–16): `ṡ_i = J s_i + ∂f/∂p_i`, both products exact from dual-number
+/// evaluations of the same right-hand side. The initial state is taken as
+/// independent of the parameters (`s_i(t0) = 0`). `observe(t, y, s)` gets
+/// `s` lane-major: `s[i·n..(i+1)·n] = ∂y/∂p_i`. Sensitivities take part in
+/// the error control.
+pub fn integrate_sens(
+    sys: &System,
+    y0: &[f64],
+    opts: &Options,
+    params: &[Param],
+    mut observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+) -> Result<Stats> {
+    opts.validate()?;
+    let n = y0.len();
+    let mut p0 = Vec::with_capacity(params.len());
+    for (k, p) in params.iter().enumerate() {
+        let v = p.value(&sys.model).ok_or_else(|| {
+            Error::input(
+                format!("params[{k}]"),
+                format!("{p:?}"),
+                "a parameter of the model",
+            )
+        })?;
+        p0.push(v);
+    }
+    let ws = RefCell::new(Workspace::<f64>::empty());
+    let wsd = RefCell::new(Workspace::<Dual64>::empty());
+    let yd = RefCell::new(vec![Dual64::from(0.0); n]);
+    let dyd = RefCell::new(vec![Dual64::from(0.0); n]);
+    let rhs_calls = std::cell::Cell::new(0u64);
+    let jvps = std::cell::Cell::new(0u64);
+    let y0v = y0.to_vec();
+    // One dual evaluation: state seeds `vy`, parameter seeds `vp`.
+    let dual_eval =
+        |x: &[f64], p: &[f64], t: f64, vy: Option<&[f64]>, vp: Option<&[f64]>, out: &mut [f64]| {
+            jvps.set(jvps.get() + 1);
+            let mut w = wsd.borrow_mut();
+            w.params.clear();
+            for (k, par) in params.iter().enumerate() {
+                w.params
+                    .push((*par, Dual64::new(p[k], vp.map_or(0.0, |v| v[k]))));
+            }
+            let mut yv = yd.borrow_mut();
+            let mut dy = dyd.borrow_mut();
+            for k in 0..x.len() {
+                yv[k] = Dual64::new(x[k], vy.map_or(0.0, |v| v[k]));
+            }
+            sys.rhs(t, &yv, &mut dy, &mut w);
+            for k in 0..x.len() {
+                out[k] = dy[k].eps;
+            }
+        };
+    let problem = OdeBuilder::<FaerMat<f64>>::new()
+        .t0(opts.t0)
+        .rtol(opts.rtol)
+        .atol([opts.atol])
+        .h0(1e-6)
+        .p(p0.clone())
+        .rhs_sens_implicit(
+            |x: &[f64], p: &[f64], t: f64, y: &mut [f64]| {
+                rhs_calls.set(rhs_calls.get() + 1);
+                let mut w = ws.borrow_mut();
+                w.params.clear();
+                w.params
+                    .extend(params.iter().copied().zip(p.iter().copied()));
+                sys.rhs(t, x, y, &mut w);
+            },
+            |x: &[f64], p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
+                dual_eval(x, p, t, Some(v), None, y)
+            },
+            |x: &[f64], p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
+                dual_eval(x, p, t, None, Some(v), y)
+            },
+        )
+        .init_sens(
+            move |_p: &[f64], _t: f64, y: &mut [f64]| y.copy_from_slice(&y0v),
+            |_p: &[f64], _t: f64, _v: &[f64], y: &mut [f64]| y.fill(0.0),
+            n,
+        )
+        .build()
+        .map_err(|e| Error::numerical("integrate_sens: problem set-up", e.to_string()))?;
+    let start = Instant::now();
+    let np = params.len();
+    let setup = |e: diffsol::error::DiffsolError| {
+        Error::numerical("integrate_sens: solver set-up", e.to_string())
+    };
+    let mut stats = match opts.method {
+        Method::Bdf => drive(
+            problem.bdf_sens::<FaerLU<f64>>().map_err(setup)?,
+            opts,
+            np,
+            &mut observe,
+        )?,
+        Method::Esdirk34 => drive(
+            problem.esdirk34_sens::<FaerLU<f64>>().map_err(setup)?,
+            opts,
+            np,
+            &mut observe,
+        )?,
+        Method::Tsit45 => drive(
+            problem.tsit45_sens().map_err(setup)?,
+            opts,
+            np,
+            &mut observe,
+        )?,
+    };
+    stats.wall = start.elapsed().as_secs_f64();
+    stats.rhs_calls = rhs_calls.get();
+    stats.jvp_calls = jvps.get();
+    Ok(stats)
+}
+
+/// Step a solver through the output times; with `nsens > 0` the
+/// sensitivities (`nsens` lanes of the state length, lane-major) are
+/// interpolated too and handed to `observe` after the state.
 fn drive<'a, Eqn, S>(
     mut solver: S,
     opts: &Options,
-    observe: &mut impl FnMut(f64, &[f64]) -> Result<()>,
+    nsens: usize,
+    observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
 ) -> Result<Stats>
 where
     Eqn: diffsol::OdeEquations<T = f64, V = diffsol::FaerVec<f64>> + 'a,
@@ -205,8 +322,10 @@ where
     let mut next = 0;
     // Output times at the start.
     while next < opts.times.len() && opts.times[next] <= opts.t0 {
-        let y = solver.state().y.clone();
-        emit(opts.times[next], &y.clone_as_vec(), observe)?;
+        let y = solver.state().y.clone_as_vec();
+        // Initial sensitivities are zero (the initial state is given).
+        let s0 = vec![0.0; y.len() * nsens];
+        emit(opts.times[next], &y, &s0, observe)?;
         next += 1;
     }
     loop {
@@ -228,7 +347,17 @@ where
                     Error::numerical_at("integrate: dense output", tq, e.to_string())
                 })?
             };
-            emit(tq, &y.clone_as_vec(), observe)?;
+            let sens = if nsens > 0 {
+                solver
+                    .interpolate_sens(tq)
+                    .map_err(|e| {
+                        Error::numerical_at("integrate: sensitivity output", tq, e.to_string())
+                    })?
+                    .clone_as_vec()
+            } else {
+                Vec::new()
+            };
+            emit(tq, &y.clone_as_vec(), &sens, observe)?;
             next += 1;
         }
         if matches!(reason, OdeSolverStopReason::TstopReached) || next >= opts.times.len() {
@@ -246,13 +375,18 @@ where
     })
 }
 
-fn emit(t: f64, y: &[f64], observe: &mut impl FnMut(f64, &[f64]) -> Result<()>) -> Result<()> {
-    if let Some(k) = y.iter().position(|v| !v.is_finite()) {
+fn emit(
+    t: f64,
+    y: &[f64],
+    sens: &[f64],
+    observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+) -> Result<()> {
+    if let Some(k) = y.iter().chain(sens).position(|v| !v.is_finite()) {
         return Err(Error::numerical_at(
             "integrate: state",
             t,
-            format!("component {k} is {}", y[k]),
+            format!("component {k} of the state/sensitivities is not finite"),
         ));
     }
-    observe(t, y)
+    observe(t, y, sens)
 }

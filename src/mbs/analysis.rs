@@ -276,6 +276,7 @@ impl<T: Scalar> Workspace<T> {
             nz: Vec::new(),
             q: Vec::new(),
             rank: 0,
+            params: Vec::new(),
         }
     }
 }

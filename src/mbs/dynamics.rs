@@ -26,7 +26,7 @@
 use super::linalg::{
     cst, euler_rate, min_degree_order, ordered_cholesky, pivoted_solve, rotation, Scalar,
 };
-use super::model::{Force, JointKind, Model};
+use super::model::{Force, JointKind, Model, Param};
 use nalgebra::{Matrix3, Vector3};
 use std::cell::Cell;
 
@@ -74,6 +74,9 @@ pub struct Workspace<T: Scalar> {
     pub q: Vec<[T; 6]>,
     /// Rank of the last factorization.
     pub rank: usize,
+    /// Parameter values overriding the model's (sensitivity analysis);
+    /// empty for plain evaluations.
+    pub params: Vec<(Param, T)>,
 }
 
 /// Kinematics of one body at the current state.
@@ -310,12 +313,12 @@ impl System {
             let gyro = -k.wb.cross(&jw);
             ws.q.push([T::zero(), T::zero(), T::zero(), gyro[0], gyro[1], gyro[2]]);
         }
-        for force in &self.model.forces {
+        for (fi, force) in self.model.forces.iter().enumerate() {
             match force {
                 Force::Gravity { g } => {
                     self.counters.gravity.set(self.counters.gravity.get() + 1);
                     for (s, &b) in self.moving.iter().enumerate() {
-                        let m = cst::<T>(self.model.bodies[b].mass);
+                        let m = pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass);
                         for c in 0..3 {
                             ws.q[s][c] += m * cst::<T>(g[c]);
                         }
@@ -347,11 +350,12 @@ impl System {
                     let mi = self.marker_kin(&ws.kin, jt.i);
                     let mj = self.marker_kin(&ws.kin, jt.j);
                     let (th, thd) = angle_of(&mi, &mj);
-                    let mut m = cst::<T>(*damping) * thd;
+                    let mut m = pval(&ws.params, Param::Damping(fi), *damping) * thd;
                     if let Some(law) = law {
-                        let seg = law.segment(th.to_subset().unwrap_or(f64::NAN));
-                        m +=
-                            cst::<T>(seg.value) + cst::<T>(seg.slope) * (cst::<T>(seg.anchor) - th);
+                        let k = law.segment_index(th.to_subset().unwrap_or(f64::NAN));
+                        let seg = &law.segments[k];
+                        let anchor = pval(&ws.params, Param::Anchor(fi, k), seg.anchor);
+                        m += cst::<T>(seg.value) + cst::<T>(seg.slope) * (anchor - th);
                     }
                     let axis: Vector3<T> = mi.frame.column(2).into();
                     let tau = axis * (-m);
@@ -372,8 +376,9 @@ impl System {
                     let l = d.norm();
                     let u = d / l;
                     let ldot = u.dot(&(mj.v - mi.v));
-                    let tension =
-                        cst::<T>(*stiffness) * (l - cst::<T>(*length)) + cst::<T>(*damping) * ldot;
+                    let k = pval(&ws.params, Param::Stiffness(fi), *stiffness);
+                    let c = pval(&ws.params, Param::Damping(fi), *damping);
+                    let tension = k * (l - cst::<T>(*length)) + c * ldot;
                     let f = u * tension; // on i, towards j
                     apply_force(ws, &mi, &f);
                     apply_force(ws, &mj, &(-f));
@@ -418,7 +423,8 @@ impl System {
             .iter()
             .map(|&b| {
                 let body = &self.model.bodies[b];
-                (cst::<T>(1.0 / body.mass), body.inv_inertia.map(cst::<T>))
+                let m = pval(&ws.params, Param::Mass(b), body.mass);
+                (T::one() / m, body.inv_inertia.map(cst::<T>))
             })
             .collect();
         let apply_minv = |s: usize, x: &[T; 6]| -> [T; 6] {
@@ -519,6 +525,16 @@ impl System {
         ws.by_body = by_body;
         acc
     }
+}
+
+/// The value of parameter `which`: the override in `params` if present,
+/// else the model's `default`.
+#[inline]
+fn pval<T: Scalar>(params: &[(Param, T)], which: Param, default: f64) -> T {
+    params
+        .iter()
+        .find(|(p, _)| *p == which)
+        .map_or_else(|| cst::<T>(default), |(_, v)| *v)
 }
 
 fn dot6<T: Scalar>(a: &[T; 6], b: &[T; 6]) -> T {

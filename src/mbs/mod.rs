@@ -35,4 +35,6 @@ pub mod simulate;
 
 pub use analysis::{Projection, Reaction};
 pub use dynamics::{System, Workspace};
-pub use model::{Body, Drive, Force, Joint, JointKind, Marker, Model, PiecewiseLaw, Segment};
+pub use model::{
+    Body, Drive, Force, Joint, JointKind, Marker, Model, Param, PiecewiseLaw, Segment,
+};

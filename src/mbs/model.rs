@@ -191,23 +191,90 @@ impl PiecewiseLaw {
 
     /// The segment that applies at `θ` (real value).
     pub fn segment(&self, theta: f64) -> &Segment {
+        &self.segments[self.segment_index(theta)]
+    }
+
+    /// Index of the segment that applies at `θ`.
+    pub fn segment_index(&self, theta: f64) -> usize {
         let segs = &self.segments;
-        for s in segs {
-            if theta > s.lower && theta <= s.upper {
-                return s;
-            }
+        if let Some(k) = segs
+            .iter()
+            .position(|s| theta > s.lower && theta <= s.upper)
+        {
+            return k;
         }
         if theta <= segs[0].lower {
-            return &segs[0];
+            return 0;
         }
         if theta > segs[segs.len() - 1].upper {
-            return &segs[segs.len() - 1];
+            return segs.len() - 1;
         }
         // A gap between segments: the nearest one below.
-        segs.iter()
-            .rev()
-            .find(|s| s.upper < theta)
-            .unwrap_or(&segs[0])
+        segs.iter().rposition(|s| s.upper < theta).unwrap_or(0)
+    }
+}
+
+/// A model value that can be a sensitivity parameter. In the right-hand
+/// side it is read through [`crate::mbs::Workspace::params`], so that a
+/// dual-number value gives the exact parameter derivative `∂f/∂p`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Param {
+    /// Stiffness `k` of the spring-damper `forces[i]` (N/m).
+    Stiffness(usize),
+    /// Damping of `forces[i]`: `c` of a spring-damper (N·s/m) or of a
+    /// rotational actuator (N·m·s).
+    Damping(usize),
+    /// Mass of `bodies[i]` (kg): translational inertia and weight (the
+    /// inertia tensor is a separate datum).
+    Mass(usize),
+    /// Anchor (breakpoint) of segment `k` of the law of the actuator
+    /// `forces[i]`: the `3.12` in `0.10 + 9.00(3.12 − θ)` (rad).
+    Anchor(usize, usize),
+}
+
+impl Param {
+    /// The model's current value of this parameter, if it exists.
+    pub fn value(&self, model: &Model) -> Option<f64> {
+        match *self {
+            Param::Mass(b) => model.bodies.get(b).map(|b| b.mass),
+            Param::Stiffness(f) => match model.forces.get(f) {
+                Some(Force::SpringDamper { stiffness, .. }) => Some(*stiffness),
+                _ => None,
+            },
+            Param::Damping(f) => match model.forces.get(f) {
+                Some(Force::SpringDamper { damping, .. }) => Some(*damping),
+                Some(Force::Rotational { damping, .. }) => Some(*damping),
+                _ => None,
+            },
+            Param::Anchor(f, k) => match model.forces.get(f) {
+                Some(Force::Rotational { law: Some(l), .. }) => l.segments.get(k).map(|s| s.anchor),
+                _ => None,
+            },
+        }
+    }
+
+    /// A copy of `model` with this parameter set to `v` (for finite
+    /// differences and studies).
+    pub fn set(&self, model: &mut Model, v: f64) {
+        match *self {
+            Param::Mass(b) => model.bodies[b].mass = v,
+            Param::Stiffness(f) => {
+                if let Force::SpringDamper { stiffness, .. } = &mut model.forces[f] {
+                    *stiffness = v;
+                }
+            }
+            Param::Damping(f) => match &mut model.forces[f] {
+                Force::SpringDamper { damping, .. } | Force::Rotational { damping, .. } => {
+                    *damping = v
+                }
+                _ => {}
+            },
+            Param::Anchor(f, k) => {
+                if let Force::Rotational { law: Some(l), .. } = &mut model.forces[f] {
+                    l.segments[k].anchor = v;
+                }
+            }
+        }
     }
 }
 
