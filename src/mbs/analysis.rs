@@ -266,7 +266,6 @@ impl<T: Scalar> Workspace<T> {
             rows: Vec::new(),
             a: Vec::new(),
             rhs: Vec::new(),
-            perm: Vec::new(),
             scale: Vec::new(),
             tmp: Vec::new(),
             kin: Vec::new(),

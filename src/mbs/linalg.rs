@@ -1,10 +1,12 @@
-//! Small generic kernels: rotations from Euler parameters and a
-//! rank-revealing (diagonally pivoted) Cholesky factorization.
+//! Small generic kernels: rotations from Euler parameters, a
+//! minimum-degree ordering and a rank-counting, regularised sparse
+//! Cholesky factorization.
 //!
 //! Everything is generic over `T: Scalar` so that the same code runs
 //! on `f64` and on `num_dual::Dual64` (exact Jacobian-vector products).
-//! Pivot decisions compare values, which for dual numbers compares the real
-//! parts: the derivative follows the same branch as the value.
+//! Branches (segment choice, rank counting) compare values, which for dual
+//! numbers compares the real parts: the derivative follows the same branch
+//! as the value. Structural zeros are detected on all components.
 
 use nalgebra::{Matrix3, RealField, Vector3};
 
@@ -76,120 +78,15 @@ pub fn euler_from_rotation(a: &Matrix3<f64>) -> [f64; 4] {
     [q.w, q.i, q.j, q.k]
 }
 
-/// Outcome of [`pivoted_cholesky`].
+/// Outcome of [`ordered_cholesky`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Factored {
     /// Numerical rank: pivots whose Schur diagonal exceeds `tol`.
     pub rank: usize,
-    /// Pivots factored (all of them when `reg > 0`, else `rank`).
+    /// Rows factored: all of them unless a pivot is not positive (possible
+    /// only with `reg = 0` on a singular matrix, or non-finite input); the
+    /// solve then uses the leading block.
     pub accepted: usize,
-}
-
-/// In-place diagonally pivoted Cholesky factorization of the symmetric
-/// positive semi-definite `n × n` matrix `a` (row-major, only the lower
-/// triangle is read), after unit-diagonal scaling `Â = S A S`,
-/// `S = diag(1/√a_kk)`.
-///
-/// Pivot `k` takes the largest remaining Schur diagonal (rows and columns
-/// are swapped in place, as LAPACK `dpstrf` does); pivots above `tol`
-/// (relative to the unit diagonal of Â) count towards the rank, so linearly
-/// dependent rows are detected and counted (`n − rank`).
-///
-/// With `reg = 0` the dependent rows are left out (truncated solve). With
-/// `reg > 0` the factored matrix is `Â + reg·I` (Tikhonov regularisation):
-/// every pivot is kept, the solution is a smooth function of the matrix
-/// even where its rank changes (singular configurations), and dependent
-/// rows share their multipliers in the minimum-norm way. On return
-/// `perm[k]` is the original row at position `k` (`perm[..rank]` are the
-/// accepted rows), the lower triangle of `a` holds the factor `L` of
-/// `Â[perm, perm]` and `scale` holds `S` (original order).
-/// Cost `≈ n·rank²/2` multiply-adds, contiguous inner loops.
-pub fn pivoted_cholesky<T: Scalar>(
-    a: &mut [T],
-    n: usize,
-    perm: &mut Vec<usize>,
-    scale: &mut Vec<T>,
-    tol: f64,
-    reg: f64,
-) -> Factored {
-    perm.clear();
-    perm.extend(0..n);
-    scale.clear();
-    let tol = cst::<T>(tol);
-    let regt = cst::<T>(reg);
-    for k in 0..n {
-        let d = a[k * n + k];
-        let s = if d > T::zero() {
-            T::one() / d.sqrt()
-        } else {
-            T::zero()
-        };
-        scale.push(s);
-    }
-    for i in 0..n {
-        let si = scale[i];
-        let row = &mut a[i * n..i * n + i + 1];
-        for (j, v) in row.iter_mut().enumerate() {
-            *v = *v * si * scale[j];
-        }
-        row[i] += regt;
-    }
-    let mut col = vec![T::zero(); n];
-    let mut rank = 0;
-    let mut accepted = 0;
-    for k in 0..n {
-        let mut best = k;
-        let mut best_val = a[k * n + k];
-        for c in k + 1..n {
-            let v = a[c * n + c];
-            if v > best_val {
-                best = c;
-                best_val = v;
-            }
-        }
-        if best_val - regt > tol {
-            rank += 1;
-        } else if reg <= 0.0
-            || best_val.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater)
-        {
-            break;
-        }
-        if best != k {
-            swap_sym(a, n, k, best);
-            perm.swap(k, best);
-        }
-        let lkk = best_val.sqrt();
-        a[k * n + k] = lkk;
-        let inv = T::one() / lkk;
-        for r in k + 1..n {
-            let v = a[r * n + k] * inv;
-            a[r * n + k] = v;
-            col[r] = v;
-        }
-        for r in k + 1..n {
-            let lr = col[r];
-            let row = &mut a[r * n + k + 1..r * n + r + 1];
-            for (x, &lc) in row.iter_mut().zip(&col[k + 1..r + 1]) {
-                *x -= lr * lc;
-            }
-        }
-        accepted = k + 1;
-    }
-    Factored { rank, accepted }
-}
-
-/// Symmetric swap of rows/columns `k < p` in lower-triangle storage.
-fn swap_sym<T: Copy>(a: &mut [T], n: usize, k: usize, p: usize) {
-    for c in 0..k {
-        a.swap(k * n + c, p * n + c);
-    }
-    a.swap(k * n + k, p * n + p);
-    for i in k + 1..p {
-        a.swap(i * n + k, p * n + i);
-    }
-    for i in p + 1..n {
-        a.swap(i * n + k, i * n + p);
-    }
 }
 
 /// Greedy minimum-degree ordering of a symmetric sparsity pattern on `n`
@@ -228,8 +125,8 @@ pub fn min_degree_order(n: usize, edges: &[(usize, usize)]) -> Vec<usize> {
     order
 }
 
-/// Cholesky factorization of `Â + reg·I` (unit-diagonal scaling as in
-/// [`pivoted_cholesky`]) without pivoting, in the order the matrix is
+/// Cholesky factorization of `Â + reg·I` (unit-diagonal scaling
+/// `Â = S A S`, `S = diag(1/√a_kk)`) without pivoting, in the order the matrix is
 /// stored (use [`min_degree_order`] to keep fill low), skipping exact
 /// (structural) zeros in the Schur updates.
 ///
@@ -302,24 +199,21 @@ pub fn ordered_cholesky<T: Scalar>(
     Factored { rank, accepted: n }
 }
 
-/// Solve `A x = b` with the factor of [`pivoted_cholesky`] (`rank` =
-/// [`Factored::accepted`]): the accepted rows are solved exactly, the
-/// left-out (dependent) rows get `x = 0`.
-/// When `b` lies in the range of `A` (a consistent redundant system) this is
-/// an exact solution, and the accelerations `M⁻¹Gᵀx` are the same for every
-/// solution. `b` is overwritten by `x`; `tmp` is scratch.
-pub fn pivoted_solve<T: Scalar>(
+/// Solve `(Â + reg·I)(S⁻¹x) = S b` with the factor of [`ordered_cholesky`]
+/// (`accepted` = [`Factored::accepted`], normally all rows): forward and
+/// backward substitution with `L`, scaling by `S` on both sides. `b` is
+/// overwritten by `x`; `tmp` is scratch.
+pub fn cholesky_solve<T: Scalar>(
     l: &[T],
     n: usize,
-    perm: &[usize],
     scale: &[T],
-    rank: usize,
+    accepted: usize,
     b: &mut [T],
     tmp: &mut Vec<T>,
 ) {
     tmp.clear();
-    tmp.extend(perm.iter().take(rank).map(|&p| b[p] * scale[p]));
-    for k in 0..rank {
+    tmp.extend((0..accepted).map(|k| b[k] * scale[k]));
+    for k in 0..accepted {
         let row = &l[k * n..k * n + k];
         let mut s = tmp[k];
         for (x, y) in row.iter().zip(tmp.iter()) {
@@ -327,9 +221,9 @@ pub fn pivoted_solve<T: Scalar>(
         }
         tmp[k] = s / l[k * n + k];
     }
-    for k in (0..rank).rev() {
+    for k in (0..accepted).rev() {
         let mut s = tmp[k];
-        for r in k + 1..rank {
+        for r in k + 1..accepted {
             s -= l[r * n + k] * tmp[r];
         }
         tmp[k] = s / l[k * n + k];
@@ -337,8 +231,8 @@ pub fn pivoted_solve<T: Scalar>(
     for v in b.iter_mut() {
         *v = T::zero();
     }
-    for k in 0..rank {
-        b[perm[k]] = tmp[k] * scale[perm[k]];
+    for k in 0..accepted {
+        b[k] = tmp[k] * scale[k];
     }
 }
 
@@ -347,43 +241,10 @@ mod tests {
     use super::*;
 
     #[test]
-    fn pivoted_cholesky_detects_dependent_rows_and_solves() {
-        // A = G Gᵀ with G 4×3 whose 4th row = row0 + row1 (rank 3):
-        // identity construction, closed form derived in this test.
-        let g = [
-            [1.0, 2.0, 0.5],
-            [0.0, 1.0, -1.0],
-            [3.0, 0.0, 1.0],
-            [1.0, 3.0, -0.5],
-        ];
-        let n = 4;
-        let mut a = vec![0.0; n * n];
-        for i in 0..n {
-            for j in 0..n {
-                a[i * n + j] = (0..3).map(|k| g[i][k] * g[j][k]).sum();
-            }
-        }
-        let a0 = a.clone();
-        let x_true = [0.3, -1.2, 0.7, 0.0];
-        let mut b: Vec<f64> = (0..n)
-            .map(|i| (0..n).map(|j| a0[i * n + j] * x_true[j]).sum())
-            .collect();
-        let (mut perm, mut scale, mut tmp) = (vec![], vec![], vec![]);
-        let f = pivoted_cholesky(&mut a, n, &mut perm, &mut scale, 1e-10, 0.0);
-        assert_eq!(f.rank, 3);
-        let b0 = b.clone();
-        pivoted_solve(&a, n, &perm, &scale, f.accepted, &mut b, &mut tmp);
-        // Residual A x − b vanishes (consistent right-hand side).
-        for i in 0..n {
-            let r: f64 = (0..n).map(|j| a0[i * n + j] * b[j]).sum::<f64>() - b0[i];
-            assert!(r.abs() < 1e-12, "row {i} residual {r}");
-        }
-    }
-
-    #[test]
     fn ordered_cholesky_counts_rank_and_solves_regularised_system() {
-        // Same rank-3 Gram matrix as above (closed form derived there),
-        // factored without pivoting in a minimum-degree order.
+        // A = G Gᵀ with G 4×3 whose 4th row = row0 + row1 (rank 3):
+        // identity construction, closed form derived in this test. The
+        // right-hand side is in the range of A (consistent).
         let g = [
             [1.0, 2.0, 0.5],
             [0.0, 1.0, -1.0],
@@ -409,8 +270,7 @@ mod tests {
         let (mut scale, mut col, mut nz, mut tmp) = (vec![], vec![], vec![], vec![]);
         let f = ordered_cholesky(&mut a, n, &mut scale, (1e-8, 1e-12), &mut col, &mut nz);
         assert_eq!((f.rank, f.accepted), (3, 4));
-        let perm: Vec<usize> = (0..n).collect();
-        pivoted_solve(&a, n, &perm, &scale, n, &mut b, &mut tmp);
+        cholesky_solve(&a, n, &scale, n, &mut b, &mut tmp);
         for i in 0..n {
             let r: f64 = (0..n).map(|j| a0[i * n + j] * b[j]).sum::<f64>() - b0[i];
             assert!(r.abs() < 1e-9, "row {i} residual {r}");

@@ -19,12 +19,23 @@
 //! for any integrator (BDF, explicit and SDIRK Runge–Kutta), unlike
 //! projection, which would have to restart multistep histories.
 //! Initial conditions are projected onto the constraints ([`analysis`]).
+//! Forward sensitivities (stiffness, damping, mass, Eq. 32 breakpoints,
+//! [`Param`]) come from [`crate::integrate::integrate_sens`], with exact
+//! products from dual-number evaluations of the same right-hand side.
 //!
 //! ## Limitations
 //! - Rigid bodies only in this part (floating-frame flexible bodies are
 //!   issue 3, part B).
 //! - A revolute relative angle is measured in (−π, π]; marker frames are
-//!   set so that the scene's initial angle sits inside that range.
+//!   set so that the scene's initial angle sits inside that range. A
+//!   driven joint's prescribed angle is compared modulo 2π.
+//! - Change-point singularities (a parallelogram four-bar passing its flat
+//!   position, where two motion branches cross) are solved without
+//!   failure thanks to the regularisation, but the motion is not
+//!   guaranteed to continue on the physical branch. Singular positions of
+//!   ordinary mechanisms (rocker dead points) are fine.
+//! - Sensitivities assume an initial state independent of the
+//!   parameters, and are not yet exposed in scene files.
 
 pub mod analysis;
 pub mod dynamics;
