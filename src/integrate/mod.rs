@@ -129,6 +129,8 @@ pub fn integrate(
         .t0(opts.t0)
         .rtol(opts.rtol)
         .atol([opts.atol])
+        // First trial step: small enough for the fastest scene here
+        // (Andrews, 0.03 s span); the controllers grow it within a few steps.
         .h0(1e-6)
         .rhs_implicit(
             |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
@@ -246,7 +248,7 @@ pub fn integrate_sens(
         .t0(opts.t0)
         .rtol(opts.rtol)
         .atol([opts.atol])
-        .h0(1e-6)
+        .h0(1e-6) // as in `integrate`
         .p(p0.clone())
         .rhs_sens_implicit(
             |x: &[f64], p: &[f64], t: f64, y: &mut [f64]| {
