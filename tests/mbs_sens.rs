@@ -200,3 +200,53 @@ fn sar_sensitivities_of_deployment_angle() {
         assert!((dth_sens - dth_fd).abs() < 1e-5 * dth_fd.abs(), "{p:?}");
     }
 }
+
+#[test]
+fn scene_sensitivities_of_outputs_match_differences() {
+    // The same pendulum with `sensitivities` in the scene: ∂θ_pin(1 s)/∂p
+    // written by `simulate` vs central differences of the simulation.
+    let text = SCENE
+        .replace(
+            "[scene.integrator]\nt_end = 1.0\ndt_out = 1.0\n",
+            "[scene.integrator]\nrtol = 1e-11\natol = 1e-13\nt_end = 1.0\ndt_out = 0.5\n\
+             [scene.outputs]\nquantities = [\"pin.angle\", \"pin.rate\"]\n",
+        )
+        .replacen(
+            "\n[[scene.bodies]]",
+            "\nsensitivities = [\"forces[0].stiffness\", \"rod.mass\", \"forces[1].segments[0].anchor\", \"forces[1].damping\"]\n[[scene.bodies]]",
+            1,
+        );
+    let table: toml::Table = toml::from_str(&text).unwrap();
+    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
+    let scene = spec.build().unwrap();
+    assert_eq!(scene.params.len(), 4);
+    let (_, sim) = plyscape::mbs::simulate::simulate(&scene).unwrap();
+    assert_eq!(sim.sens_headers.len(), 1 + 4 * 2);
+    assert_eq!(sim.sens_rows.len(), 3);
+    assert!(sim.sens_headers[1].starts_with("d(pin.angle)/d(forces[0].stiffness)"));
+    let last = sim.sens_rows.last().unwrap();
+    for (i, (_, p)) in scene.params.iter().enumerate() {
+        let v = p.value(&scene.model).unwrap();
+        let h = 1e-4 * v.abs();
+        let mut th = [0.0; 2];
+        for (k, sign) in [1.0, -1.0].iter().enumerate() {
+            let mut sc = spec.build().unwrap();
+            p.set(&mut sc.model, v + sign * h);
+            sc.params.clear();
+            let (_, s) = plyscape::mbs::simulate::simulate(&sc).unwrap();
+            th[k] = s.rows.last().unwrap()[1];
+        }
+        let fd = (th[0] - th[1]) / (2.0 * h);
+        let exact = last[1 + 2 * i];
+        println!("{p:?}: dθ/dp {exact:.9e} vs FD {fd:.9e}");
+        assert!((exact - fd).abs() < 1e-5 * fd.abs(), "{p:?}");
+    }
+    // Bad names are input errors naming the key.
+    let bad = text.replace("\"rod.mass\"", "\"rod.masss\"");
+    let table: toml::Table = toml::from_str(&bad).unwrap();
+    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
+    match spec.build() {
+        Err(plyscape::Error::Input { key, .. }) => assert_eq!(key, "sensitivities[1]"),
+        other => panic!("{other:?}"),
+    }
+}

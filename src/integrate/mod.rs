@@ -274,6 +274,13 @@ pub fn integrate_sens(
         .build()
         .map_err(|e| Error::numerical("integrate_sens: problem set-up", e.to_string()))?;
     let start = Instant::now();
+    let observer_time = std::cell::Cell::new(0.0f64);
+    let mut observe = |t: f64, y: &[f64], s: &[f64]| {
+        let t0 = Instant::now();
+        let r = observe(t, y, s);
+        observer_time.set(observer_time.get() + t0.elapsed().as_secs_f64());
+        r
+    };
     let np = params.len();
     let setup = |e: diffsol::error::DiffsolError| {
         Error::numerical("integrate_sens: solver set-up", e.to_string())
@@ -298,7 +305,8 @@ pub fn integrate_sens(
             &mut observe,
         )?,
     };
-    stats.wall = start.elapsed().as_secs_f64();
+    stats.wall = start.elapsed().as_secs_f64() - observer_time.get();
+    stats.observer_wall = observer_time.get();
     stats.rhs_calls = rhs_calls.get();
     stats.jvp_calls = jvps.get();
     Ok(stats)

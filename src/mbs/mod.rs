@@ -35,7 +35,8 @@
 //!   guaranteed to continue on the physical branch. Singular positions of
 //!   ordinary mechanisms (rocker dead points) are fine.
 //! - Sensitivities assume an initial state independent of the
-//!   parameters, and are not yet exposed in scene files.
+//!   parameters; in scene files (`sensitivities = [..]`) they are written
+//!   for angle, rate and position outputs only (`sensitivities.csv`).
 
 pub mod analysis;
 pub mod dynamics;

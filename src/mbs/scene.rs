@@ -21,6 +21,7 @@
 //! type = "spring"; marker_i, marker_j, stiffness, damping, length
 //! type = "load"; body, force, torque
 //! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out
+//! sensitivities = ["forces[0].damping", "forces[0].segments[0].anchor", "B3.mass"]
 //! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation"]
 //!                  plot = "R3.angle"
 //! ```
@@ -28,8 +29,8 @@
 //! both the global and the body-frame tensor at `t = 0`.
 
 use super::model::{
-    axis_angle, frame_from_axis, Body, Drive, Force, Joint, JointKind, Marker, Model, PiecewiseLaw,
-    Segment,
+    axis_angle, frame_from_axis, Body, Drive, Force, Joint, JointKind, Marker, Model, Param,
+    PiecewiseLaw, Segment,
 };
 use crate::error::{Error, Result};
 use crate::integrate::{Method, Options};
@@ -57,6 +58,11 @@ pub struct SceneSpec {
     pub integrator: IntegratorSpec,
     #[serde(default)]
     pub outputs: OutputSpec,
+    /// Parameters for forward sensitivities of the outputs:
+    /// `"<body>.mass"`, `"forces[i].stiffness"`, `"forces[i].damping"`,
+    /// `"forces[i].segments[k].anchor"` (indices as in `scene.forces`).
+    #[serde(default)]
+    pub sensitivities: Vec<String>,
 }
 
 fn default_gravity() -> [f64; 3] {
@@ -196,6 +202,8 @@ pub struct Scene {
     pub outputs: Vec<(String, Quantity)>,
     pub plot: Option<String>,
     pub effects: Vec<String>,
+    /// Sensitivity parameters with their names from the scene file.
+    pub params: Vec<(String, Param)>,
 }
 
 impl Quantity {
@@ -396,6 +404,8 @@ impl SceneSpec {
                 g: finite3("gravity".into(), self.gravity)?,
             });
         }
+        // Model index of each scene force (None: not built).
+        let mut force_index: Vec<Option<usize>> = vec![None; self.forces.len()];
         for (k, f) in self.forces.iter().enumerate() {
             let key = format!("forces[{k}]");
             match f {
@@ -444,6 +454,7 @@ impl SceneSpec {
                     };
                     let c = if has("damping") { *damping } else { 0.0 };
                     if law.is_some() || c != 0.0 {
+                        force_index[k] = Some(model.forces.len());
                         model.forces.push(Force::Rotational {
                             joint: jt,
                             law,
@@ -491,6 +502,7 @@ impl SceneSpec {
                         continue;
                     }
                     let c = if has("damping") { *damping } else { 0.0 };
+                    force_index[k] = Some(model.forces.len());
                     model.forces.push(Force::SpringDamper {
                         i,
                         j,
@@ -512,6 +524,7 @@ impl SceneSpec {
                     if !has("loads") {
                         continue;
                     }
+                    force_index[k] = Some(model.forces.len());
                     model.forces.push(Force::BodyLoad {
                         body: b,
                         force,
@@ -571,14 +584,74 @@ impl SceneSpec {
                 }
             }
         }
+        let mut params = Vec::new();
+        for (k, name) in self.sensitivities.iter().enumerate() {
+            let key = format!("sensitivities[{k}]");
+            let p = parse_param(&model, &self.forces, &force_index, name).ok_or_else(|| {
+                Error::input(
+                    &key,
+                    name,
+                    "<body>.mass, forces[i].stiffness, forces[i].damping or \
+                         forces[i].segments[k].anchor of a force the effects list builds",
+                )
+            })?;
+            if params.iter().any(|(_, q)| *q == p) {
+                return Err(Error::input(key, name, "each parameter once"));
+            }
+            params.push((name.clone(), p));
+        }
         Ok(Scene {
             model,
             options,
             outputs,
             plot: self.outputs.plot.clone(),
             effects: self.effects.clone(),
+            params,
         })
     }
+}
+
+/// A sensitivity parameter name → [`Param`], if it names an existing,
+/// built model value.
+/// Segment indices are those of the scene file; the model's law is sorted
+/// by `lower`, so they are translated through the segment bounds.
+fn parse_param(
+    model: &Model,
+    forces: &[ForceSpec],
+    force_index: &[Option<usize>],
+    name: &str,
+) -> Option<Param> {
+    if let Some(body) = name.strip_suffix(".mass") {
+        return model.body(body).map(Param::Mass);
+    }
+    let rest = name.strip_prefix("forces[")?;
+    let (idx, rest) = rest.split_once(']')?;
+    let k_spec = idx.parse::<usize>().ok()?;
+    let fi = (*force_index.get(k_spec)?)?;
+    let p = match rest {
+        ".stiffness" => Param::Stiffness(fi),
+        ".damping" => Param::Damping(fi),
+        _ => {
+            let seg: usize = rest
+                .strip_prefix(".segments[")?
+                .strip_suffix("].anchor")?
+                .parse()
+                .ok()?;
+            let ForceSpec::Actuator { segments, .. } = forces.get(k_spec)? else {
+                return None;
+            };
+            let spec = segments.get(seg)?;
+            let Force::Rotational { law: Some(law), .. } = &model.forces[fi] else {
+                return None;
+            };
+            let sorted = law
+                .segments
+                .iter()
+                .position(|s| s.lower == spec.lower && s.upper == spec.upper)?;
+            Param::Anchor(fi, sorted)
+        }
+    };
+    p.value(model).map(|_| p)
 }
 
 fn parse_quantity(model: &Model, key: &str, q: &str) -> Result<Quantity> {

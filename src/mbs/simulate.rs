@@ -6,8 +6,10 @@ use super::analysis::Projection;
 use super::dynamics::{System, Workspace};
 use super::scene::{Quantity, Scene, SceneSpec};
 use crate::error::{Error, Result};
-use crate::integrate::{integrate, Stats};
+use crate::integrate::{integrate, integrate_sens, Stats};
+use crate::mbs::Param;
 use crate::study::Study;
+use num_dual::Dual64;
 use std::path::{Path, PathBuf};
 
 /// Everything a simulation produced.
@@ -27,6 +29,11 @@ pub struct Simulation {
     /// Redundant equations (equations − rank) at the start.
     pub redundant: usize,
     pub equations: usize,
+    /// Headers of the output sensitivities (`t` first); only `t` when the
+    /// scene asks for none.
+    pub sens_headers: Vec<String>,
+    /// One row per output time: `[t, ∂outputs/∂p_1.., ∂outputs/∂p_2..]`.
+    pub sens_rows: Vec<Vec<f64>>,
 }
 
 /// Read the `[scene]` section of a study and build it.
@@ -55,7 +62,38 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         .outputs
         .iter()
         .any(|(_, q)| matches!(q, Quantity::Reaction(_)));
-    let stats = integrate(&sys, &y0, &scene.options, |t, y| {
+    let sens_quantities: Vec<(String, Quantity)> = scene
+        .outputs
+        .iter()
+        .filter(|(_, q)| {
+            matches!(
+                q,
+                Quantity::Angle(_) | Quantity::Rate(_) | Quantity::Position(_)
+            )
+        })
+        .cloned()
+        .collect();
+    let mut sens_headers = vec!["t [s]".to_string()];
+    for (pname, _) in &scene.params {
+        for (label, q) in &sens_quantities {
+            for h in q.headers(label) {
+                let (name, unit) = h.split_once(" [").unwrap_or((h.as_str(), "-]"));
+                let unit = unit.trim_end_matches(']');
+                sens_headers.push(format!("d({name})/d({pname}) [{unit} per SI unit of p]"));
+            }
+        }
+    }
+    let mut sens_rows = Vec::new();
+    let n = y0.len();
+    let mut observe = |t: f64, y: &[f64], s: &[f64]| {
+        if !scene.params.is_empty() {
+            let mut row = vec![t];
+            for i in 0..scene.params.len() {
+                let lane = &s[i * n..(i + 1) * n];
+                row.extend(output_sensitivities(&sys, &sens_quantities, y, lane));
+            }
+            sens_rows.push(row);
+        }
         // The reactions' solve assembles the constraint rows at (t, y):
         // the violation is read from them instead of a second assembly.
         let reactions = wants_reactions.then(|| sys.reactions(t, y, &mut ws));
@@ -102,7 +140,13 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         rows.push(row);
         y_end.copy_from_slice(y);
         Ok(())
-    })?;
+    };
+    let stats = if scene.params.is_empty() {
+        integrate(&sys, &y0, &scene.options, |t, y| observe(t, y, &[]))?
+    } else {
+        let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
+        integrate_sens(&sys, &y0, &scene.options, &params, &mut observe)?
+    };
     let sim = Simulation {
         headers,
         rows,
@@ -113,8 +157,37 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         stats,
         max_violation,
         energy_error: conservative.then_some(energy_error),
+        sens_headers,
+        sens_rows,
     };
     Ok((sys, sim))
+}
+
+/// Exact derivatives of the angle, rate and position outputs along the
+/// state sensitivity `s = ∂y/∂p`: one dual-number evaluation of each output
+/// at `y + ε s`.
+fn output_sensitivities(
+    sys: &System,
+    quantities: &[(String, Quantity)],
+    y: &[f64],
+    s: &[f64],
+) -> Vec<f64> {
+    let yd: Vec<Dual64> = y.iter().zip(s).map(|(&a, &b)| Dual64::new(a, b)).collect();
+    let mut kin = Vec::new();
+    sys.body_kin(&yd, &mut kin);
+    let mut out = Vec::new();
+    for (_, q) in quantities {
+        match q {
+            Quantity::Angle(j) => out.push(sys.joint_angle(&kin, *j).0.eps),
+            Quantity::Rate(j) => out.push(sys.joint_angle(&kin, *j).1.eps),
+            Quantity::Position(b) => match sys.slot[*b] {
+                Some(k) => out.extend_from_slice(&s[7 * k..7 * k + 3]),
+                None => out.extend([0.0; 3]),
+            },
+            _ => {}
+        }
+    }
+    out
 }
 
 /// Write `history.csv`, `stats.csv` and (if asked) `<output>.svg` into `dir`.
@@ -171,6 +244,18 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
     }
     w.flush().map_err(|e| Error::io(&stats_path, e))?;
     let mut written = vec![hist, stats_path];
+    if !sim.sens_rows.is_empty() {
+        let path = dir.join("sensitivities.csv");
+        let mut w = csv::Writer::from_path(&path).map_err(|e| Error::csv(&path, e))?;
+        w.write_record(&sim.sens_headers)
+            .map_err(|e| Error::csv(&path, e))?;
+        for row in &sim.sens_rows {
+            w.write_record(row.iter().map(|v| format!("{v:.12e}")))
+                .map_err(|e| Error::csv(&path, e))?;
+        }
+        w.flush().map_err(|e| Error::io(&path, e))?;
+        written.push(path);
+    }
     if let Some(name) = &scene.plot {
         let col = sim
             .headers
