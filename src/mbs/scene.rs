@@ -5,6 +5,7 @@
 //! effects = ["gravity", "actuators", "damping"]   # what is not listed is not built
 //! gravity = [0.0, 0.0, -9.81]                       # m/s²
 //! baumgarte = 10.0                                  # 1/s
+//! sensitivities = ["forces[0].damping", "forces[0].segments[0].anchor", "B3.mass"]
 //! [[scene.bodies]]
 //! name = "B2"; mass = 8.3; com = [1.3, 0.0, -1.0]   # kg, m (global, initial)
 //! inertia = [[..], [..], [..]]                      # kg·m², about com, global axes
@@ -21,7 +22,6 @@
 //! type = "spring"; marker_i, marker_j, stiffness, damping, length
 //! type = "load"; body, force, torque
 //! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out
-//! sensitivities = ["forces[0].damping", "forces[0].segments[0].anchor", "B3.mass"]
 //! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation"]
 //!                  plot = "R3.angle"
 //! ```
