@@ -51,6 +51,13 @@ pub enum Command {
         #[command(flatten)]
         common: Common,
     },
+    /// Simulate the multibody scene of a study (its `[scene]` section).
+    Simulate {
+        /// Study file (TOML) with a `[scene]` section.
+        study: PathBuf,
+        #[command(flatten)]
+        common: Common,
+    },
     /// Local optimizer from many start points; runs.csv, optima.csv.
     Multistart {
         /// Study file (TOML) with the sections `problem` and `multistart`.
@@ -162,6 +169,10 @@ pub fn execute(cli: Cli) -> Result<()> {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
             run_modes_handler(&cfg)
         }
+        Command::Simulate { study, common } => {
+            let cfg = RunConfig::resolve(Some(&study), &common)?;
+            run_scene(&cfg)
+        }
         Command::Multistart {
             study,
             common,
@@ -242,6 +253,7 @@ type Handler = fn(&RunConfig) -> Result<()>;
 fn handlers() -> Vec<(&'static str, Handler)> {
     vec![
         ("modes", run_modes_handler),
+        ("scene", run_scene),
         ("multistart", run_multistart_handler),
         ("evolve", run_evolve_handler),
         ("compare", run_compare_handler),
@@ -253,6 +265,23 @@ fn handlers() -> Vec<(&'static str, Handler)> {
 /// The `[modes]` section: panel modal analysis.
 fn run_modes_handler(cfg: &RunConfig) -> Result<()> {
     crate::panels::run_modes(&cfg.study, &cfg.out, cfg.quiet)
+}
+
+/// The `[scene]` handler: simulate the multibody scene and write
+/// `history.csv`, `stats.csv` (and an SVG) into the study's output folder.
+pub fn run_scene(cfg: &RunConfig) -> Result<()> {
+    use crate::mbs::simulate;
+    let scene = simulate::load_scene(&cfg.study)?;
+    let (_, sim) = simulate::simulate(&scene).map_err(cfg.study.locate("scene"))?;
+    let dir = cfg.study.output_dir(&cfg.out)?;
+    let files = simulate::write_results(&scene, &sim, &dir)?;
+    if !cfg.quiet {
+        println!("{}", simulate::summary(&sim));
+        for f in files {
+            println!("wrote {}", f.display());
+        }
+    }
+    Ok(())
 }
 
 /// `plyscape run`: do every kind of work the study has a section for.

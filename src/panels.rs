@@ -190,7 +190,11 @@ impl PanelAnalysis {
 
     /// Modes (and derivatives) for `laminate` (same ply count as the
     /// panel's; ply angles may differ).
-    pub fn run(&mut self, laminate: &crate::laminate::Laminate, n_modes: usize) -> Result<PanelModes> {
+    pub fn run(
+        &mut self,
+        laminate: &crate::laminate::Laminate,
+        n_modes: usize,
+    ) -> Result<PanelModes> {
         let t0 = Instant::now();
         self.model
             .assemble_into(laminate, &self.panel.design, &mut self.sys)?;
@@ -269,8 +273,11 @@ fn mirror_map(nodes: &[[f64; 2]], s: [f64; 2]) -> Option<Vec<usize>> {
         .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
     let h = 1e-9 * size.max(f64::MIN_POSITIVE);
     let key = |p: [f64; 2]| ((p[0] / h).round() as i64, (p[1] / h).round() as i64);
-    let index: HashMap<(i64, i64), usize> =
-        nodes.iter().enumerate().map(|(i, &p)| (key(p), i)).collect();
+    let index: HashMap<(i64, i64), usize> = nodes
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| (key(p), i))
+        .collect();
     nodes
         .iter()
         .map(|&p| {
@@ -390,7 +397,10 @@ pub fn analyse_study(study: &Study, spec: &ModesSpec) -> Result<Vec<PanelModes>>
     for (i, p) in panels.iter().enumerate() {
         // Same mesh, lay-up, design map and support: reuse (compute once).
         let twin = panels[..i].iter().position(|q| {
-            q.mesh == p.mesh && q.laminate == p.laminate && q.support == p.support && q.design == p.design
+            q.mesh == p.mesh
+                && q.laminate == p.laminate
+                && q.support == p.support
+                && q.design == p.design
         });
         let r = match twin {
             Some(k) => {
@@ -399,9 +409,8 @@ pub fn analyse_study(study: &Study, spec: &ModesSpec) -> Result<Vec<PanelModes>>
                 r.seconds = [0.0; 3];
                 r
             }
-            None => analyse_panel(p, spec.n_modes, want).map_err(|e| {
-                in_panel(e, &p.name).in_file(&study.path, &format!("panels[{i}]"))
-            })?,
+            None => analyse_panel(p, spec.n_modes, want)
+                .map_err(|e| in_panel(e, &p.name).in_file(&study.path, &format!("panels[{i}]")))?,
         };
         out.push(r);
     }
@@ -449,7 +458,13 @@ pub fn write_results(dir: &Path, results: &[PanelModes], spec: &ModesSpec) -> Re
         &mut w,
         &path,
         [
-            "panel", "layup", "mode", "frequency_hz", "reference_hz", "residual", "kind",
+            "panel",
+            "layup",
+            "mode",
+            "frequency_hz",
+            "reference_hz",
+            "residual",
+            "kind",
             "symmetry",
         ],
     )?;
@@ -570,7 +585,11 @@ pub fn print_table(results: &[PanelModes], spec: &ModesSpec) {
         let reference = spec.reference_hz.get(&r.panel);
         println!(
             "  mode  f [Hz]     {}kind      symmetry",
-            if reference.is_some() { "ref [Hz]  ratio  " } else { "" }
+            if reference.is_some() {
+                "ref [Hz]  ratio  "
+            } else {
+                ""
+            }
         );
         for (j, f) in r.modes.frequencies_hz().iter().enumerate() {
             let refcol = match reference.and_then(|v| v.get(j)) {
@@ -624,7 +643,11 @@ fn first_with(r: &PanelModes, symmetry: &str) -> Option<f64> {
 }
 
 /// The convergence-and-cost table for one panel over mesh densities.
-pub fn convergence(study: &Study, spec: &ConvergenceSpec, n_modes: usize) -> Result<Vec<ConvergenceRow>> {
+pub fn convergence(
+    study: &Study,
+    spec: &ConvergenceSpec,
+    n_modes: usize,
+) -> Result<Vec<ConvergenceRow>> {
     let specs: Vec<crate::fe::PanelSpec> = study.section("panels")?.unwrap_or_default();
     let Some(i) = specs.iter().position(|p| p.name == spec.panel) else {
         return Err(study.error(
@@ -647,9 +670,7 @@ pub fn convergence(study: &Study, spec: &ConvergenceSpec, n_modes: usize) -> Res
     for &d in &spec.divisions {
         let mut s = specs[i].clone();
         s.divisions = d;
-        let panel = s
-            .resolve()
-            .map_err(study.locate(&format!("panels[{i}]")))?;
+        let panel = s.resolve().map_err(study.locate(&format!("panels[{i}]")))?;
         let mut plain_a = PanelAnalysis::new(&panel, None)?;
         let mut full_a = PanelAnalysis::new(&panel, Some(ModeUpdate::Updated))?;
         let mut plain = Vec::new();
@@ -748,7 +769,10 @@ pub fn run_modes(study: &Study, out_root: &Path, quiet: bool) -> Result<()> {
         let rows = convergence(study, &conv, spec.n_modes)?;
         files.push(write_convergence(&dir, &rows)?);
         if !quiet {
-            println!("mesh convergence of {} (median of {} runs):", conv.panel, conv.repeats);
+            println!(
+                "mesh convergence of {} (median of {} runs):",
+                conv.panel, conv.repeats
+            );
             println!("  div   DOF     f_SS [Hz]  f_AA [Hz]  modes [ms]  +derivs [ms]");
             for r in &rows {
                 println!(

@@ -1,0 +1,722 @@
+//! Scenes from TOML: the `[scene]` section of a study file.
+//!
+//! ```toml
+//! [scene]
+//! effects = ["gravity", "actuators", "damping"]   # what is not listed is not built
+//! gravity = [0.0, 0.0, -9.81]                       # m/s²
+//! baumgarte = 10.0                                  # 1/s
+//! sensitivities = ["forces[0].damping", "forces[0].segments[0].anchor", "B3.mass"]
+//! [[scene.bodies]]
+//! name = "B2"; mass = 8.3; com = [1.3, 0.0, -1.0]   # kg, m (global, initial)
+//! inertia = [[..], [..], [..]]                      # kg·m², about com, global axes
+//! fixed = false; velocity = [..]; angular_velocity = [..]   # m/s, rad/s (global)
+//! [[scene.joints]]
+//! name = "R3"; type = "revolute"   # spherical | revolute | locked | driven | fixed
+//! body_i = "B12"; body_j = "B8"    # "ground" allowed
+//! point = [..]; axis = [..]; angle = 3.12   # global initial point, axis, θ0 (rad)
+//! drive = [c0, c1, ..]             # driven: θ(t) = Σ c_k t^k
+//! [[scene.markers]]  name, body, point       # extra points for springs
+//! [[scene.forces]]
+//! type = "actuator"; joint = "R3"; damping = 0.5
+//! segments = [{ lower, upper, value, slope, anchor }, ..]  # Eq. 32
+//! type = "spring"; marker_i, marker_j, stiffness, damping, length
+//! type = "load"; body, force, torque
+//! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out
+//! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation"]
+//!                  plot = "R3.angle"
+//! ```
+//! Bodies start with their axes along the global axes, so `inertia` is
+//! both the global and the body-frame tensor at `t = 0`.
+
+use super::model::{
+    axis_angle, frame_from_axis, Body, Drive, Force, Joint, JointKind, Marker, Model, Param,
+    PiecewiseLaw, Segment,
+};
+use crate::error::{Error, Result};
+use crate::integrate::{Method, Options};
+use nalgebra::{Matrix3, Vector3};
+use serde::Deserialize;
+
+/// Effects a scene may list.
+pub const EFFECTS: [&str; 5] = ["gravity", "actuators", "damping", "springs", "loads"];
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    pub effects: Vec<String>,
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 3],
+    #[serde(default = "default_baumgarte")]
+    pub baumgarte: f64,
+    pub bodies: Vec<BodySpec>,
+    #[serde(default)]
+    pub joints: Vec<JointSpec>,
+    #[serde(default)]
+    pub markers: Vec<MarkerSpec>,
+    #[serde(default)]
+    pub forces: Vec<ForceSpec>,
+    pub integrator: IntegratorSpec,
+    #[serde(default)]
+    pub outputs: OutputSpec,
+    /// Parameters for forward sensitivities of the outputs:
+    /// `"<body>.mass"`, `"forces[i].stiffness"`, `"forces[i].damping"`,
+    /// `"forces[i].segments[k].anchor"` (indices as in `scene.forces`).
+    #[serde(default)]
+    pub sensitivities: Vec<String>,
+}
+
+fn default_gravity() -> [f64; 3] {
+    [0.0, 0.0, -9.81]
+}
+/// Baumgarte rate default: 10 1/s damps drift within ~0.5 s, slower than
+/// the mechanisms' dynamics of interest yet far from making them stiff.
+fn default_baumgarte() -> f64 {
+    10.0
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    pub name: String,
+    pub mass: f64,
+    pub com: [f64; 3],
+    pub inertia: [[f64; 3]; 3],
+    #[serde(default)]
+    pub fixed: bool,
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(default)]
+    pub angular_velocity: [f64; 3],
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub body_i: String,
+    pub body_j: String,
+    pub point: [f64; 3],
+    pub axis: Option<[f64; 3]>,
+    #[serde(default)]
+    pub angle: f64,
+    pub drive: Option<Vec<f64>>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MarkerSpec {
+    pub name: String,
+    pub body: String,
+    pub point: [f64; 3],
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SegmentSpec {
+    pub lower: f64,
+    pub upper: f64,
+    pub value: f64,
+    #[serde(default)]
+    pub slope: f64,
+    #[serde(default)]
+    pub anchor: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, tag = "type", rename_all = "lowercase")]
+pub enum ForceSpec {
+    Actuator {
+        joint: String,
+        #[serde(default)]
+        damping: f64,
+        #[serde(default)]
+        segments: Vec<SegmentSpec>,
+    },
+    Spring {
+        marker_i: String,
+        marker_j: String,
+        stiffness: f64,
+        #[serde(default)]
+        damping: f64,
+        length: Option<f64>,
+    },
+    Load {
+        body: String,
+        #[serde(default)]
+        force: [f64; 3],
+        #[serde(default)]
+        torque: [f64; 3],
+    },
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSpec {
+    #[serde(default = "default_method")]
+    pub method: Method,
+    #[serde(default = "default_rtol")]
+    pub rtol: f64,
+    #[serde(default = "default_atol")]
+    pub atol: f64,
+    pub t_end: f64,
+    pub dt_out: f64,
+}
+fn default_method() -> Method {
+    Method::Bdf
+}
+fn default_rtol() -> f64 {
+    1e-6
+}
+fn default_atol() -> f64 {
+    1e-8
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    #[serde(default)]
+    pub quantities: Vec<String>,
+    pub plot: Option<String>,
+}
+
+/// One output column.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Quantity {
+    Angle(usize),
+    Rate(usize),
+    /// Reaction force (3) and torque (3) of a joint.
+    Reaction(usize),
+    /// Global position of a body's centre of mass.
+    Position(usize),
+    Energy,
+    Violation,
+}
+
+/// A built scene: the system model, integrator options and outputs.
+#[derive(Debug)]
+pub struct Scene {
+    pub model: Model,
+    pub options: Options,
+    pub outputs: Vec<(String, Quantity)>,
+    pub plot: Option<String>,
+    pub effects: Vec<String>,
+    /// Sensitivity parameters with their names from the scene file.
+    pub params: Vec<(String, Param)>,
+}
+
+impl Quantity {
+    /// CSV column headers with SI units.
+    pub fn headers(&self, label: &str) -> Vec<String> {
+        match self {
+            Quantity::Angle(_) => vec![format!("{label} [rad]")],
+            Quantity::Rate(_) => vec![format!("{label} [rad/s]")],
+            Quantity::Reaction(_) => {
+                let base = label.trim_end_matches(".reaction");
+                let mut h: Vec<String> = ["x", "y", "z"]
+                    .iter()
+                    .map(|c| format!("{base}.force_{c} [N]"))
+                    .collect();
+                h.extend(
+                    ["x", "y", "z"]
+                        .iter()
+                        .map(|c| format!("{base}.torque_{c} [N*m]")),
+                );
+                h
+            }
+            Quantity::Position(_) => ["x", "y", "z"]
+                .iter()
+                .map(|c| format!("{label}_{c} [m]"))
+                .collect(),
+            Quantity::Energy => vec!["energy [J]".into()],
+            Quantity::Violation => vec!["violation [m|rad]".into()],
+        }
+    }
+}
+
+fn vec3(a: [f64; 3]) -> Vector3<f64> {
+    Vector3::new(a[0], a[1], a[2])
+}
+
+fn finite3(key: String, a: [f64; 3]) -> Result<Vector3<f64>> {
+    if a.iter().all(|v| v.is_finite()) {
+        Ok(vec3(a))
+    } else {
+        Err(Error::input(key, format!("{a:?}"), "finite components"))
+    }
+}
+
+impl SceneSpec {
+    /// Build the model. Errors name the key below `scene` (e.g.
+    /// `joints[2].body_i`); callers attach the file with `Error::in_file`.
+    pub fn build(&self) -> Result<Scene> {
+        for (k, e) in self.effects.iter().enumerate() {
+            if !EFFECTS.contains(&e.as_str()) {
+                return Err(Error::input(
+                    format!("effects[{k}]"),
+                    e,
+                    format!("one of {}", EFFECTS.join(", ")),
+                ));
+            }
+        }
+        let has = |e: &str| self.effects.iter().any(|x| x == e);
+        if !(self.baumgarte >= 0.0 && self.baumgarte.is_finite()) {
+            return Err(Error::input(
+                "baumgarte",
+                self.baumgarte,
+                "a finite rate ≥ 0 (1/s)",
+            ));
+        }
+        let mut model = Model {
+            baumgarte: self.baumgarte,
+            ..Model::default()
+        };
+        for (k, b) in self.bodies.iter().enumerate() {
+            let key = format!("bodies[{k}]");
+            if model.body(&b.name).is_some() || b.name == "ground" {
+                return Err(Error::input(
+                    format!("{key}.name"),
+                    &b.name,
+                    "a unique body name other than 'ground'",
+                ));
+            }
+            let inertia = Matrix3::from_fn(|r, c| b.inertia[r][c]);
+            let com = finite3(format!("{key}.com"), b.com)?;
+            let mut body = Body::new(&key, &b.name, b.mass, inertia, (com, [1.0, 0.0, 0.0, 0.0]))?;
+            body.fixed = b.fixed;
+            body.v0 = finite3(format!("{key}.velocity"), b.velocity)?;
+            body.w0 = finite3(format!("{key}.angular_velocity"), b.angular_velocity)?;
+            model.bodies.push(body);
+        }
+        let find_body = |key: String, name: &str, model: &Model| -> Result<Option<usize>> {
+            if name == "ground" {
+                return Ok(None);
+            }
+            model.body(name).map(Some).ok_or_else(|| {
+                Error::input(
+                    key,
+                    name,
+                    "the name of a body in scene.bodies, or \"ground\"",
+                )
+            })
+        };
+        for (k, m) in self.markers.iter().enumerate() {
+            let key = format!("markers[{k}]");
+            let body = find_body(format!("{key}.body"), &m.body, &model)?;
+            let p = finite3(format!("{key}.point"), m.point)?;
+            model
+                .markers
+                .push(make_marker(&model, &m.name, body, p, Matrix3::identity()));
+        }
+        for (k, j) in self.joints.iter().enumerate() {
+            let key = format!("joints[{k}]");
+            let bi = find_body(format!("{key}.body_i"), &j.body_i, &model)?;
+            let bj = find_body(format!("{key}.body_j"), &j.body_j, &model)?;
+            if bi == bj {
+                return Err(Error::input(
+                    format!("{key}.body_j"),
+                    &j.body_j,
+                    "a body other than body_i",
+                ));
+            }
+            let point = finite3(format!("{key}.point"), j.point)?;
+            let kind = match j.kind.as_str() {
+                "spherical" => JointKind::Spherical,
+                "revolute" => JointKind::Revolute,
+                "fixed" => JointKind::Fixed,
+                "locked" => JointKind::Driven(Drive {
+                    coefficients: vec![j.angle],
+                }),
+                "driven" => match &j.drive {
+                    Some(c) if !c.is_empty() && c.iter().all(|v| v.is_finite()) => {
+                        JointKind::Driven(Drive {
+                            coefficients: c.clone(),
+                        })
+                    }
+                    other => {
+                        return Err(Error::input(
+                            format!("{key}.drive"),
+                            format!("{other:?}"),
+                            "polynomial coefficients [c0, c1, ..] of θ(t) (rad, s)",
+                        ))
+                    }
+                },
+                other => {
+                    return Err(Error::input(
+                        format!("{key}.type"),
+                        other,
+                        "spherical, revolute, locked, driven or fixed",
+                    ))
+                }
+            };
+            let axis = match (&kind, j.axis) {
+                (JointKind::Spherical, _) => Vector3::z(),
+                (_, Some(a)) => {
+                    let a = finite3(format!("{key}.axis"), a)?;
+                    if a.norm() < 1e-12 {
+                        return Err(Error::input(
+                            format!("{key}.axis"),
+                            format!("{:?}", j.axis.unwrap_or_default()),
+                            "a non-zero axis vector",
+                        ));
+                    }
+                    a
+                }
+                (_, None) => {
+                    return Err(Error::input(
+                        format!("{key}.axis"),
+                        "(missing)",
+                        "an axis vector for this joint type",
+                    ))
+                }
+            };
+            if !j.angle.is_finite() || j.angle.abs() >= std::f64::consts::PI {
+                return Err(Error::input(
+                    format!("{key}.angle"),
+                    j.angle,
+                    "an initial angle in (−π, π) rad",
+                ));
+            }
+            let fi = frame_from_axis(&axis);
+            let fj = axis_angle(&axis.normalize(), j.angle) * fi;
+            let n = model.markers.len();
+            let mi = make_marker(&model, &format!("{}.i", j.name), bi, point, fi);
+            let mj = make_marker(&model, &format!("{}.j", j.name), bj, point, fj);
+            model.markers.push(mi);
+            model.markers.push(mj);
+            if model.joint(&j.name).is_some() {
+                return Err(Error::input(
+                    format!("{key}.name"),
+                    &j.name,
+                    "a unique joint name",
+                ));
+            }
+            model.joints.push(Joint {
+                name: j.name.clone(),
+                kind,
+                i: n,
+                j: n + 1,
+            });
+        }
+        if has("gravity") {
+            model.forces.push(Force::Gravity {
+                g: finite3("gravity".into(), self.gravity)?,
+            });
+        }
+        // Model index of each scene force (None: not built).
+        let mut force_index: Vec<Option<usize>> = vec![None; self.forces.len()];
+        for (k, f) in self.forces.iter().enumerate() {
+            let key = format!("forces[{k}]");
+            match f {
+                ForceSpec::Actuator {
+                    joint,
+                    damping,
+                    segments,
+                } => {
+                    let jt = model.joint(joint).ok_or_else(|| {
+                        Error::input(
+                            format!("{key}.joint"),
+                            joint,
+                            "the name of a joint in scene.joints",
+                        )
+                    })?;
+                    if !model.joints[jt].kind.has_angle()
+                        || matches!(model.joints[jt].kind, JointKind::Driven(_))
+                    {
+                        return Err(Error::input(
+                            format!("{key}.joint"),
+                            joint,
+                            "a free revolute joint",
+                        ));
+                    }
+                    if !(damping.is_finite() && *damping >= 0.0) {
+                        return Err(Error::input(
+                            format!("{key}.damping"),
+                            damping,
+                            "a finite damping ≥ 0 (N·m·s)",
+                        ));
+                    }
+                    let law = if has("actuators") && !segments.is_empty() {
+                        let segs = segments
+                            .iter()
+                            .map(|s| Segment {
+                                lower: s.lower,
+                                upper: s.upper,
+                                value: s.value,
+                                slope: s.slope,
+                                anchor: s.anchor,
+                            })
+                            .collect();
+                        Some(PiecewiseLaw::new(&format!("{key}.segments"), segs)?)
+                    } else {
+                        None
+                    };
+                    let c = if has("damping") { *damping } else { 0.0 };
+                    if law.is_some() || c != 0.0 {
+                        force_index[k] = Some(model.forces.len());
+                        model.forces.push(Force::Rotational {
+                            joint: jt,
+                            law,
+                            damping: c,
+                        });
+                    }
+                }
+                ForceSpec::Spring {
+                    marker_i,
+                    marker_j,
+                    stiffness,
+                    damping,
+                    length,
+                } => {
+                    let find = |key: String, name: &str| {
+                        model.marker(name).ok_or_else(|| {
+                            Error::input(key, name, "the name of a marker in scene.markers")
+                        })
+                    };
+                    let i = find(format!("{key}.marker_i"), marker_i)?;
+                    let j = find(format!("{key}.marker_j"), marker_j)?;
+                    let l0 = initial_distance(&model, i, j);
+                    let length = length.unwrap_or(l0);
+                    for (name, v) in [
+                        ("stiffness", *stiffness),
+                        ("damping", *damping),
+                        ("length", length),
+                    ] {
+                        if !(v.is_finite() && v >= 0.0) {
+                            return Err(Error::input(
+                                format!("{key}.{name}"),
+                                v,
+                                "a finite value ≥ 0",
+                            ));
+                        }
+                    }
+                    if l0 < 1e-9 {
+                        return Err(Error::input(
+                            format!("{key}.marker_j"),
+                            marker_j,
+                            "a point distinct from marker_i",
+                        ));
+                    }
+                    if !has("springs") {
+                        continue;
+                    }
+                    let c = if has("damping") { *damping } else { 0.0 };
+                    force_index[k] = Some(model.forces.len());
+                    model.forces.push(Force::SpringDamper {
+                        i,
+                        j,
+                        stiffness: *stiffness,
+                        damping: c,
+                        length,
+                    });
+                }
+                ForceSpec::Load {
+                    body,
+                    force,
+                    torque,
+                } => {
+                    let b = find_body(format!("{key}.body"), body, &model)?.ok_or_else(|| {
+                        Error::input(format!("{key}.body"), body, "a body (not ground)")
+                    })?;
+                    let force = finite3(format!("{key}.force"), *force)?;
+                    let torque = finite3(format!("{key}.torque"), *torque)?;
+                    if !has("loads") {
+                        continue;
+                    }
+                    force_index[k] = Some(model.forces.len());
+                    model.forces.push(Force::BodyLoad {
+                        body: b,
+                        force,
+                        torque,
+                    });
+                }
+            }
+        }
+        let it = &self.integrator;
+        if !(it.dt_out > 0.0 && it.dt_out.is_finite()) {
+            return Err(Error::input(
+                "integrator.dt_out",
+                it.dt_out,
+                "an output interval > 0 (s)",
+            ));
+        }
+        if !(it.t_end > 0.0 && it.t_end.is_finite()) || it.t_end / it.dt_out > 1e7 {
+            return Err(Error::input(
+                "integrator.t_end",
+                it.t_end,
+                "an end time > 0 (s) with at most 1e7 output intervals",
+            ));
+        }
+        let nout = (it.t_end / it.dt_out).round().max(1.0) as usize;
+        let mut times: Vec<f64> = (0..=nout)
+            .map(|k| (k as f64 * it.dt_out).min(it.t_end))
+            .collect();
+        times.dedup();
+        if *times.last().unwrap_or(&0.0) < it.t_end {
+            times.push(it.t_end);
+        }
+        let options = Options {
+            method: it.method,
+            rtol: it.rtol,
+            atol: it.atol,
+            t0: 0.0,
+            times,
+        };
+        options.validate()?;
+        let mut outputs = Vec::new();
+        for (k, q) in self.outputs.quantities.iter().enumerate() {
+            outputs.push((
+                q.clone(),
+                parse_quantity(&model, &format!("outputs.quantities[{k}]"), q)?,
+            ));
+        }
+        if let Some(p) = &self.outputs.plot {
+            match parse_quantity(&model, "outputs.plot", p)? {
+                Quantity::Angle(_) | Quantity::Rate(_) | Quantity::Energy | Quantity::Violation => {
+                }
+                _ => {
+                    return Err(Error::input(
+                        "outputs.plot",
+                        p,
+                        "a scalar output (angle, rate, energy, violation)",
+                    ))
+                }
+            }
+        }
+        let mut params = Vec::new();
+        for (k, name) in self.sensitivities.iter().enumerate() {
+            let key = format!("sensitivities[{k}]");
+            let p = parse_param(&model, &self.forces, &force_index, name).ok_or_else(|| {
+                Error::input(
+                    &key,
+                    name,
+                    "<body>.mass, forces[i].stiffness, forces[i].damping or \
+                         forces[i].segments[k].anchor of a force the effects list builds",
+                )
+            })?;
+            if params.iter().any(|(_, q)| *q == p) {
+                return Err(Error::input(key, name, "each parameter once"));
+            }
+            params.push((name.clone(), p));
+        }
+        Ok(Scene {
+            model,
+            options,
+            outputs,
+            plot: self.outputs.plot.clone(),
+            effects: self.effects.clone(),
+            params,
+        })
+    }
+}
+
+/// A sensitivity parameter name → [`Param`], if it names an existing,
+/// built model value.
+/// Segment indices are those of the scene file; the model's law is sorted
+/// by `lower`, so they are translated through the segment bounds.
+fn parse_param(
+    model: &Model,
+    forces: &[ForceSpec],
+    force_index: &[Option<usize>],
+    name: &str,
+) -> Option<Param> {
+    if let Some(body) = name.strip_suffix(".mass") {
+        return model.body(body).map(Param::Mass);
+    }
+    let rest = name.strip_prefix("forces[")?;
+    let (idx, rest) = rest.split_once(']')?;
+    let k_spec = idx.parse::<usize>().ok()?;
+    let fi = (*force_index.get(k_spec)?)?;
+    let p = match rest {
+        ".stiffness" => Param::Stiffness(fi),
+        ".damping" => Param::Damping(fi),
+        _ => {
+            let seg: usize = rest
+                .strip_prefix(".segments[")?
+                .strip_suffix("].anchor")?
+                .parse()
+                .ok()?;
+            let ForceSpec::Actuator { segments, .. } = forces.get(k_spec)? else {
+                return None;
+            };
+            let spec = segments.get(seg)?;
+            let Force::Rotational { law: Some(law), .. } = &model.forces[fi] else {
+                return None;
+            };
+            let sorted = law
+                .segments
+                .iter()
+                .position(|s| s.lower == spec.lower && s.upper == spec.upper)?;
+            Param::Anchor(fi, sorted)
+        }
+    };
+    p.value(model).map(|_| p)
+}
+
+fn parse_quantity(model: &Model, key: &str, q: &str) -> Result<Quantity> {
+    match q {
+        "energy" => return Ok(Quantity::Energy),
+        "violation" => return Ok(Quantity::Violation),
+        _ => {}
+    }
+    let bad = || {
+        Error::input(
+            key,
+            q,
+            "energy, violation, <joint>.angle|rate|reaction or <body>.position",
+        )
+    };
+    let (name, what) = q.rsplit_once('.').ok_or_else(bad)?;
+    match what {
+        "angle" | "rate" | "reaction" => {
+            let j = model.joint(name).ok_or_else(bad)?;
+            if what != "reaction" && !model.joints[j].kind.has_angle() {
+                return Err(Error::input(
+                    key,
+                    q,
+                    "an angle or rate of a revolute, locked or driven joint",
+                ));
+            }
+            Ok(match what {
+                "angle" => Quantity::Angle(j),
+                "rate" => Quantity::Rate(j),
+                _ => Quantity::Reaction(j),
+            })
+        }
+        "position" => {
+            let b = model.body(name).ok_or_else(bad)?;
+            Ok(Quantity::Position(b))
+        }
+        _ => Err(bad()),
+    }
+}
+
+/// A marker at the global point `p` with global frame `frame`, expressed in
+/// the body's initial frame (bodies start aligned with the global axes).
+fn make_marker(
+    model: &Model,
+    name: &str,
+    body: Option<usize>,
+    p: Vector3<f64>,
+    frame: Matrix3<f64>,
+) -> Marker {
+    let pos = match body {
+        Some(b) => p - model.bodies[b].r0,
+        None => p,
+    };
+    Marker {
+        name: name.to_string(),
+        body,
+        pos,
+        frame,
+    }
+}
+
+fn initial_distance(model: &Model, i: usize, j: usize) -> f64 {
+    let g = |m: &Marker| match m.body {
+        Some(b) => model.bodies[b].r0 + m.pos,
+        None => m.pos,
+    };
+    (g(&model.markers[j]) - g(&model.markers[i])).norm()
+}

@@ -1,0 +1,327 @@
+//! `plyscape simulate`: build a scene, make its initial state consistent,
+//! integrate, and write `history.csv` (time + outputs, SI units in the
+//! header), `stats.csv` and an SVG of one output.
+
+use super::analysis::Projection;
+use super::dynamics::{System, Workspace};
+use super::scene::{Quantity, Scene, SceneSpec};
+use crate::error::{Error, Result};
+use crate::integrate::{integrate, integrate_sens, Stats};
+use crate::mbs::Param;
+use crate::study::Study;
+use num_dual::Dual64;
+use std::path::{Path, PathBuf};
+
+/// Everything a simulation produced.
+#[derive(Debug)]
+pub struct Simulation {
+    pub headers: Vec<String>,
+    /// One row per output time: `[t, outputs..]`.
+    pub rows: Vec<Vec<f64>>,
+    /// Final state.
+    pub y_end: Vec<f64>,
+    pub projection: Projection,
+    pub stats: Stats,
+    /// Largest `|Φ|` over the output times.
+    pub max_violation: f64,
+    /// Largest relative energy change, when the scene is conservative.
+    pub energy_error: Option<f64>,
+    /// Redundant equations (equations − rank) at the start.
+    pub redundant: usize,
+    pub equations: usize,
+    /// Headers of the output sensitivities (`t` first); only `t` when the
+    /// scene asks for none.
+    pub sens_headers: Vec<String>,
+    /// One row per output time: `[t, ∂outputs/∂p_1.., ∂outputs/∂p_2..]`.
+    pub sens_rows: Vec<Vec<f64>>,
+}
+
+/// Read the `[scene]` section of a study and build it.
+pub fn load_scene(study: &Study) -> Result<Scene> {
+    let spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
+    spec.build().map_err(study.locate("scene"))
+}
+
+/// Simulate a built scene (no files written).
+pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
+    let sys = System::new(scene.model.clone());
+    let mut y0 = sys.initial_state();
+    let projection = sys.project(scene.options.t0, &mut y0)?;
+    let mut headers = vec!["t [s]".to_string()];
+    for (label, q) in &scene.outputs {
+        headers.extend(q.headers(label));
+    }
+    let mut ws = Workspace::<f64>::empty();
+    let e0 = sys.energy(&y0, &mut ws);
+    let conservative = sys.conservative();
+    let mut rows = Vec::new();
+    let mut max_violation = 0.0f64;
+    let mut energy_error = 0.0f64;
+    let mut y_end = y0.clone();
+    let wants_reactions = scene
+        .outputs
+        .iter()
+        .any(|(_, q)| matches!(q, Quantity::Reaction(_)));
+    let sens_quantities: Vec<(String, Quantity)> = scene
+        .outputs
+        .iter()
+        .filter(|(_, q)| {
+            matches!(
+                q,
+                Quantity::Angle(_) | Quantity::Rate(_) | Quantity::Position(_)
+            )
+        })
+        .cloned()
+        .collect();
+    let mut sens_headers = vec!["t [s]".to_string()];
+    for (pname, _) in &scene.params {
+        for (label, q) in &sens_quantities {
+            for h in q.headers(label) {
+                let (name, unit) = h.split_once(" [").unwrap_or((h.as_str(), "-]"));
+                let unit = unit.trim_end_matches(']');
+                sens_headers.push(format!("d({name})/d({pname}) [{unit} per SI unit of p]"));
+            }
+        }
+    }
+    let mut sens_rows = Vec::new();
+    let n = y0.len();
+    let mut observe = |t: f64, y: &[f64], s: &[f64]| {
+        if !scene.params.is_empty() {
+            let mut row = vec![t];
+            for i in 0..scene.params.len() {
+                let lane = &s[i * n..(i + 1) * n];
+                row.extend(output_sensitivities(&sys, &sens_quantities, y, lane));
+            }
+            sens_rows.push(row);
+        }
+        // The reactions' solve assembles the constraint rows at (t, y):
+        // the violation is read from them instead of a second assembly.
+        let reactions = wants_reactions.then(|| sys.reactions(t, y, &mut ws));
+        let viol = if wants_reactions {
+            ws.rows.iter().fold(0.0f64, |m, r| m.max(r.phi.abs()))
+        } else {
+            sys.violation(t, y, &mut ws)
+        };
+        max_violation = max_violation.max(viol);
+        if conservative {
+            let e = sys.energy(y, &mut ws);
+            energy_error = energy_error.max((e - e0).abs() / e0.abs().max(1e-300));
+        }
+        let mut row = vec![t];
+        for (_, q) in &scene.outputs {
+            match q {
+                Quantity::Angle(j) => row.push(sys.angle(y, *j, &mut ws).0),
+                Quantity::Rate(j) => row.push(sys.angle(y, *j, &mut ws).1),
+                Quantity::Reaction(j) => {
+                    let r = reactions
+                        .as_ref()
+                        .map(|r| r[*j])
+                        .unwrap_or(super::Reaction {
+                            force: Default::default(),
+                            torque: Default::default(),
+                        });
+                    row.extend(r.force.iter().chain(r.torque.iter()));
+                }
+                Quantity::Position(b) => match sys.slot[*b] {
+                    Some(s) => row.extend_from_slice(&y[7 * s..7 * s + 3]),
+                    None => row.extend(sys.model.bodies[*b].r0.iter()),
+                },
+                Quantity::Energy => row.push(sys.energy(y, &mut ws)),
+                Quantity::Violation => row.push(viol),
+            }
+        }
+        if let Some(k) = row.iter().position(|v| !v.is_finite()) {
+            return Err(Error::numerical_at(
+                "simulate: outputs",
+                t,
+                format!("column {k} is not finite"),
+            ));
+        }
+        rows.push(row);
+        y_end.copy_from_slice(y);
+        Ok(())
+    };
+    let stats = if scene.params.is_empty() {
+        integrate(&sys, &y0, &scene.options, |t, y| observe(t, y, &[]))?
+    } else {
+        let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
+        integrate_sens(&sys, &y0, &scene.options, &params, &mut observe)?
+    };
+    let sim = Simulation {
+        headers,
+        rows,
+        y_end,
+        redundant: projection.equations - projection.rank,
+        equations: projection.equations,
+        projection,
+        stats,
+        max_violation,
+        energy_error: conservative.then_some(energy_error),
+        sens_headers,
+        sens_rows,
+    };
+    Ok((sys, sim))
+}
+
+/// Exact derivatives of the angle, rate and position outputs along the
+/// state sensitivity `s = ∂y/∂p`: one dual-number evaluation of each output
+/// at `y + ε s`.
+fn output_sensitivities(
+    sys: &System,
+    quantities: &[(String, Quantity)],
+    y: &[f64],
+    s: &[f64],
+) -> Vec<f64> {
+    let yd: Vec<Dual64> = y.iter().zip(s).map(|(&a, &b)| Dual64::new(a, b)).collect();
+    let mut kin = Vec::new();
+    sys.body_kin(&yd, &mut kin);
+    let mut out = Vec::new();
+    for (_, q) in quantities {
+        match q {
+            Quantity::Angle(j) => out.push(sys.joint_angle(&kin, *j).0.eps),
+            Quantity::Rate(j) => out.push(sys.joint_angle(&kin, *j).1.eps),
+            Quantity::Position(b) => match sys.slot[*b] {
+                Some(k) => out.extend_from_slice(&s[7 * k..7 * k + 3]),
+                None => out.extend([0.0; 3]),
+            },
+            _ => {}
+        }
+    }
+    out
+}
+
+/// Write `history.csv`, `stats.csv` and (if asked) `<output>.svg` into `dir`.
+pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>> {
+    let hist = dir.join("history.csv");
+    let mut w = csv::Writer::from_path(&hist).map_err(|e| Error::csv(&hist, e))?;
+    w.write_record(&sim.headers)
+        .map_err(|e| Error::csv(&hist, e))?;
+    for row in &sim.rows {
+        w.write_record(row.iter().map(|v| format!("{v:.12e}")))
+            .map_err(|e| Error::csv(&hist, e))?;
+    }
+    w.flush().map_err(|e| Error::io(&hist, e))?;
+    let stats_path = dir.join("stats.csv");
+    let mut w = csv::Writer::from_path(&stats_path).map_err(|e| Error::csv(&stats_path, e))?;
+    let s = &sim.stats;
+    let p = &sim.projection;
+    let records: Vec<(&str, String)> = vec![
+        ("method", scene.options.method.name().to_string()),
+        ("rtol", format!("{:e}", scene.options.rtol)),
+        ("atol", format!("{:e}", scene.options.atol)),
+        ("steps", s.steps.to_string()),
+        ("rhs_calls", s.rhs_calls.to_string()),
+        ("jvp_calls", s.jvp_calls.to_string()),
+        ("jacobians", s.jacobians.to_string()),
+        ("error_test_failures", s.error_test_failures.to_string()),
+        ("nonlinear_iterations", s.nonlinear_iterations.to_string()),
+        ("nonlinear_failures", s.nonlinear_failures.to_string()),
+        ("wall_time_s", format!("{:.6e}", s.wall)),
+        ("output_wall_time_s", format!("{:.6e}", s.observer_wall)),
+        ("equations", sim.equations.to_string()),
+        ("redundant_equations", sim.redundant.to_string()),
+        ("initial_violation", format!("{:.3e}", p.phi_before)),
+        (
+            "position_correction",
+            format!("{:.3e}", p.position_correction),
+        ),
+        (
+            "velocity_correction",
+            format!("{:.3e}", p.velocity_correction),
+        ),
+        ("max_violation", format!("{:.3e}", sim.max_violation)),
+        (
+            "energy_error",
+            sim.energy_error
+                .map_or("n/a".into(), |e| format!("{e:.3e}")),
+        ),
+    ];
+    w.write_record(["quantity", "value"])
+        .map_err(|e| Error::csv(&stats_path, e))?;
+    for (k, v) in &records {
+        w.write_record([*k, v.as_str()])
+            .map_err(|e| Error::csv(&stats_path, e))?;
+    }
+    w.flush().map_err(|e| Error::io(&stats_path, e))?;
+    let mut written = vec![hist, stats_path];
+    if !sim.sens_rows.is_empty() {
+        let path = dir.join("sensitivities.csv");
+        let mut w = csv::Writer::from_path(&path).map_err(|e| Error::csv(&path, e))?;
+        w.write_record(&sim.sens_headers)
+            .map_err(|e| Error::csv(&path, e))?;
+        for row in &sim.sens_rows {
+            w.write_record(row.iter().map(|v| format!("{v:.12e}")))
+                .map_err(|e| Error::csv(&path, e))?;
+        }
+        w.flush().map_err(|e| Error::io(&path, e))?;
+        written.push(path);
+    }
+    if let Some(name) = &scene.plot {
+        let col = sim
+            .headers
+            .iter()
+            .position(|h| h.starts_with(name.as_str()));
+        if let Some(col) = col {
+            let path = dir.join(format!("{name}.svg"));
+            plot_svg(&path, &sim.headers[col], &sim.rows, col)?;
+            written.push(path);
+        }
+    }
+    Ok(written)
+}
+
+/// Plot column `col` of `rows` against time into an SVG file.
+pub fn plot_svg(path: &Path, label: &str, rows: &[Vec<f64>], col: usize) -> Result<()> {
+    use plotters::prelude::*;
+    let (t0, t1) = (rows[0][0], rows[rows.len() - 1][0]);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for r in rows {
+        lo = lo.min(r[col]);
+        hi = hi.max(r[col]);
+    }
+    let pad = 0.05 * (hi - lo).max(1e-12);
+    let err = |e: String| Error::numerical("simulate: svg plot", e);
+    let root = SVGBackend::new(path, (800, 480)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+    let mut chart = ChartBuilder::on(&root)
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(t0..t1, (lo - pad)..(hi + pad))
+        .map_err(|e| err(e.to_string()))?;
+    chart
+        .configure_mesh()
+        .x_desc("t [s]")
+        .y_desc(label)
+        .draw()
+        .map_err(|e| err(e.to_string()))?;
+    chart
+        .draw_series(LineSeries::new(rows.iter().map(|r| (r[0], r[col])), &BLUE))
+        .map_err(|e| err(e.to_string()))?;
+    root.present().map_err(|e| err(e.to_string()))?;
+    Ok(())
+}
+
+/// One-paragraph summary for the terminal.
+pub fn summary(sim: &Simulation) -> String {
+    let s = &sim.stats;
+    format!(
+        "constraints: {} equations, {} redundant; initial |Φ| {:.2e} (position correction {:.2e}, velocity {:.2e})\n\
+         max constraint violation {:.2e}; energy error {}\n\
+         integrator: {} steps, {} rhs calls, {} Jacobian-vector products, {} Jacobians, {} error-test failures; wall {:.3} ms (+ {:.3} ms outputs)",
+        sim.equations,
+        sim.redundant,
+        sim.projection.phi_before,
+        sim.projection.position_correction,
+        sim.projection.velocity_correction,
+        sim.max_violation,
+        sim.energy_error.map_or("n/a (non-conservative scene)".into(), |e| format!("{e:.2e}")),
+        s.steps,
+        s.rhs_calls,
+        s.jvp_calls,
+        s.jacobians,
+        s.error_test_failures,
+        s.wall * 1e3,
+        s.observer_wall * 1e3
+    )
+}

@@ -1,0 +1,190 @@
+//! Scene input errors (one clear error each, naming file, key and value),
+//! the effects list (what is not listed is not built), and the
+//! `plyscape simulate` command end to end.
+use plyscape::mbs::simulate::{load_scene, simulate};
+use plyscape::study::Study;
+use plyscape::Error;
+
+/// A small valid scene: a pendulum rod on a revolute joint.
+const BASE: &str = r#"
+[study]
+name = "pendulum"
+[scene]
+effects = ["gravity"]
+[[scene.bodies]]
+name = "rod"
+mass = 1.0
+com = [0.5, 0.0, 0.0]
+inertia = [[1e-4, 0.0, 0.0], [0.0, 0.0834, 0.0], [0.0, 0.0, 0.0834]]
+[[scene.joints]]
+name = "pin"
+type = "revolute"
+body_i = "ground"
+body_j = "rod"
+point = [0.0, 0.0, 0.0]
+axis = [0.0, 1.0, 0.0]
+[scene.integrator]
+rtol = 1e-6
+t_end = 0.5
+dt_out = 0.1
+[scene.outputs]
+quantities = ["pin.angle"]
+"#;
+
+fn error_of(text: &str) -> (String, String, String) {
+    let study = Study::parse("bad.toml", text).unwrap();
+    let r =
+        load_scene(&study).and_then(|s| simulate(&s).map(|_| ()).map_err(study.locate("scene")));
+    match r {
+        Err(Error::Input {
+            file, key, value, ..
+        }) => (file, key, value),
+        other => panic!("expected an input error, got {other:?}"),
+    }
+}
+
+#[test]
+fn base_scene_runs() {
+    let study = Study::parse("ok.toml", BASE).unwrap();
+    let scene = load_scene(&study).unwrap();
+    let (_, sim) = simulate(&scene).unwrap();
+    assert_eq!(sim.rows.len(), 6);
+}
+
+#[test]
+fn each_bad_input_names_file_key_and_value() {
+    let cases: Vec<(String, &str, &str)> = vec![
+        (BASE.replace("body_j = \"rod\"", "body_j = \"rood\""), "scene.joints[0].body_j", "rood"),
+        (BASE.replace("axis = [0.0, 1.0, 0.0]", "axis = [0.0, 0.0, 0.0]"), "scene.joints[0].axis", "0"),
+        (BASE.replace("mass = 1.0", "mass = -1.0"), "scene.bodies[0].mass", "-1"),
+        (BASE.replace("[0.0, 0.0, 0.0834]]", "[0.0, 0.0, -0.0834]]"), "scene.bodies[0].inertia", "-0.0834"),
+        (BASE.replace("rtol = 1e-6", "rtol = 2.0"), "scene.integrator.rtol", "2"),
+        (BASE.replace("t_end = 0.5", "t_end = -0.5"), "scene.integrator.t_end", "-0.5"),
+        (BASE.replace("effects = [\"gravity\"]", "effects = [\"gravitee\"]"), "scene.effects[0]", "gravitee"),
+        (BASE.replace("\"pin.angle\"", "\"pn.angle\""), "scene.outputs.quantities[0]", "pn.angle"),
+        (
+            BASE.to_string()
+                + "[[scene.markers]]\nname = \"m\"\nbody = \"rod\"\npoint = [1.0, 0.0, 0.0]\n"
+                + "[[scene.forces]]\ntype = \"spring\"\nmarker_i = \"m\"\nmarker_j = \"nowhere\"\nstiffness = 1.0\n",
+            "scene.forces[0].marker_j",
+            "nowhere",
+        ),
+        (
+            // A fixed joint and a joint driven to another angle about the
+            // same axis: contradictory, cannot be projected.
+            BASE.to_string()
+                + "[[scene.joints]]\nname = \"lock\"\ntype = \"driven\"\nbody_i = \"ground\"\nbody_j = \"rod\"\n"
+                + "point = [0.0, 0.0, 0.0]\naxis = [0.0, 1.0, 0.0]\ndrive = [0.5]\n"
+                + "[[scene.joints]]\nname = \"weld\"\ntype = \"fixed\"\nbody_i = \"ground\"\nbody_j = \"rod\"\n"
+                + "point = [1.0, 0.0, 0.0]\naxis = [0.0, 1.0, 0.0]\n",
+            "scene.joints",
+            "max |Φ|",
+        ),
+    ];
+    for (text, key, value) in cases {
+        println!("case {key}");
+        let (file, k, v) = error_of(&text);
+        assert_eq!(file, "bad.toml");
+        assert_eq!(k, key, "value {v}");
+        assert!(
+            v.contains(value),
+            "key {k}: value {v} should contain {value}"
+        );
+    }
+}
+
+#[test]
+fn effects_not_listed_are_not_built_or_evaluated() {
+    let with = Study::parse("a.toml", BASE).unwrap();
+    let without = Study::parse(
+        "b.toml",
+        &BASE.replace("effects = [\"gravity\"]", "effects = []"),
+    )
+    .unwrap();
+    let (sys_a, sim_a) = simulate(&load_scene(&with).unwrap()).unwrap();
+    let (sys_b, sim_b) = simulate(&load_scene(&without).unwrap()).unwrap();
+    assert!(sys_a.counters.gravity.get() > 0);
+    assert_eq!(sys_b.counters.gravity.get(), 0);
+    assert!(sys_b.model.forces.is_empty());
+    // Without gravity the pendulum stays at rest; with it, it swings.
+    assert!(sim_b.rows.iter().all(|r| r[1].abs() < 1e-12));
+    assert!(sim_a.rows.last().unwrap()[1].abs() > 0.1);
+    // Actuator law and damping are separate effects.
+    let sar = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/studies/sar_phase1_rigid.toml"
+    ))
+    .unwrap();
+    let only_damping = Study::parse(
+        "c.toml",
+        // (the breakpoint sensitivity needs the law: leave it out)
+        &sar.replace(
+            "effects = [\"actuators\", \"damping\"]",
+            "effects = [\"damping\"]",
+        )
+        .replace("sensitivities = [", "# sensitivities = ["),
+    )
+    .unwrap();
+    let scene = load_scene(&only_damping).unwrap();
+    match &scene.model.forces[..] {
+        [plyscape::mbs::Force::Rotational {
+            law: None, damping, ..
+        }] => assert_eq!(*damping, 0.5),
+        other => panic!("unexpected forces {other:?}"),
+    }
+}
+
+#[test]
+fn simulate_command_writes_history_stats_and_svg() {
+    let dir = std::env::temp_dir().join(format!("plyscape_mbs_cli_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let study = dir.join("pendulum.toml");
+    std::fs::write(
+        &study,
+        BASE.replace(
+            "quantities = [\"pin.angle\"]",
+            "quantities = [\"pin.angle\", \"pin.reaction\"]\nplot = \"pin.angle\"",
+        ),
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_plyscape"))
+        .args([
+            "simulate",
+            study.to_str().unwrap(),
+            "--out",
+            dir.join("results").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("redundant"), "{stdout}");
+    let res = dir.join("results/pendulum");
+    let hist = std::fs::read_to_string(res.join("history.csv")).unwrap();
+    assert!(
+        hist.starts_with("t [s],pin.angle [rad],pin.force_x [N]"),
+        "{hist}"
+    );
+    assert_eq!(hist.lines().count(), 7);
+    let stats = std::fs::read_to_string(res.join("stats.csv")).unwrap();
+    assert!(stats.contains("redundant_equations,0"), "{stats}");
+    assert!(res.join("pin.angle.svg").exists());
+    // A bad file gives exit code 2 (input error) and names the key.
+    std::fs::write(&study, BASE.replace("mass = 1.0", "mass = 0.0")).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_plyscape"))
+        .args([
+            "simulate",
+            study.to_str().unwrap(),
+            "--out",
+            dir.join("results").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("scene.bodies[0].mass"));
+    std::fs::remove_dir_all(&dir).ok();
+}
