@@ -105,7 +105,7 @@ pub struct PanelModes {
     pub labels: Vec<(&'static str, &'static str)>,
     /// Derivatives per design variable (empty unless asked for).
     pub derivatives: Vec<VariableDerivatives>,
-    /// Design-variable names, e.g. `theta[1,4]`.
+    /// Design-variable names: `theta_1_4` ties plies 1 and 4.
     pub variables: Vec<String>,
     /// Wall times [s]: assembly, modes, derivatives.
     pub seconds: [f64; 3],
@@ -230,7 +230,7 @@ impl PanelAnalysis {
             .iter()
             .map(|g| {
                 let plies: Vec<String> = g.iter().map(|k| (k + 1).to_string()).collect();
-                format!("theta[{}]", plies.join(","))
+                format!("theta_{}", plies.join("_"))
             })
             .collect();
         let mut with_layup = self.panel.clone();
