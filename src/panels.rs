@@ -200,10 +200,15 @@ impl PanelAnalysis {
             .assemble_into(laminate, &self.panel.design, &mut self.sys)?;
         self.solver.set_stiffness(&self.sys.k)?;
         let t1 = Instant::now();
-        let modes = self.solver.solve(&ModalOptions::new(n_modes))?;
+        let free = self.panel.support == crate::fe::Support::FreeFree;
+        let mut opts = ModalOptions::new(if free { n_modes + 6 } else { n_modes });
+        if free {
+            opts.shift = FREE_FREE_SHIFT;
+        }
+        let mut modes = self.solver.solve(&opts)?;
         let t2 = Instant::now();
         let sys = &self.sys;
-        let derivatives = match self.want {
+        let mut derivatives = match self.want {
             None => Vec::new(),
             Some(update) => {
                 let vars: Vec<DesignDerivative<'_>> = (0..sys.dk.len())
@@ -219,6 +224,9 @@ impl PanelAnalysis {
                 self.solver.derivatives(&modes, &vars, &opts)?
             }
         };
+        if free {
+            remove_rigid_modes(&mut modes, &mut derivatives, sys)?;
+        }
         let t3 = Instant::now();
         let labels = (0..modes.lambda.len())
             .map(|j| label_mode(sys, &self.mirrors, &modes, j))
@@ -252,6 +260,70 @@ impl PanelAnalysis {
             nodes: self.panel.mesh.nodes.clone(),
         })
     }
+}
+
+/// Shift σ [rad²/s²] for free–free panels: K − σM must be positive
+/// definite although K has the six rigid-body modes (λ = 0) as null space.
+/// −1 rad²/s² lifts them to 1 while keeping the pencil well conditioned and
+/// the wanted eigenvalues (flexural λ of order 10–10⁴ for the SAR panel) far
+/// from σ relative to the gaps the shift-invert Lanczos needs.
+pub const FREE_FREE_SHIFT: f64 = -1.0;
+
+/// Identify the six rigid-body modes among the computed ones by their
+/// M-projection onto the rigid-body fields of the model (share of the mode's
+/// M-norm in the rigid subspace > 1/2; elastic modes are M-orthogonal to it)
+/// and remove them, with their derivatives (rigid motions do not depend on
+/// the ply angles). Exactly six must be found, else it is a numerical error.
+fn remove_rigid_modes(
+    modes: &mut Modes,
+    derivatives: &mut [VariableDerivatives],
+    sys: &PanelSystem,
+) -> Result<()> {
+    let n = modes.modes.nrows();
+    let k = modes.lambda.len();
+    let rigid: Vec<bool> = (0..k)
+        .map(|j| {
+            let share: f64 = sys
+                .rigid_modes
+                .iter()
+                .map(|r| {
+                    (0..n)
+                        .map(|i| r[i] * sys.m_diag[i] * modes.modes[(i, j)])
+                        .sum::<f64>()
+                        .powi(2)
+                })
+                .sum();
+            share > 0.5
+        })
+        .collect();
+    let found = rigid.iter().filter(|&&r| r).count();
+    if found != 6 || sys.rigid_modes.len() != 6 {
+        return Err(Error::numerical(
+            "panels::remove_rigid_modes",
+            format!(
+                "free-free panel: {found} computed modes lie in the rigid-body subspace \
+                 (expected 6); lowest eigenvalues {:?}",
+                &modes.lambda[..k.min(8)]
+            ),
+        ));
+    }
+    let keep: Vec<usize> = (0..k).filter(|&j| !rigid[j]).collect();
+    let take = |m: &faer::Mat<f64>| faer::Mat::from_fn(n, keep.len(), |i, c| m[(i, keep[c])]);
+    modes.modes = take(&modes.modes);
+    modes.lambda = keep.iter().map(|&j| modes.lambda[j]).collect();
+    modes.residuals = keep.iter().map(|&j| modes.residuals[j]).collect();
+    for d in derivatives.iter_mut() {
+        d.dlambda = keep.iter().map(|&j| d.dlambda[j]).collect();
+        d.dmodes = d.dmodes.as_ref().map(take);
+        // Clusters index the full list: keep those wholly among the
+        // elastic modes, renumbered.
+        d.clusters
+            .retain(|c| (c.first..c.first + c.len).all(|j| !rigid[j]));
+        for c in d.clusters.iter_mut() {
+            c.first = keep.iter().position(|&j| j == c.first).unwrap_or(c.first);
+        }
+    }
+    Ok(())
 }
 
 /// Analyse one panel once (set-up + one run).
