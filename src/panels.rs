@@ -308,13 +308,15 @@ fn remove_rigid_modes(
         ));
     }
     let keep: Vec<usize> = (0..k).filter(|&j| !rigid[j]).collect();
-    let take = |m: &faer::Mat<f64>| faer::Mat::from_fn(n, keep.len(), |i, c| m[(i, keep[c])]);
-    modes.modes = take(&modes.modes);
+    fn columns(m: &faer::Mat<f64>, keep: &[usize]) -> faer::Mat<f64> {
+        faer::Mat::from_fn(m.nrows(), keep.len(), |i, c| m[(i, keep[c])])
+    }
+    modes.modes = columns(&modes.modes, &keep);
     modes.lambda = keep.iter().map(|&j| modes.lambda[j]).collect();
     modes.residuals = keep.iter().map(|&j| modes.residuals[j]).collect();
     for d in derivatives.iter_mut() {
         d.dlambda = keep.iter().map(|&j| d.dlambda[j]).collect();
-        d.dmodes = d.dmodes.as_ref().map(take);
+        d.dmodes = d.dmodes.as_ref().map(|m| columns(m, &keep));
         // Clusters index the full list: keep those wholly among the
         // elastic modes, renumbered.
         d.clusters
