@@ -124,15 +124,7 @@ fn simply_supported_plate_frequencies_match_closed_form() {
 
 fn sar_laminate(angles_deg: [f64; 4]) -> Laminate {
     // IM6/SC1081, 4 plies of 0.5 mm (paper §6, SAR_MODEL.md).
-    let m = Orthotropic {
-        e1: 177e9,
-        e2: 10.8e9,
-        g12: 7.6e9,
-        g13: 7.6e9,
-        g23: 8.504e9,
-        nu12: 0.27,
-        rho: 1600.0,
-    };
+    let m = Orthotropic::im6_sc1081();
     Laminate::new(
         angles_deg
             .iter()

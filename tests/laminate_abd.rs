@@ -9,19 +9,6 @@ use plyscape::laminate::{
 };
 use plyscape::Error;
 
-fn im6() -> Orthotropic {
-    // IM6/SC1081, paper §6 / SAR_MODEL.md.
-    Orthotropic {
-        e1: 177e9,
-        e2: 10.8e9,
-        g12: 7.6e9,
-        g13: 7.6e9,
-        g23: 8.504e9,
-        nu12: 0.27,
-        rho: 1600.0,
-    }
-}
-
 fn stack(m: Orthotropic, angles_deg: &[f64], t: f64) -> Laminate {
     Laminate::new(
         angles_deg
@@ -87,7 +74,7 @@ fn single_ply_limit() {
     // Closed form: one ply, A = Q̄ h, B = 0, D = Q̄ h³/12; at θ = 0 Q̄ = Q
     // (Q11 = E1/(1−ν12ν21), Q12 = ν12 E2/(1−ν12ν21), Q66 = G12), and
     // S = κ h diag(G13, G23).
-    let m = im6();
+    let m = Orthotropic::im6_sc1081();
     let h = 2e-3;
     let st = stack(m, &[0.0], h).stiffness();
     let nu21 = m.nu12 * m.e2 / m.e1;
@@ -121,7 +108,7 @@ fn single_ply_limit() {
 
 #[test]
 fn symmetric_layups_have_no_coupling_and_cross_ply_has_closed_form_b() {
-    let m = im6();
+    let m = Orthotropic::im6_sc1081();
     let t = 0.5e-3;
     for angles in [
         [0.0, 0.0, 0.0, 0.0],
@@ -214,7 +201,7 @@ fn ply_angle_derivatives_match_hyper_dual_numbers() {
     // Reference: forward-mode AD with hyper-dual numbers (num-dual 0.15) of
     // the generic twin `stiffness_generic` (explicit transformation
     // polynomials, an independent route from the invariant closed forms).
-    let m = im6();
+    let m = Orthotropic::im6_sc1081();
     let lam = stack(m, &[12.0, -37.0, 71.0, 155.0], 0.5e-3);
     let scale = lam.stiffness();
     let n = lam.plies().len();
@@ -256,7 +243,7 @@ fn ply_angle_derivatives_match_hyper_dual_numbers() {
 fn design_variable_derivatives_sum_over_tied_plies() {
     // [θ1/θ2/θ2/θ1] (paper §6): variable 0 ties plies 1&4, variable 1 ties
     // 2&3. Reference: hyper-dual numbers seeded on every ply of a group.
-    let m = im6();
+    let m = Orthotropic::im6_sc1081();
     let lam = stack(m, &[25.0, -60.0, -60.0, 25.0], 0.5e-3);
     let map = DesignMap::new(vec![vec![0, 3], vec![1, 2]], 4).unwrap();
     assert_eq!(map, DesignMap::symmetric(4));

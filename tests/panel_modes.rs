@@ -13,25 +13,12 @@ use plyscape::study::Study;
 use std::path::PathBuf;
 use std::process::Command;
 
-/// IM6/SC1081 (paper §6.2).
-fn im6() -> Orthotropic {
-    Orthotropic {
-        e1: 177e9,
-        e2: 10.8e9,
-        g12: 7.6e9,
-        g13: 7.6e9,
-        g23: 8.504e9,
-        nu12: 0.27,
-        rho: 1600.0,
-    }
-}
-
 fn laminate(angles_deg: &[f64], ply_thickness: f64) -> Laminate {
     Laminate::new(
         angles_deg
             .iter()
             .map(|a| Ply {
-                material: im6(),
+                material: Orthotropic::im6_sc1081(),
                 thickness: ply_thickness,
                 angle: a.to_radians(),
             })

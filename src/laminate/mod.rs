@@ -67,6 +67,21 @@ pub struct Orthotropic {
 }
 
 impl Orthotropic {
+    /// IM6/SC1081 carbon/epoxy, the paper's panel material (§6.2):
+    /// E1 = 177 GPa, E2 = 10.8 GPa, G12 = G13 = 7.6 GPa, G23 = 8.504 GPa,
+    /// ν12 = 0.27, ρ = 1600 kg/m³.
+    pub fn im6_sc1081() -> Orthotropic {
+        Orthotropic {
+            e1: 177e9,
+            e2: 10.8e9,
+            g12: 7.6e9,
+            g13: 7.6e9,
+            g23: 8.504e9,
+            nu12: 0.27,
+            rho: 1600.0,
+        }
+    }
+
     /// Validate: moduli and density finite and > 0; ν12 finite with
     /// ν12² < E1/E2 (the plane-stress stiffness is positive definite only
     /// then, since ν12·ν21 = ν12²·E2/E1 must be < 1).
@@ -518,22 +533,10 @@ pub use spec::{MaterialSpec, PlySpec};
 mod tests {
     use super::*;
 
-    fn im6() -> Orthotropic {
-        Orthotropic {
-            e1: 177e9,
-            e2: 10.8e9,
-            g12: 7.6e9,
-            g13: 7.6e9,
-            g23: 8.504e9,
-            nu12: 0.27,
-            rho: 1600.0,
-        }
-    }
-
     #[test]
     fn invariant_and_polynomial_forms_agree() {
         // Two independent routes to Q̄(θ) (module doc): must agree to rounding.
-        let m = im6();
+        let m = Orthotropic::im6_sc1081();
         for &t in &[0.0, 0.3, 1.1, -2.0, 3.0] {
             let p = Ply {
                 material: m,
