@@ -259,7 +259,13 @@ fn handlers() -> Vec<(&'static str, Handler)> {
         ("compare", run_compare_handler),
         ("scaling", run_scaling_handler),
         ("map", run_map_handler),
+        ("kernel_bench", run_kernel_bench_handler),
     ]
+}
+
+/// The `[kernel_bench]` section: multibody kernel cost and accuracy table.
+fn run_kernel_bench_handler(cfg: &RunConfig) -> Result<()> {
+    crate::mbs::bench::run_kernel_bench(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
 }
 
 /// The `[modes]` section: panel modal analysis.

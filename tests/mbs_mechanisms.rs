@@ -1,6 +1,8 @@
 //! Closed-loop mechanisms with redundant constraints: planar four-bars
 //! (crank-rocker through the rocker's dead points) and the Bricard 6R
-//! linkage.
+//! linkage. The scenes run from the shipped study files
+//! (studies/fourbar.toml, studies/bricard.toml); the generators below
+//! derive the same geometry and check that the files hold it.
 use nalgebra::{Matrix3, Vector3};
 use plyscape::mbs::scene::SceneSpec;
 use plyscape::mbs::simulate::{simulate, Simulation};
@@ -28,9 +30,20 @@ fn revolute(name: &str, bi: &str, bj: &str, p: Vector3<f64>, axis: Vector3<f64>)
     )
 }
 
-fn run(text: &str) -> Simulation {
-    let table: toml::Table = toml::from_str(text).unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
+/// Check that the shipped study `file` holds the scene `generated` (every
+/// key of `[scene]` but the outputs, which the file extends), then
+/// simulate the file's scene.
+fn run_shipped(generated: &str, file: &str) -> Simulation {
+    let path = format!("{}/studies/{file}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap();
+    let shipped: toml::Table = toml::from_str(&text).unwrap();
+    let generated: toml::Table = toml::from_str(generated).unwrap();
+    let (mut a, mut b) = (shipped["scene"].clone(), generated["scene"].clone());
+    for t in [&mut a, &mut b] {
+        t.as_table_mut().unwrap().remove("outputs");
+    }
+    assert_eq!(a, b, "{file} differs from the generated scene");
+    let spec: SceneSpec = shipped["scene"].clone().try_into().unwrap();
     let scene = spec.build().unwrap();
     simulate(&scene).unwrap().1
 }
@@ -75,8 +88,8 @@ fn crank_rocker_passes_dead_points_conserving_energy() {
         ["angular_velocity = [0.0, 0.0, 12.0]\n", "", ""],
     );
     s += "[scene.integrator]\nmethod = \"bdf\"\nrtol = 1e-9\natol = 1e-11\nt_end = 10.0\ndt_out = 0.002\n";
-    s += "[scene.outputs]\nquantities = [\"O2.angle\", \"O4.angle\", \"O4.rate\"]\n";
-    let sim = run(&s);
+    // Outputs (studies/fourbar.toml): O2.angle, O4.angle, O4.rate, ...
+    let sim = run_shipped(&s, "fourbar.toml");
     // 4 revolutes × 5 = 20 equations on 18 coordinates, mobility 1:
     // rank 17, 3 redundant (closed form).
     assert_eq!(sim.equations, 20);
@@ -144,8 +157,8 @@ fn bricard_linkage_is_mobile_and_stable() {
         s += &revolute(&format!("J{k}"), &name(prev), &name(k), v[k], a);
     }
     s += "[scene.integrator]\nmethod = \"bdf\"\nrtol = 1e-9\natol = 1e-11\nt_end = 10.0\ndt_out = 0.01\n";
-    s += "[scene.outputs]\nquantities = [\"J0.angle\", \"L2.position\"]\n";
-    let sim = run(&s);
+    // Outputs (studies/bricard.toml): J0.angle, L2.position, ...
+    let sim = run_shipped(&s, "bricard.toml");
     assert_eq!(sim.equations, 30);
     assert_eq!(sim.redundant, 1);
     let range = sim

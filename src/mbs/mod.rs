@@ -39,6 +39,7 @@
 //!   for angle, rate and position outputs only (`sensitivities.csv`).
 
 pub mod analysis;
+pub mod bench;
 pub mod dynamics;
 pub mod linalg;
 pub mod model;
