@@ -61,7 +61,7 @@ use faer::Mat;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 use super::sign_normalize;
-use super::sparse::{gmres_refine, spmv, Pencil};
+use super::sparse::{gmres_refine, spmv, Pencil, Refine};
 use super::Modes;
 use crate::error::{Error, Result};
 
@@ -282,20 +282,49 @@ fn setup_variable(
     }
 }
 
-/// Solve `Â X = B` where `Â` is `K − λ̄M` with the rows and columns marked
-/// in `is_r` replaced by the identity: one block solve with the (possibly
-/// regularised) `LDLᵀ`, then Krylov refinement per column to 1e-13.
+/// Solve `Â X = B` where `Â` is `K − λ̄M` with the rows and columns `rows`
+/// (marked in `is_r`) replaced by the identity: one block solve with the
+/// (possibly regularised) `LDLᵀ`, then Krylov refinement per column to
+/// 1e-13. The residuals and the first GMRES step (one solve, one product)
+/// are computed for all columns at once (block solve and one pass over `K`);
+/// further GMRES steps, when needed, run per column.
 fn refined_solve(
     pencil: &Pencil,
     factor: &mut super::sparse::Factor<'_>,
     lambda_bar: f64,
-    is_r: &[bool],
+    (rows, is_r): (&[usize], &[bool]),
     b: &Mat<f64>,
 ) -> Result<Mat<f64>> {
-    let n = b.nrows();
+    const TOL: f64 = 1e-13;
+    let (n, q) = (b.nrows(), b.ncols());
     let mass = pencil.mass();
     let mut x = b.clone();
     factor.solve_in_place(x.as_mut());
+    // Residuals R = B − ÂX of all columns.
+    let mut res = Mat::<f64>::zeros(n, q);
+    pencil.shifted_mul_block(lambda_bar, rows, x.as_ref(), res.as_mut());
+    let norm = |m: &Mat<f64>, j: usize| m.col(j).iter().map(|v| v * v).sum::<f64>().sqrt();
+    let mut todo = Vec::new();
+    for j in 0..q {
+        for i in 0..n {
+            res[(i, j)] = b[(i, j)] - res[(i, j)];
+        }
+        let (beta, bn) = (norm(&res, j), norm(b, j).max(f64::MIN_POSITIVE));
+        if beta > TOL * bn {
+            todo.push((j, beta));
+        }
+    }
+    if todo.is_empty() {
+        return Ok(x);
+    }
+    // First GMRES step of every unconverged column: Z = F⁻¹ R/β, W = ÂZ.
+    let mut z = Mat::<f64>::from_fn(n, todo.len(), |i, c| {
+        let (j, beta) = todo[c];
+        res[(i, j)] / beta
+    });
+    factor.solve_in_place(z.as_mut());
+    let mut w = Mat::<f64>::zeros(n, todo.len());
+    pencil.shifted_mul_block(lambda_bar, rows, z.as_ref(), w.as_mut());
     let apply = |v: &[f64], y: &mut [f64]| {
         let vn: Vec<f64> = (0..n).map(|i| if is_r[i] { 0.0 } else { v[i] }).collect();
         pencil.k_mul(&vn, y);
@@ -307,16 +336,26 @@ fn refined_solve(
             };
         }
     };
-    for j in 0..b.ncols() {
-        let bj: Vec<f64> = (0..n).map(|i| b[(i, j)]).collect();
-        let mut xj: Vec<f64> = (0..n).map(|i| x[(i, j)]).collect();
-        let res = gmres_refine(factor, &apply, &bj, &mut xj, 1e-13, 40);
-        if res.is_nan() || res > 1e-10 {
+    for (c, &(j, _)) in todo.iter().enumerate() {
+        let bj: Vec<f64> = b.col(j).iter().copied().collect();
+        let mut xj: Vec<f64> = x.col(j).iter().copied().collect();
+        let job = Refine {
+            b: &bj,
+            tol: TOL,
+            max_iter: 40,
+            residual: Some(res.col(j).iter().copied().collect()),
+            first: Some((
+                z.col(c).iter().copied().collect(),
+                w.col(c).iter().copied().collect(),
+            )),
+        };
+        let rj = gmres_refine(factor, &apply, &mut xj, job);
+        if rj.is_nan() || rj > 1e-10 {
             return Err(Error::numerical(
                 "modal::derivatives",
                 format!(
                     "refined solve with K - lambda*M (lambda = {lambda_bar:e}) stalled at \
-                     relative residual {res:e}"
+                     relative residual {rj:e}"
                 ),
             ));
         }
@@ -386,7 +425,7 @@ impl<'p> ClusterSystem<'p> {
                 }
             }
         }
-        let y = refined_solve(pencil, &mut factor, lambda_bar, &is_r, &y)?;
+        let y = refined_solve(pencil, &mut factor, lambda_bar, (&rows, &is_r), &y)?;
         let y1 = Mat::<f64>::from_fn(n, r, |i, j| if is_r[i] { 0.0 } else { y[(i, j)] });
         let y2 = Mat::<f64>::from_fn(n, r, |i, j| if is_r[i] { 0.0 } else { y[(i, r + j)] });
         let mut sys = ClusterSystem {
@@ -460,7 +499,13 @@ impl<'p> ClusterSystem<'p> {
         let mut is_r = vec![false; n];
         self.rows.iter().for_each(|&i| is_r[i] = true);
         let z = Mat::<f64>::from_fn(n, q, |i, j| if is_r[i] { 0.0 } else { f[(i, j)] });
-        let mut z = refined_solve(self.pencil, &mut self.factor, self.lambda_bar, &is_r, &z)?;
+        let mut z = refined_solve(
+            self.pencil,
+            &mut self.factor,
+            self.lambda_bar,
+            (&self.rows, &is_r),
+            &z,
+        )?;
         for j in 0..q {
             for i in 0..n {
                 if is_r[i] {
