@@ -229,12 +229,61 @@ pub(crate) struct Pencil {
     mass: Vec<f64>,
     /// The lower triangle of `P(K ∪ diag)Pᵀ` in the fill-reducing order.
     ordered: Ordered,
+    /// How the entries of the input matrix map onto the pattern.
+    input: InputMap,
     /// Symbolic Cholesky of the permuted pattern (identity ordering: the
     /// numeric factorizations then read `values` directly, without the
     /// per-factorization permutation of the input inside faer).
     symbolic: SymbolicCholesky<usize>,
     /// Largest |K_ij|, used to scale pivot reports.
     k_max: f64,
+}
+
+/// The input stiffness pattern and where its entries go on the pattern of
+/// `K ∪ diag`: lets [`Pencil::set_stiffness`] take a new design's values in
+/// one pass (no sort, no binary search) when the input pattern is unchanged.
+struct InputMap {
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// Pattern position of each input entry (duplicates share one).
+    dest: Vec<usize>,
+    /// For each pattern entry `(i, j)` with `i > j`: the position of
+    /// `(j, i)`, or `usize::MAX` when absent.
+    transpose: Vec<usize>,
+}
+
+impl InputMap {
+    fn build(k: &SparseColMat<usize, f64>, col_ptr: &[usize], row_idx: &[usize]) -> Option<Self> {
+        let kr = k.as_ref();
+        if kr.col_nnz().is_some() {
+            return None;
+        }
+        let find = |j: usize, i: usize| {
+            let r = &row_idx[col_ptr[j]..col_ptr[j + 1]];
+            r.binary_search(&i).ok().map(|q| col_ptr[j] + q)
+        };
+        let (in_ptr, in_idx) = (kr.col_ptr(), kr.row_idx());
+        let mut dest = Vec::with_capacity(in_idx.len());
+        for j in 0..kr.ncols() {
+            for &i in &in_idx[in_ptr[j]..in_ptr[j + 1]] {
+                dest.push(find(j, i)?);
+            }
+        }
+        let mut transpose = vec![usize::MAX; row_idx.len()];
+        for j in 0..kr.ncols() {
+            for q in col_ptr[j]..col_ptr[j + 1] {
+                if row_idx[q] > j {
+                    transpose[q] = find(row_idx[q], j).unwrap_or(usize::MAX);
+                }
+            }
+        }
+        Some(InputMap {
+            col_ptr: in_ptr.to_vec(),
+            row_idx: in_idx.to_vec(),
+            dest,
+            transpose,
+        })
+    }
 }
 
 /// Lower triangle of the symmetrically permuted pattern, CSC, rows sorted,
@@ -446,6 +495,12 @@ impl Pencil {
             ..
         } = pat;
         let (ordered, symbolic) = Ordered::build(n, &col_ptr, &row_idx)?;
+        let input = InputMap::build(k, &col_ptr, &row_idx).unwrap_or(InputMap {
+            col_ptr: Vec::new(),
+            row_idx: Vec::new(),
+            dest: Vec::new(),
+            transpose: Vec::new(),
+        });
         Ok(Pencil {
             n,
             col_ptr,
@@ -453,6 +508,7 @@ impl Pencil {
             k_val,
             mass: mass.to_vec(),
             ordered,
+            input,
             symbolic,
             k_max,
         })
@@ -468,6 +524,9 @@ impl Pencil {
                 format!("a {0} x {0} matrix (same DOFs as before)", self.n),
             ));
         }
+        if self.fast_values(k) {
+            return Ok(());
+        }
         let pat = Pattern::build(k)?;
         if pat.col_ptr == self.col_ptr && pat.row_idx == self.row_idx {
             self.k_val = pat.k_val;
@@ -478,6 +537,48 @@ impl Pencil {
             *self = Pencil::new(k, &mass)?;
             Ok(())
         }
+    }
+
+    /// New values on an unchanged input pattern: scatter through
+    /// [`InputMap`] (duplicates summed in input order, as
+    /// [`Pattern::build`] does), then the finiteness and symmetry checks.
+    /// Returns `false`, leaving `self` unchanged, when the pattern differs or
+    /// a check fails (the caller's full path then reports the error).
+    fn fast_values(&mut self, k: &SparseColMat<usize, f64>) -> bool {
+        let kr = k.as_ref();
+        let m = &self.input;
+        if m.dest.is_empty()
+            || kr.col_nnz().is_some()
+            || kr.col_ptr() != m.col_ptr.as_slice()
+            || kr.row_idx() != m.row_idx.as_slice()
+        {
+            return false;
+        }
+        let mut val = vec![0.0; self.row_idx.len()];
+        let mut k_max = 0.0f64;
+        for (&v, &d) in kr.val().iter().zip(&m.dest) {
+            if !v.is_finite() {
+                return false;
+            }
+            k_max = k_max.max(v.abs());
+            val[d] += v;
+        }
+        let tol = 1e-10 * k_max;
+        for j in 0..self.n {
+            for q in self.col_ptr[j]..self.col_ptr[j + 1] {
+                if self.row_idx[q] <= j {
+                    continue;
+                }
+                let t = m.transpose[q];
+                let kji = if t == usize::MAX { 0.0 } else { val[t] };
+                if (val[q] - kji).abs() > tol {
+                    return false;
+                }
+            }
+        }
+        self.k_val = val;
+        self.k_max = k_max;
+        true
     }
 
     /// Column `j` of `K` (rows, values); by symmetry also row `j`.
