@@ -162,7 +162,7 @@ pub(crate) struct Factor<'a> {
     values: Vec<f64>,
     kind: Kind,
     buf: MemBuffer,
-    /// Permuted right-hand sides, `n × MAX_RHS`.
+    /// Permuted right-hand sides, `n ×` (widest chunk solved so far).
     tmp: Mat<f64>,
 }
 
@@ -182,7 +182,7 @@ impl Factor<'_> {
     fn solve_chunk(&mut self, mut rhs: MatMut<'_, f64>) {
         let (n, w) = (rhs.nrows(), rhs.ncols());
         if self.tmp.nrows() != n || self.tmp.ncols() < w {
-            self.tmp = Mat::zeros(n, MAX_RHS);
+            self.tmp = Mat::zeros(n, w);
         }
         for c in 0..w {
             let src = rhs.rb().col(c);
@@ -622,16 +622,31 @@ impl Pencil {
     pub(crate) fn k_mul_block(&self, x: MatRef<'_, f64>, mut y: MatMut<'_, f64>) {
         const W: usize = 4;
         let q = x.ncols();
+        // Row-interleaved copy of (up to) 4 columns, zero-padded: the gather
+        // then reads one contiguous group of 4 per entry.
+        let mut xt = vec![0.0f64; self.n * W];
         let mut c0 = 0;
         while c0 < q {
             let w = (q - c0).min(W);
-            let xs: Vec<&[f64]> = (c0..c0 + w).map(|c| col_of(x, c)).collect();
+            for c in 0..W {
+                if c < w {
+                    let col = col_of(x, c0 + c);
+                    for i in 0..self.n {
+                        xt[i * W + c] = col[i];
+                    }
+                } else {
+                    for i in 0..self.n {
+                        xt[i * W + c] = 0.0;
+                    }
+                }
+            }
             for j in 0..self.n {
                 let r = self.col_ptr[j]..self.col_ptr[j + 1];
                 let mut acc = [0.0f64; W];
                 for (&i, &v) in self.row_idx[r.clone()].iter().zip(&self.k_val[r]) {
-                    for c in 0..w {
-                        acc[c] += v * xs[c][i];
+                    let xr: &[f64; W] = xt[i * W..i * W + W].try_into().expect("W entries");
+                    for c in 0..W {
+                        acc[c] += v * xr[c];
                     }
                 }
                 for c in 0..w {
