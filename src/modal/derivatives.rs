@@ -61,7 +61,7 @@ use faer::Mat;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 use super::sign_normalize;
-use super::sparse::{gmres_refine, spmv, Pencil, Refine};
+use super::sparse::{gmres_refine, spmv, sym_mul_block, Pencil, Refine};
 use super::Modes;
 use crate::error::{Error, Result};
 
@@ -223,17 +223,12 @@ fn setup_variable(
 ) -> VarSetup {
     let (n, k) = (modes.nrows(), modes.ncols());
     let mut kpx = Mat::<f64>::zeros(n, k);
-    let mut x = vec![0.0; n];
-    let mut y = vec![0.0; n];
-    for j in 0..k {
-        for (i, xi) in x.iter_mut().enumerate() {
-            *xi = modes[(i, j)];
-        }
-        spmv(dk, &x, &mut y);
-        for (i, &yi) in y.iter().enumerate() {
-            kpx[(i, j)] = yi;
-        }
-    }
+    let dkr = dk.as_ref();
+    sym_mul_block(
+        |j| (dkr.row_idx_of_col_raw(j), dkr.val_of_col(j)),
+        modes.as_ref(),
+        kpx.as_mut(),
+    );
     let mut dlambda = vec![0.0; k];
     let mut gamma = Vec::with_capacity(clusters.len());
     for &(first, r) in clusters {

@@ -619,42 +619,15 @@ impl Pencil {
     /// `Y = K X` for a block of columns (`n × q`, column-major): the matrix
     /// is streamed once per group of up to 4 columns (gather form, as
     /// [`Self::k_mul`]; the same summation order per entry).
-    pub(crate) fn k_mul_block(&self, x: MatRef<'_, f64>, mut y: MatMut<'_, f64>) {
-        const W: usize = 4;
-        let q = x.ncols();
-        // Row-interleaved copy of (up to) 4 columns, zero-padded: the gather
-        // then reads one contiguous group of 4 per entry.
-        let mut xt = vec![0.0f64; self.n * W];
-        let mut c0 = 0;
-        while c0 < q {
-            let w = (q - c0).min(W);
-            for c in 0..W {
-                if c < w {
-                    let col = col_of(x, c0 + c);
-                    for i in 0..self.n {
-                        xt[i * W + c] = col[i];
-                    }
-                } else {
-                    for i in 0..self.n {
-                        xt[i * W + c] = 0.0;
-                    }
-                }
-            }
-            for j in 0..self.n {
+    pub(crate) fn k_mul_block(&self, x: MatRef<'_, f64>, y: MatMut<'_, f64>) {
+        sym_mul_block(
+            |j| {
                 let r = self.col_ptr[j]..self.col_ptr[j + 1];
-                let mut acc = [0.0f64; W];
-                for (&i, &v) in self.row_idx[r.clone()].iter().zip(&self.k_val[r]) {
-                    let xr: &[f64; W] = xt[i * W..i * W + W].try_into().expect("W entries");
-                    for c in 0..W {
-                        acc[c] += v * xr[c];
-                    }
-                }
-                for c in 0..w {
-                    y[(j, c0 + c)] = acc[c];
-                }
-            }
-            c0 += w;
-        }
+                (&self.row_idx[r.clone()], &self.k_val[r])
+            },
+            x,
+            y,
+        );
     }
 
     /// `Y = Â X` (`n × q`) with `Â = K − s·M` whose rows and columns listed
@@ -834,6 +807,50 @@ impl Pencil {
     /// Original DOF of elimination step `index` (AMD permutation).
     fn original_dof(&self, index: usize) -> usize {
         self.ordered.fwd.get(index).copied().unwrap_or(index)
+    }
+}
+
+/// `Y = A X` for a symmetric `A` in full storage given by its columns
+/// (`col(j)` = rows and values of column `j`, which is also row `j`), `X`
+/// `n × q`. Gather form, 4 columns of `X` per pass over `A`, row-interleaved
+/// so that each stored entry reads one contiguous group of 4.
+pub(crate) fn sym_mul_block<'m>(
+    col: impl Fn(usize) -> (&'m [usize], &'m [f64]),
+    x: MatRef<'_, f64>,
+    mut y: MatMut<'_, f64>,
+) {
+    const W: usize = 4;
+    let (n, q) = (x.nrows(), x.ncols());
+    let mut xt = vec![0.0f64; n * W];
+    let mut c0 = 0;
+    while c0 < q {
+        let w = (q - c0).min(W);
+        for c in 0..W {
+            if c < w {
+                let xc = col_of(x, c0 + c);
+                for i in 0..n {
+                    xt[i * W + c] = xc[i];
+                }
+            } else {
+                for i in 0..n {
+                    xt[i * W + c] = 0.0;
+                }
+            }
+        }
+        for j in 0..n {
+            let (rows, vals) = col(j);
+            let mut acc = [0.0f64; W];
+            for (&i, &v) in rows.iter().zip(vals) {
+                let xr: &[f64; W] = xt[i * W..i * W + W].try_into().expect("W entries");
+                for c in 0..W {
+                    acc[c] += v * xr[c];
+                }
+            }
+            for c in 0..w {
+                y[(j, c0 + c)] = acc[c];
+            }
+        }
+        c0 += w;
     }
 }
 
