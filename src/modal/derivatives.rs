@@ -380,7 +380,14 @@ struct ClusterSystem<'p> {
 }
 
 impl<'p> ClusterSystem<'p> {
-    fn new(pencil: &'p Pencil, modes: &Modes, first: usize, r: usize) -> Result<Self> {
+    /// `spare`: the factorization of a previous cluster, whose buffers are
+    /// reused.
+    fn new(
+        pencil: &'p Pencil,
+        modes: &Modes,
+        (first, r): (usize, usize),
+        spare: Option<super::sparse::Factor<'p>>,
+    ) -> Result<Self> {
         let n = pencil.n();
         let mass = pencil.mass();
         let lambda_bar = modes.lambda[first..first + r].iter().sum::<f64>() / r as f64;
@@ -388,7 +395,7 @@ impl<'p> ClusterSystem<'p> {
         let rows = pivot_rows(&xc);
         let mut is_r = vec![false; n];
         rows.iter().for_each(|&i| is_r[i] = true);
-        let mut factor = pencil.factor_ldlt(lambda_bar, &rows)?;
+        let mut factor = pencil.factor_ldlt(lambda_bar, &rows, spare)?;
         let mx = Mat::<f64>::from_fn(n, r, |i, j| mass[i] * xc[(i, j)]);
         if r == 1 {
             // Nelson: the system is consistent, no border needed.
@@ -626,6 +633,7 @@ pub(crate) fn compute(
         o.dmodes = Some(Mat::<f64>::zeros(n, k));
     }
     let mass = pencil.mass();
+    let mut spare = None;
     for (ci, &(first, r)) in clusters.iter().enumerate() {
         if r > 1 {
             if let Some(v) = vars.iter().position(|d| d.d2k.is_none()) {
@@ -640,7 +648,7 @@ pub(crate) fn compute(
                 ));
             }
         }
-        let mut sys = ClusterSystem::new(pencil, modes, first, r)?;
+        let mut sys = ClusterSystem::new(pencil, modes, (first, r), spare.take())?;
         // Right-hand sides −(K' − λⱼ'M) ψⱼ for every variable and cluster member.
         let nv = vars.len();
         let mut f = Mat::<f64>::zeros(n, nv * r);
@@ -720,6 +728,7 @@ pub(crate) fn compute(
                 }
             }
         }
+        spare = Some(sys.factor);
     }
     Ok(out)
 }

@@ -756,11 +756,25 @@ impl Pencil {
 
     /// `LDLᵀ` (no pivoting) of `K − λM` with the rows and columns `fixed`
     /// replaced by the identity (Nelson's trick keeps the pattern, so the
-    /// symbolic structure is reused).
-    pub(crate) fn factor_ldlt(&self, lambda: f64, fixed: &[usize]) -> Result<Factor<'_>> {
+    /// symbolic structure is reused). `spare`: a previous `LDLᵀ` of this
+    /// pencil whose buffers (factor values, scratch, permuted right-hand
+    /// sides) are reused, avoiding fresh allocations and page faults per
+    /// factorization (faer overwrites the values).
+    pub(crate) fn factor_ldlt<'s>(
+        &'s self,
+        lambda: f64,
+        fixed: &[usize],
+        spare: Option<Factor<'s>>,
+    ) -> Result<Factor<'s>> {
         let a = self.shifted_values(lambda, fixed);
-        let mut buf = self.scratch(false);
-        let mut values = vec![0.0; self.symbolic.len_val()];
+        let (mut values, mut buf, tmp) = match spare {
+            Some(f) if matches!(f.kind, Kind::Ldlt) => (f.values, f.buf, f.tmp),
+            _ => (
+                vec![0.0; self.symbolic.len_val()],
+                self.scratch(false),
+                Mat::zeros(0, 0),
+            ),
+        };
         let sym = self.ordered_sym();
         // Pivots below 1e-10·max|Aᵢᵢ| (zero pivots of the unpivoted LDLᵀ of
         // an indefinite matrix, e.g. a Sturm-sequence zero) are replaced by
@@ -789,7 +803,7 @@ impl Pencil {
                 symbolic: &self.symbolic,
                 perm: &self.ordered.fwd,
                 values,
-                tmp: Mat::zeros(0, 0),
+                tmp,
                 kind: Kind::Ldlt,
                 buf,
             }),
