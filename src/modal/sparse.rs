@@ -6,6 +6,18 @@
 //! eigenvector derivatives. [`Pencil`] stores that one pattern, computes the
 //! fill-reducing ordering and the symbolic Cholesky structure once (faer,
 //! AMD ordering), and every numeric factorization reuses it.
+//!
+//! Performance choices (measured on the SAR panel, 4152 DOFs):
+//! - the AMD permutation is applied once to the pattern ([`Ordered`]): the
+//!   symbolic structure is computed on the permuted pattern with identity
+//!   ordering, numeric values are written straight into the permuted lower
+//!   triangle through a position map, and the solves permute the right-hand
+//!   sides themselves, so faer does not re-permute `A` at every numeric
+//!   factorization (15 per design with eigenvector derivatives);
+//! - products with `K` are gathers over columns (symmetric full storage),
+//!   4 right-hand sides per pass over `K` ([`sym_mul_block`]);
+//! - a new design's stiffness on the same input pattern is taken through a
+//!   precomputed map ([`InputMap`]) with the same checks, without re-sorting.
 
 // Index loops mirror the formulas in these numeric kernels.
 #![allow(clippy::needless_range_loop)]
