@@ -61,7 +61,7 @@ use faer::Mat;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 use super::sign_normalize;
-use super::sparse::{gmres_refine, spmv, Pencil};
+use super::sparse::{gmres_refine, spmv, sym_mul_block, Pencil, Refine};
 use super::Modes;
 use crate::error::{Error, Result};
 
@@ -223,17 +223,12 @@ fn setup_variable(
 ) -> VarSetup {
     let (n, k) = (modes.nrows(), modes.ncols());
     let mut kpx = Mat::<f64>::zeros(n, k);
-    let mut x = vec![0.0; n];
-    let mut y = vec![0.0; n];
-    for j in 0..k {
-        for (i, xi) in x.iter_mut().enumerate() {
-            *xi = modes[(i, j)];
-        }
-        spmv(dk, &x, &mut y);
-        for (i, &yi) in y.iter().enumerate() {
-            kpx[(i, j)] = yi;
-        }
-    }
+    let dkr = dk.as_ref();
+    sym_mul_block(
+        |j| (dkr.row_idx_of_col_raw(j), dkr.val_of_col(j)),
+        modes.as_ref(),
+        kpx.as_mut(),
+    );
     let mut dlambda = vec![0.0; k];
     let mut gamma = Vec::with_capacity(clusters.len());
     for &(first, r) in clusters {
@@ -282,20 +277,49 @@ fn setup_variable(
     }
 }
 
-/// Solve `Â X = B` where `Â` is `K − λ̄M` with the rows and columns marked
-/// in `is_r` replaced by the identity: one block solve with the (possibly
-/// regularised) `LDLᵀ`, then Krylov refinement per column to 1e-13.
+/// Solve `Â X = B` where `Â` is `K − λ̄M` with the rows and columns `rows`
+/// (marked in `is_r`) replaced by the identity: one block solve with the
+/// (possibly regularised) `LDLᵀ`, then Krylov refinement per column to
+/// 1e-13. The residuals and the first GMRES step (one solve, one product)
+/// are computed for all columns at once (block solve and one pass over `K`);
+/// further GMRES steps, when needed, run per column.
 fn refined_solve(
     pencil: &Pencil,
     factor: &mut super::sparse::Factor<'_>,
     lambda_bar: f64,
-    is_r: &[bool],
+    (rows, is_r): (&[usize], &[bool]),
     b: &Mat<f64>,
 ) -> Result<Mat<f64>> {
-    let n = b.nrows();
+    const TOL: f64 = 1e-13;
+    let (n, q) = (b.nrows(), b.ncols());
     let mass = pencil.mass();
     let mut x = b.clone();
     factor.solve_in_place(x.as_mut());
+    // Residuals R = B − ÂX of all columns.
+    let mut res = Mat::<f64>::zeros(n, q);
+    pencil.shifted_mul_block(lambda_bar, rows, x.as_ref(), res.as_mut());
+    let norm = |m: &Mat<f64>, j: usize| m.col(j).iter().map(|v| v * v).sum::<f64>().sqrt();
+    let mut todo = Vec::new();
+    for j in 0..q {
+        for i in 0..n {
+            res[(i, j)] = b[(i, j)] - res[(i, j)];
+        }
+        let (beta, bn) = (norm(&res, j), norm(b, j).max(f64::MIN_POSITIVE));
+        if beta > TOL * bn {
+            todo.push((j, beta));
+        }
+    }
+    if todo.is_empty() {
+        return Ok(x);
+    }
+    // First GMRES step of every unconverged column: Z = F⁻¹ R/β, W = ÂZ.
+    let mut z = Mat::<f64>::from_fn(n, todo.len(), |i, c| {
+        let (j, beta) = todo[c];
+        res[(i, j)] / beta
+    });
+    factor.solve_in_place(z.as_mut());
+    let mut w = Mat::<f64>::zeros(n, todo.len());
+    pencil.shifted_mul_block(lambda_bar, rows, z.as_ref(), w.as_mut());
     let apply = |v: &[f64], y: &mut [f64]| {
         let vn: Vec<f64> = (0..n).map(|i| if is_r[i] { 0.0 } else { v[i] }).collect();
         pencil.k_mul(&vn, y);
@@ -307,16 +331,26 @@ fn refined_solve(
             };
         }
     };
-    for j in 0..b.ncols() {
-        let bj: Vec<f64> = (0..n).map(|i| b[(i, j)]).collect();
-        let mut xj: Vec<f64> = (0..n).map(|i| x[(i, j)]).collect();
-        let res = gmres_refine(factor, &apply, &bj, &mut xj, 1e-13, 40);
-        if res.is_nan() || res > 1e-10 {
+    for (c, &(j, _)) in todo.iter().enumerate() {
+        let bj: Vec<f64> = b.col(j).iter().copied().collect();
+        let mut xj: Vec<f64> = x.col(j).iter().copied().collect();
+        let job = Refine {
+            b: &bj,
+            tol: TOL,
+            max_iter: 40,
+            residual: Some(res.col(j).iter().copied().collect()),
+            first: Some((
+                z.col(c).iter().copied().collect(),
+                w.col(c).iter().copied().collect(),
+            )),
+        };
+        let rj = gmres_refine(factor, &apply, &mut xj, job);
+        if rj.is_nan() || rj > 1e-10 {
             return Err(Error::numerical(
                 "modal::derivatives",
                 format!(
                     "refined solve with K - lambda*M (lambda = {lambda_bar:e}) stalled at \
-                     relative residual {res:e}"
+                     relative residual {rj:e}"
                 ),
             ));
         }
@@ -346,7 +380,14 @@ struct ClusterSystem<'p> {
 }
 
 impl<'p> ClusterSystem<'p> {
-    fn new(pencil: &'p Pencil, modes: &Modes, first: usize, r: usize) -> Result<Self> {
+    /// `spare`: the factorization of a previous cluster, whose buffers are
+    /// reused.
+    fn new(
+        pencil: &'p Pencil,
+        modes: &Modes,
+        (first, r): (usize, usize),
+        spare: Option<super::sparse::Factor<'p>>,
+    ) -> Result<Self> {
         let n = pencil.n();
         let mass = pencil.mass();
         let lambda_bar = modes.lambda[first..first + r].iter().sum::<f64>() / r as f64;
@@ -354,7 +395,7 @@ impl<'p> ClusterSystem<'p> {
         let rows = pivot_rows(&xc);
         let mut is_r = vec![false; n];
         rows.iter().for_each(|&i| is_r[i] = true);
-        let mut factor = pencil.factor_ldlt(lambda_bar, &rows)?;
+        let mut factor = pencil.factor_ldlt(lambda_bar, &rows, spare)?;
         let mx = Mat::<f64>::from_fn(n, r, |i, j| mass[i] * xc[(i, j)]);
         if r == 1 {
             // Nelson: the system is consistent, no border needed.
@@ -386,7 +427,7 @@ impl<'p> ClusterSystem<'p> {
                 }
             }
         }
-        let y = refined_solve(pencil, &mut factor, lambda_bar, &is_r, &y)?;
+        let y = refined_solve(pencil, &mut factor, lambda_bar, (&rows, &is_r), &y)?;
         let y1 = Mat::<f64>::from_fn(n, r, |i, j| if is_r[i] { 0.0 } else { y[(i, j)] });
         let y2 = Mat::<f64>::from_fn(n, r, |i, j| if is_r[i] { 0.0 } else { y[(i, r + j)] });
         let mut sys = ClusterSystem {
@@ -460,7 +501,13 @@ impl<'p> ClusterSystem<'p> {
         let mut is_r = vec![false; n];
         self.rows.iter().for_each(|&i| is_r[i] = true);
         let z = Mat::<f64>::from_fn(n, q, |i, j| if is_r[i] { 0.0 } else { f[(i, j)] });
-        let mut z = refined_solve(self.pencil, &mut self.factor, self.lambda_bar, &is_r, &z)?;
+        let mut z = refined_solve(
+            self.pencil,
+            &mut self.factor,
+            self.lambda_bar,
+            (&self.rows, &is_r),
+            &z,
+        )?;
         for j in 0..q {
             for i in 0..n {
                 if is_r[i] {
@@ -586,6 +633,7 @@ pub(crate) fn compute(
         o.dmodes = Some(Mat::<f64>::zeros(n, k));
     }
     let mass = pencil.mass();
+    let mut spare = None;
     for (ci, &(first, r)) in clusters.iter().enumerate() {
         if r > 1 {
             if let Some(v) = vars.iter().position(|d| d.d2k.is_none()) {
@@ -600,7 +648,7 @@ pub(crate) fn compute(
                 ));
             }
         }
-        let mut sys = ClusterSystem::new(pencil, modes, first, r)?;
+        let mut sys = ClusterSystem::new(pencil, modes, (first, r), spare.take())?;
         // Right-hand sides −(K' − λⱼ'M) ψⱼ for every variable and cluster member.
         let nv = vars.len();
         let mut f = Mat::<f64>::zeros(n, nv * r);
@@ -680,6 +728,7 @@ pub(crate) fn compute(
                 }
             }
         }
+        spare = Some(sys.factor);
     }
     Ok(out)
 }
