@@ -63,6 +63,11 @@ fn each_bad_input_names_file_key_and_value() {
         (BASE.replace("effects = [\"gravity\"]", "effects = [\"gravitee\"]"), "scene.effects[0]", "gravitee"),
         (BASE.replace("\"pin.angle\"", "\"pn.angle\""), "scene.outputs.quantities[0]", "pn.angle"),
         (
+            BASE.replace("quantities = [\"pin.angle\"]", "quantities = [\"pin.angle\"]\nplot = \"pin.angle\"\nplot_file = \"../x\""),
+            "scene.outputs.plot_file",
+            "../x",
+        ),
+        (
             BASE.to_string()
                 + "[[scene.markers]]\nname = \"m\"\nbody = \"rod\"\npoint = [1.0, 0.0, 0.0]\n"
                 + "[[scene.forces]]\ntype = \"spring\"\nmarker_i = \"m\"\nmarker_j = \"nowhere\"\nstiffness = 1.0\n",

@@ -42,14 +42,21 @@ fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 #[test]
 fn shipped_scene_studies_run_and_write_history() {
     let out = temp_dir("mbs-studies");
-    // (file, end time, output interval, extra file expected)
-    for (file, t_end, dt, extra) in [
-        ("dzhanibekov.toml", 10.0f64, 0.025f64, "energy.svg"),
-        ("fourbar.toml", 10.0, 0.002, "O4.rate.svg"),
-        ("bricard.toml", 10.0, 0.01, "J0.angle.svg"),
-        ("andrews.toml", 0.03, 5e-4, "sensitivities.csv"),
-        ("sar_phase1_rigid.toml", 3.0, 0.01, "sensitivities.csv"),
-    ] {
+    // (file, end time, output interval, extra files expected)
+    let cases: [(&str, f64, f64, &[&str]); 5] = [
+        ("dzhanibekov.toml", 10.0, 0.025, &["energy.svg"]),
+        ("fourbar.toml", 10.0, 0.002, &["O4.rate.svg"]),
+        ("bricard.toml", 10.0, 0.01, &["J0.angle.svg"]),
+        ("andrews.toml", 0.03, 5e-4, &["sensitivities.csv"]),
+        // The SAR study names its plot: outputs.plot_file = "theta".
+        (
+            "sar_phase1_rigid.toml",
+            3.0,
+            0.01,
+            &["sensitivities.csv", "theta.svg"],
+        ),
+    ];
+    for (file, t_end, dt, extra) in cases {
         let study = Study::load(study_path(file)).unwrap();
         let cfg = RunConfig {
             study: study.clone(),
@@ -59,7 +66,7 @@ fn shipped_scene_studies_run_and_write_history() {
         };
         run_study(&cfg).unwrap_or_else(|e| panic!("{file}: {e}"));
         let dir = out.join(study.name());
-        for f in ["history.csv", "stats.csv", extra] {
+        for f in ["history.csv", "stats.csv"].iter().chain(extra) {
             assert!(dir.join(f).is_file(), "{file}: no {f}");
         }
         let (header, rows) = read_csv(&dir.join("history.csv"));

@@ -23,7 +23,7 @@
 //! type = "load"; body, force, torque
 //! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out
 //! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation"]
-//!                  plot = "R3.angle"
+//!                  plot = "R3.angle"; plot_file = "theta"   # theta.svg
 //! ```
 //! Bodies start with their axes along the global axes, so `inertia` is
 //! both the global and the body-frame tensor at `t = 0`.
@@ -179,6 +179,9 @@ pub struct OutputSpec {
     #[serde(default)]
     pub quantities: Vec<String>,
     pub plot: Option<String>,
+    /// File stem of the plot (default: the plotted output's name), e.g.
+    /// `theta` for `theta.svg`.
+    pub plot_file: Option<String>,
 }
 
 /// One output column.
@@ -201,6 +204,8 @@ pub struct Scene {
     pub options: Options,
     pub outputs: Vec<(String, Quantity)>,
     pub plot: Option<String>,
+    /// File stem of the plot (`<plot_file>.svg`).
+    pub plot_file: Option<String>,
     pub effects: Vec<String>,
     /// Sensitivity parameters with their names from the scene file.
     pub params: Vec<(String, Param)>,
@@ -584,6 +589,20 @@ impl SceneSpec {
                 }
             }
         }
+        if let Some(f) = &self.outputs.plot_file {
+            if self.outputs.plot.is_none()
+                || f.is_empty()
+                || f.contains(['/', '\\'])
+                || f == "."
+                || f == ".."
+            {
+                return Err(Error::input(
+                    "outputs.plot_file",
+                    format!("\"{f}\""),
+                    "a file name without path separators, together with outputs.plot",
+                ));
+            }
+        }
         let mut params = Vec::new();
         for (k, name) in self.sensitivities.iter().enumerate() {
             let key = format!("sensitivities[{k}]");
@@ -605,6 +624,7 @@ impl SceneSpec {
             options,
             outputs,
             plot: self.outputs.plot.clone(),
+            plot_file: self.outputs.plot_file.clone(),
             effects: self.effects.clone(),
             params,
         })

@@ -190,7 +190,8 @@ fn output_sensitivities(
     out
 }
 
-/// Write `history.csv`, `stats.csv` and (if asked) `<output>.svg` into `dir`.
+/// Write `history.csv`, `stats.csv` and (if asked) `<plot_file or output>.svg`
+/// into `dir`.
 pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>> {
     let hist = dir.join("history.csv");
     let mut w = csv::Writer::from_path(&hist).map_err(|e| Error::csv(&hist, e))?;
@@ -262,7 +263,8 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
             .iter()
             .position(|h| h.starts_with(name.as_str()));
         if let Some(col) = col {
-            let path = dir.join(format!("{name}.svg"));
+            let stem = scene.plot_file.as_deref().unwrap_or(name);
+            let path = dir.join(format!("{stem}.svg"));
             plot_svg(&path, &sim.headers[col], &sim.rows, col)?;
             written.push(path);
         }
