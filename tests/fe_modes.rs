@@ -1,74 +1,23 @@
-//! K and M together: natural frequencies of a simply supported plate against
-//! the closed form, and (ignored, run by hand) the mesh convergence of the
-//! SAR panel's lowest modes and the assembly time.
-//!
-//! The eigen-solver here is a small test-only shift-invert subspace
-//! iteration (the crate's own solver lives in `modal`).
+//! K and M together, solved by the crate's modal solver: natural
+//! frequencies of simply supported plates against closed forms, the
+//! free–free rigid-body count, and (ignored, run by hand) the mesh
+//! convergence of the SAR panel's 14 lowest modes. Assembly and modal
+//! timings are measured by `studies/panel_convergence.toml`, not here.
 
-use faer::prelude::*;
-use faer::sparse::SparseColMat;
-use faer::Side;
-use nalgebra::DMatrix;
 use plyscape::fe::{Derivatives, Mesh, MeshParams, PanelModel, PanelSystem, Support};
 use plyscape::laminate::{DesignMap, Laminate, Orthotropic, Ply};
+use plyscape::modal::{ModalOptions, ModalSolver};
 
-/// Lowest `nev` eigenvalues of K x = λ M x (M diagonal) by subspace
-/// iteration on (K − σM)⁻¹M with Rayleigh–Ritz, deterministic start.
+/// Lowest `nev` eigenvalues of K x = λ M x by the crate's shift-invert
+/// Lanczos (`modal`), shift σ below the lowest eigenvalue.
 fn lowest_eigenvalues(sys: &PanelSystem, sigma: f64, nev: usize) -> Vec<f64> {
-    let n = sys.n_dof();
-    let p = nev + 10;
-    let mut kv = sys.k.val().to_vec();
-    let k = sys.k.as_ref();
-    for j in 0..n {
-        let range = k.col_ptr()[j]..k.col_ptr()[j + 1];
-        let diag = range.start
-            + k.row_idx()[range]
-                .binary_search(&j)
-                .expect("diagonal stored");
-        kv[diag] -= sigma * sys.m_diag[j];
-    }
-    let ks = SparseColMat::new(sys.k.symbolic().to_owned().unwrap(), kv);
-    let llt = ks
-        .sp_cholesky(Side::Lower)
-        .expect("K − σM positive definite");
-    let mut x = Mat::<f64>::from_fn(n, p, |i, j| {
-        ((i * 7 + 3) as f64 * (j + 1) as f64 * 0.618).sin()
-    });
-    let mut prev = vec![f64::INFINITY; nev];
-    for _ in 0..500 {
-        let mx = Mat::<f64>::from_fn(n, p, |i, j| sys.m_diag[i] * x[(i, j)]);
-        let y = llt.solve(&mx);
-        // Reduced pencil: Yᵀ(K−σM)Y = YᵀMX, YᵀMY.
-        let kr = DMatrix::<f64>::from_fn(p, p, |a, b| (0..n).map(|i| y[(i, a)] * mx[(i, b)]).sum());
-        let mr = DMatrix::<f64>::from_fn(p, p, |a, b| {
-            (0..n).map(|i| y[(i, a)] * sys.m_diag[i] * y[(i, b)]).sum()
-        });
-        let kr = (&kr + kr.transpose()) * 0.5;
-        let l = mr.cholesky().expect("Ritz basis independent").l();
-        let li = l.clone().try_inverse().unwrap();
-        let s = &li * kr * li.transpose();
-        let eig = s.symmetric_eigen();
-        let mut order: Vec<usize> = (0..p).collect();
-        order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
-        let q = li.transpose() * &eig.eigenvectors;
-        x = Mat::<f64>::from_fn(n, p, |i, j| {
-            let c = order[j];
-            (0..p).map(|a| y[(i, a)] * q[(a, c)]).sum()
-        });
-        let lam: Vec<f64> = order[..nev]
-            .iter()
-            .map(|&c| sigma + eig.eigenvalues[c])
-            .collect();
-        let done = lam
-            .iter()
-            .zip(&prev)
-            .all(|(a, b)| (a - b).abs() <= 1e-11 * a.abs().max(1e-300));
-        prev = lam;
-        if done {
-            break;
-        }
-    }
-    prev
+    let mut opts = ModalOptions::new(nev);
+    opts.shift = sigma;
+    ModalSolver::new(&sys.k, &sys.m_diag)
+        .unwrap()
+        .solve(&opts)
+        .unwrap()
+        .lambda
 }
 
 #[test]
@@ -269,93 +218,5 @@ fn sar_panel_mode_convergence() {
                 e.join(" ")
             );
         }
-    }
-}
-
-/// CPU time of this thread \[ms\] from /proc/thread-self/schedstat (Linux;
-/// immune to other processes on a loaded machine), or wall time elsewhere.
-fn cpu_ms(wall0: std::time::Instant) -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map(|ns| ns * 1e-6)
-        .unwrap_or_else(|| wall0.elapsed().as_secs_f64() * 1e3)
-}
-
-/// Measurement, not a check: assembly time (median and min of 21) of the
-/// SAR panel (the minimum is the better estimate on a loaded machine).
-/// `cargo test --release --test fe_modes assembly_time -- --ignored --nocapture`
-#[test]
-#[ignore]
-fn sar_panel_assembly_time() {
-    let lam = sar_laminate([0.0, 90.0, 90.0, 0.0]);
-    let map = DesignMap::symmetric(4);
-    for div in [20, 40, 64, 80] {
-        let model = sar_panel3(div, Support::CentreClamp);
-        for want in [Derivatives::None, Derivatives::Second] {
-            let mut t = Vec::new();
-            // Wall time per run (median, min) and CPU time averaged over the
-            // batch (schedstat is updated at scheduler ticks: per-run CPU
-            // deltas would be quantised).
-            let w0 = std::time::Instant::now();
-            let c0 = cpu_ms(w0);
-            for _ in 0..21 {
-                let t0 = std::time::Instant::now();
-                let sys = model.assemble(&lam, &map, want).unwrap();
-                t.push(t0.elapsed().as_secs_f64() * 1e3);
-                std::hint::black_box(sys);
-            }
-            let cpu = (cpu_ms(w0) - c0) / 21.0;
-            t.sort_by(f64::total_cmp);
-            eprintln!(
-                "assembly div {div} ({} DOF, {} elements) {want:?}: wall median {:.3} ms, min {:.3} ms; CPU mean {cpu:.3} ms",
-                model.n_dof(),
-                model.mesh().triangles.len(),
-                t[10],
-                t[0]
-            );
-        }
-        let mut sys = model.assemble(&lam, &map, Derivatives::Second).unwrap();
-        let mut t = Vec::new();
-        for _ in 0..21 {
-            let t0 = std::time::Instant::now();
-            model.assemble_into(&lam, &map, &mut sys).unwrap();
-            t.push(t0.elapsed().as_secs_f64() * 1e3);
-        }
-        t.sort_by(f64::total_cmp);
-        eprintln!(
-            "  assemble_into (buffers reused) Second: wall median {:.3} ms, min {:.3} ms",
-            t[10], t[0]
-        );
-        let mut sys = model.assemble(&lam, &map, Derivatives::None).unwrap();
-        let mut t = Vec::new();
-        for _ in 0..21 {
-            let t0 = std::time::Instant::now();
-            model.assemble_into(&lam, &map, &mut sys).unwrap();
-            t.push(t0.elapsed().as_secs_f64() * 1e3);
-        }
-        t.sort_by(f64::total_cmp);
-        eprintln!(
-            "  assemble_into (buffers reused) None: wall median {:.3} ms, min {:.3} ms",
-            t[10], t[0]
-        );
-        let mut t = Vec::new();
-        for _ in 0..21 {
-            let t0 = std::time::Instant::now();
-            std::hint::black_box(sys.k.clone());
-            t.push(t0.elapsed().as_secs_f64() * 1e3);
-        }
-        t.sort_by(f64::total_cmp);
-        eprintln!(
-            "  nnz {}: copying K alone takes min {:.3} ms",
-            sys.k.val().len(),
-            t[0]
-        );
-        let t0 = std::time::Instant::now();
-        let _ = sar_panel3(div, Support::CentreClamp);
-        eprintln!(
-            "model build (mesh + pattern) div {div}: {:.3} ms",
-            t0.elapsed().as_secs_f64() * 1e3
-        );
     }
 }

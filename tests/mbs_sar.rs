@@ -2,9 +2,8 @@
 //! from /work/shared/design/sar_geometry.json, a reconstruction).
 use plyscape::integrate::Method;
 use plyscape::mbs::simulate::{load_scene, simulate};
-use plyscape::mbs::{System, Workspace};
+use plyscape::mbs::Workspace;
 use plyscape::study::Study;
-use std::time::Instant;
 
 fn sar() -> plyscape::mbs::scene::Scene {
     let study = Study::load(concat!(
@@ -107,71 +106,4 @@ fn sar_phase1_methods_agree() {
             finals[0][2]
         );
     }
-}
-
-/// Timing of the right-hand side and of the whole 0–3 s run (release;
-/// run with `--ignored --nocapture`).
-#[test]
-#[ignore]
-fn sar_timing() {
-    let mut scene = sar();
-    let params = std::mem::take(&mut scene.params);
-    let sys = System::new(scene.model.clone());
-    let mut y = sys.initial_state();
-    sys.project(0.0, &mut y).unwrap();
-    let mut dy = vec![0.0; y.len()];
-    let mut ws = Workspace::empty();
-    sys.rhs(0.0, &y, &mut dy, &mut ws);
-    let m = ws.rows.len();
-    let nnz: usize = (0..m)
-        .map(|i| (0..=i).filter(|&j| ws.a[i * m + j] != 0.0).count())
-        .sum();
-    println!(
-        "factor: {m} rows, {nnz} non-zeros in L (dense {})",
-        m * (m + 1) / 2
-    );
-    // Minimum over batches: robust against other load on a shared VM.
-    let best = |f: &mut dyn FnMut()| {
-        let mut best = f64::INFINITY;
-        for _ in 0..40 {
-            let t = Instant::now();
-            for _ in 0..250 {
-                f();
-            }
-            best = best.min(t.elapsed().as_secs_f64() / 250.0);
-        }
-        best * 1e6
-    };
-    let t_f64 = best(&mut || sys.rhs(0.0, &y, &mut dy, &mut ws));
-    println!("rhs f64: {t_f64:.2} us (min over batches)");
-    let yd: Vec<num_dual::Dual64> = y.iter().map(|&v| num_dual::Dual64::new(v, 1.0)).collect();
-    let mut dyd = yd.clone();
-    let mut wsd = Workspace::empty();
-    let t_dual = best(&mut || sys.rhs(0.0, &yd, &mut dyd, &mut wsd));
-    println!("rhs dual (one Jacobian-vector product): {t_dual:.2} us");
-    let mut times = vec![];
-    for _ in 0..9 {
-        let t = Instant::now();
-        let (_, sim) = simulate(&scene).unwrap();
-        times.push(t.elapsed().as_secs_f64());
-        println!("{:?}", sim.stats);
-    }
-    times.sort_by(f64::total_cmp);
-    let mut with_sens = sar();
-    with_sens.params = params;
-    let mut st = vec![];
-    for _ in 0..5 {
-        st.push(simulate(&with_sens).unwrap().1.stats.wall);
-    }
-    st.sort_by(f64::total_cmp);
-    println!(
-        "with {} sensitivities: integration median of 5 {:.2} ms",
-        with_sens.params.len(),
-        st[2] * 1e3
-    );
-    println!(
-        "simulate 0-3 s (with outputs): median of 9 {:.2} ms, min {:.2} ms",
-        times[4] * 1e3,
-        times[0] * 1e3
-    );
 }

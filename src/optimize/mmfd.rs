@@ -53,7 +53,9 @@
 //! gradients counts one function call and one gradient call.
 
 use super::driver::{self, OptState, Recorded};
-use super::{qp, Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination};
+use super::{
+    qp, Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination, Variable,
+};
 use crate::error::{Error, Result};
 use argmin::core::{
     Problem as ArgminProblem, Solver, State, TerminationReason, TerminationStatus, KV,
@@ -214,6 +216,12 @@ pub struct Mmfd {
 
 type Ap<'a> = ArgminProblem<Counted<'a>>;
 
+/// The design variables of the wrapped problem (none if argmin has taken
+/// the problem out, which it does not while a solver step runs).
+fn variables<'p>(problem: &'p Ap<'_>) -> &'p [Variable] {
+    problem.problem.as_ref().map_or(&[], |c| c.variables())
+}
+
 fn evaluate(problem: &mut Ap<'_>, x: &[f64], gradients: bool) -> Result<Evaluation> {
     let key = if gradients {
         "gradient_count"
@@ -357,11 +365,7 @@ impl Mmfd {
 
     /// Design at scaled offset `z` from `x`: wrapped (periodic) or clamped.
     fn moved(&self, problem: &Ap<'_>, x: &[f64], z: &[f64]) -> Vec<f64> {
-        let vars = problem
-            .problem
-            .as_ref()
-            .map(|c| c.variables())
-            .unwrap_or(&[]);
+        let vars = variables(problem);
         vars.iter()
             .enumerate()
             .map(|(i, v)| v.wrap(x[i] + z[i] * self.range[i]))
@@ -418,11 +422,7 @@ impl Mmfd {
     /// Largest α keeping `y + c₀ + αS` inside the bounds of the non-periodic
     /// variables.
     fn alpha_max(&self, problem: &Ap<'_>, sr: &Search<'_>) -> f64 {
-        let vars = problem
-            .problem
-            .as_ref()
-            .map(|c| c.variables())
-            .unwrap_or(&[]);
+        let vars = variables(problem);
         let snorm = sr.s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let mut amax = f64::INFINITY;
         for (i, v) in vars.iter().enumerate() {
@@ -631,11 +631,7 @@ impl Mmfd {
 
     /// Scaled step length `|Δy|` between two designs.
     fn scaled_distance(&self, problem: &Ap<'_>, a: &[f64], b: &[f64]) -> f64 {
-        let vars = problem
-            .problem
-            .as_ref()
-            .map(|c| c.variables())
-            .unwrap_or(&[]);
+        let vars = variables(problem);
         vars.iter()
             .enumerate()
             .map(|(i, v)| (v.difference(a[i], b[i]) / self.range[i]).powi(2))
@@ -651,11 +647,7 @@ impl Mmfd {
         gg: &[Vec<f64>],
     ) -> Result<Option<Point>> {
         let o = self.options.clone();
-        let vars: Vec<_> = problem
-            .problem
-            .as_ref()
-            .map(|c| c.variables().to_vec())
-            .unwrap_or_default();
+        let vars = variables(problem).to_vec();
         let n = vars.len();
         let mut rows = Vec::new();
         let mut b = Vec::new();
@@ -704,11 +696,7 @@ impl Mmfd {
     /// One MMFD iteration (steps 1–6 of the module doc).
     fn iterate(&mut self, problem: &mut Ap<'_>) -> Result<()> {
         let o = self.options.clone();
-        let vars: Vec<_> = problem
-            .problem
-            .as_ref()
-            .map(|c| c.variables().to_vec())
-            .unwrap_or_default();
+        let vars = variables(problem).to_vec();
         let n = vars.len();
         let x = match &self.current {
             Some(p) => p.x.clone(),
