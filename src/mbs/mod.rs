@@ -41,6 +41,7 @@
 pub mod analysis;
 pub mod bench;
 pub mod dynamics;
+pub mod flex;
 pub mod linalg;
 pub mod model;
 pub mod scene;
@@ -48,6 +49,7 @@ pub mod simulate;
 
 pub use analysis::{Projection, Reaction};
 pub use dynamics::{System, Workspace};
+pub use flex::{BasisDerivative, Invariants, ModalBasis};
 pub use model::{
     Body, Drive, Force, Joint, JointKind, Marker, Model, Param, PiecewiseLaw, Segment,
 };
