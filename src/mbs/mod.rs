@@ -39,6 +39,7 @@
 //!   for angle, rate and position outputs only (`sensitivities.csv`).
 
 pub mod analysis;
+pub mod beam;
 pub mod bench;
 pub mod dynamics;
 pub mod flex;

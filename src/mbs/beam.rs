@@ -1,0 +1,850 @@
+//! A closed-form flexible body: the uniform Euler–Bernoulli cantilever
+//! beam as a [`ModalBasis`], with its quasi-static deflections.
+//!
+//! ## Model
+//! The beam lies along the body x axis from the clamped root `x = 0` (the
+//! body-frame origin) to the free tip `x = L`, with bending stiffnesses
+//! `EI_z` (deflection `v` along y, small rotation about z = `+v'`) and
+//! `EI_y` (deflection `w` along z, small rotation about y = `−w'`) and
+//! mass per length `ρA`. No axial or torsion modes, no rotary inertia,
+//! no shear deformation (Euler–Bernoulli).
+//!
+//! ## Modes (closed form)
+//! `EI φ'''' = λ ρA φ` with `φ(0) = φ'(0) = 0`, `φ''(L) = φ'''(L) = 0`
+//! has the eigenvalues `λ_j = ω_j² = (β_j L)⁴ EI / (ρA L⁴)`, where `β_j L`
+//! are the roots of `1 + cos βL cosh βL = 0` ([`cantilever_root`]), and
+//! the modes (Blevins, *Formulas for Natural Frequency and Mode Shape*,
+//! Table 8-1, clamped-free)
+//! `φ_j(x) = C_j [cosh βx − cos βx − σ_j (sinh βx − sin βx)]`,
+//! `σ_j = (cosh βL + cos βL) / (sinh βL + sin βL)`.
+//! Because `∫₀ᴸ [cosh − cos − σ(sinh − sin)]² dx = L` (same table),
+//! `C_j = ±1/√(ρA L)` makes the modes mass-normalized,
+//! `∫ ρA φ_i φ_j dx = δ_ij`. Sign convention: the tip displacement is
+//! positive, `φ_j(L) = +2/√(ρA L)` for every mode.
+//!
+//! The textbook form loses all digits beyond `βL ≈ 20` (it subtracts
+//! `cosh` and `σ sinh`, both `≈ e^{βx}/2`, with `1 − σ ≈ e^{−βL}`). It is
+//! evaluated here as `cosh z − σ sinh z = ((1−σ)e^{z} + (1+σ)e^{−z})/2`
+//! with `(1 − σ) e^{βL} = 2 (sin βL − cos βL − e^{−βL}) / D`,
+//! `σ = (1 + e^{−2βL} + 2e^{−βL} cos βL) / D`,
+//! `D = 1 − e^{−2βL} + 2 e^{−βL} sin βL`: only bounded exponentials
+//! `e^{−βL}`, `e^{βx − βL}`, `e^{−βx}` appear, so every mode is accurate to
+//! rounding relative to its amplitude.
+//!
+//! ## Nodes and mass lumping
+//! The floating-frame kernel sees the beam through nodes with lumped
+//! masses ([`ModalBasis`]). The masses sit at the points of a composite
+//! Gauss–Legendre rule (`segments` equal segments × [`GAUSS_POINTS`]
+//! points, exact for polynomials of degree 11 on each segment) with
+//! weights `ρA w_i`, so that every invariant of
+//! [`crate::mbs::flex::Invariants`] is the Gauss quadrature of the
+//! corresponding integral of the continuous modes (`mww = I`,
+//! `mass = ρA L`, `∫ ρA x φ_j dx`, …) to ~1e-12 when the segments resolve
+//! the highest mode ([`Beam::segments_for`]). Zero-mass nodes carry the
+//! markers:
+//!
+//! | node | position |
+//! |---|---|
+//! | 0 ([`ROOT_NODE`]) | root, `x = 0` |
+//! | 1 ([`TIP_NODE`]) | tip, `x = L` |
+//! | 2..=10 | stations `x = kL/10`, `k = 1..9` ([`station_node`]) |
+//! | 11.. | the quadrature points (masses `ρA w_i`), in increasing `x` |
+//!
+//! ## Quasi-static deflections
+//! [`Beam::static_deflection`] gives the closed-form deflection curves of
+//! the cantilever under a tip force, a uniform load and the linearly
+//! varying load `p(x) = p_L x / L` (the inertial load of a spin-up about
+//! the root with angular acceleration `α`: `|p_L| = ρA α L`, against the
+//! sense of rotation), for checking
+//! slow-loading simulations against statics.
+
+use super::flex::ModalBasis;
+use crate::error::{Error, Result};
+use nalgebra::Vector3;
+use std::f64::consts::PI;
+
+/// Gauss–Legendre points per segment of the mass-lumping rule (exact for
+/// polynomials of degree `2·6 − 1 = 11` on each segment).
+pub const GAUSS_POINTS: usize = 6;
+/// Node index of the root (`x = 0`, zero mass).
+pub const ROOT_NODE: usize = 0;
+/// Node index of the tip (`x = L`, zero mass).
+pub const TIP_NODE: usize = 1;
+/// Number of zero-mass station nodes (root, tip and the nine interior
+/// tenths) before the quadrature nodes.
+pub const STATION_NODES: usize = 11;
+
+/// The node at the station `x = k L / 10` (`k = 0..=10`): 0 is the root,
+/// 10 the tip; `None` for `k > 10`.
+pub fn station_node(k: usize) -> Option<usize> {
+    match k {
+        0 => Some(ROOT_NODE),
+        10 => Some(TIP_NODE),
+        1..=9 => Some(k + 1),
+        _ => None,
+    }
+}
+
+/// Bending plane of a mode or a load.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Plane {
+    /// Deflection `v` along body y, rotation about z (`+v'`); stiffness `EI_z`.
+    Y,
+    /// Deflection `w` along body z, rotation about y (`−w'`); stiffness `EI_y`.
+    Z,
+}
+
+/// A static load on the cantilever (in one bending plane).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StaticLoad {
+    /// Force `F` (N) at the tip.
+    Tip(f64),
+    /// Uniform distributed load `q` (N/m).
+    Uniform(f64),
+    /// Linearly varying load `p(x) = p_L x / L` with tip value `p_L` (N/m).
+    Linear(f64),
+}
+
+/// A uniform Euler–Bernoulli cantilever beam along body x (see the module
+/// doc for axes and conventions).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Beam {
+    /// Length `L` (m).
+    pub length: f64,
+    /// Bending stiffness for deflection along body z, rotation about y
+    /// (N·m²).
+    pub ei_y: f64,
+    /// Bending stiffness for deflection along body y, rotation about z
+    /// (N·m²).
+    pub ei_z: f64,
+    /// Mass per unit length `ρA` (kg/m).
+    pub rho_a: f64,
+}
+
+/// `key.name`, or `name` alone when `key` is empty.
+fn sub(key: &str, name: &str) -> String {
+    if key.is_empty() {
+        name.to_string()
+    } else {
+        format!("{key}.{name}")
+    }
+}
+
+impl Beam {
+    /// Check that length, stiffnesses and mass per length are finite and
+    /// positive; `key` prefixes the error keys (empty: none).
+    pub fn validate(&self, key: &str) -> Result<()> {
+        for (name, v, unit) in [
+            ("length", self.length, "m"),
+            ("ei_y", self.ei_y, "N·m²"),
+            ("ei_z", self.ei_z, "N·m²"),
+            ("rho_a", self.rho_a, "kg/m"),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::input(
+                    sub(key, name),
+                    v,
+                    format!("a finite value > 0 ({unit})"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Bending stiffness of `plane` (N·m²).
+    pub fn stiffness(&self, plane: Plane) -> f64 {
+        match plane {
+            Plane::Y => self.ei_z,
+            Plane::Z => self.ei_y,
+        }
+    }
+
+    /// Eigenvalue `λ_j = (β_j L)⁴ EI / (ρA L⁴)` (1/s²) of mode `j`
+    /// (0-based) in `plane`.
+    pub fn eigenvalue(&self, plane: Plane, j: usize) -> f64 {
+        let b = cantilever_root(j) / self.length;
+        b.powi(4) * self.stiffness(plane) / self.rho_a
+    }
+
+    /// Natural circular frequency `ω_j = (β_j L)² √(EI / (ρA L⁴))`
+    /// (rad/s) of mode `j` (0-based) in `plane`.
+    pub fn frequency(&self, plane: Plane, j: usize) -> f64 {
+        let b = cantilever_root(j) / self.length;
+        b * b * (self.stiffness(plane) / self.rho_a).sqrt()
+    }
+
+    /// Mass-normalized mode `j` (0-based) at `x ∈ [0, L]`: `(φ_j(x),
+    /// φ_j'(x))` in 1/√kg and 1/(m·√kg). The shape is the same in both
+    /// planes (uniform section); `φ_j(L) > 0`.
+    pub fn mode(&self, j: usize, x: f64) -> (f64, f64) {
+        let d = ModeFn::new(j, self.length, self.rho_a).eval(x);
+        (d[0], d[1])
+    }
+
+    /// The basis columns in order: `(plane, j)` of each mode, both planes
+    /// merged by increasing frequency, ties with plane Y first.
+    pub fn mode_order(&self, modes_per_plane: usize) -> Vec<(Plane, usize)> {
+        let mut order: Vec<(Plane, usize)> = [Plane::Y, Plane::Z]
+            .iter()
+            .flat_map(|&p| (0..modes_per_plane).map(move |j| (p, j)))
+            .collect();
+        // `sort_by` is stable and plane Y comes first in the list, so equal
+        // frequencies keep plane Y first.
+        order.sort_by(|a, b| {
+            self.eigenvalue(a.0, a.1)
+                .total_cmp(&self.eigenvalue(b.0, b.1))
+        });
+        order
+    }
+
+    /// A segment count for which the quadrature of the invariants of the
+    /// first `modes_per_plane` modes per plane is accurate to ~1e-12: the
+    /// highest product `φ_i φ_j` oscillates with wavenumber `≤ 2β_n`, and
+    /// the 6-point rule's error on one segment of length `h` scales like
+    /// `(2β_n h)^{12} / 5·10¹⁵` (Abramowitz & Stegun 25.4.30), so
+    /// `2β_n h ≤ 2` suffices: `segments ≥ β_n L`.
+    pub fn segments_for(modes_per_plane: usize) -> usize {
+        let n = modes_per_plane.max(1);
+        (cantilever_root(n - 1).ceil() as usize).max(4)
+    }
+
+    /// The modal basis with `modes_per_plane` bending modes in each plane
+    /// (`n = 2·modes_per_plane` columns in the order of
+    /// [`Beam::mode_order`]), masses lumped at the points of `segments`
+    /// equal segments × [`GAUSS_POINTS`] Gauss–Legendre points (see the
+    /// module doc for the node list; [`Beam::segments_for`] gives a count
+    /// that resolves the modes). Shape components: plane Y modes
+    /// `u_y = φ`, `r_z = φ'`; plane Z modes `u_z = φ`, `r_y = −φ'`.
+    pub fn basis(&self, modes_per_plane: usize, segments: usize) -> Result<ModalBasis> {
+        self.validate("")?;
+        if modes_per_plane == 0 {
+            return Err(Error::input(
+                "modes_per_plane",
+                modes_per_plane,
+                "at least one bending mode per plane",
+            ));
+        }
+        if segments == 0 {
+            return Err(Error::input(
+                "segments",
+                segments,
+                "at least one quadrature segment",
+            ));
+        }
+        let l = self.length;
+        let mut xs = vec![0.0, l];
+        xs.extend((1..10).map(|k| k as f64 * l / 10.0));
+        let mut node_mass = vec![0.0; STATION_NODES];
+        let (gx, gw) = gauss_legendre(GAUSS_POINTS);
+        let h = l / segments as f64;
+        for s in 0..segments {
+            for (xi, wi) in gx.iter().zip(&gw) {
+                xs.push((s as f64 + 0.5 * (1.0 + xi)) * h);
+                node_mass.push(self.rho_a * 0.5 * h * wi);
+            }
+        }
+        let fns: Vec<ModeFn> = (0..modes_per_plane)
+            .map(|j| ModeFn::new(j, l, self.rho_a))
+            .collect();
+        let order = self.mode_order(modes_per_plane);
+        let (nn, n) = (xs.len(), order.len());
+        let mut shapes = vec![0.0; 6 * nn * n];
+        for (k, &x) in xs.iter().enumerate() {
+            let vals: Vec<[f64; 4]> = fns.iter().map(|f| f.eval(x)).collect();
+            for (c, &(plane, j)) in order.iter().enumerate() {
+                let [phi, dphi, ..] = vals[j];
+                match plane {
+                    Plane::Y => {
+                        shapes[(k * 6 + 1) * n + c] = phi;
+                        shapes[(k * 6 + 5) * n + c] = dphi;
+                    }
+                    Plane::Z => {
+                        shapes[(k * 6 + 2) * n + c] = phi;
+                        shapes[(k * 6 + 4) * n + c] = -dphi;
+                    }
+                }
+            }
+        }
+        let eigenvalues: Vec<f64> = order.iter().map(|&(p, j)| self.eigenvalue(p, j)).collect();
+        if let Some(j) = eigenvalues
+            .iter()
+            .position(|l| !(l.is_finite() && *l > 0.0))
+        {
+            return Err(Error::numerical(
+                "mbs::beam::basis",
+                format!(
+                    "eigenvalue {j} = {} out of range (L = {l} m, EI_y = {}, EI_z = {} N·m², ρA = {} kg/m)",
+                    eigenvalues[j], self.ei_y, self.ei_z, self.rho_a
+                ),
+            ));
+        }
+        if let Some(i) = shapes.iter().position(|v| !v.is_finite()) {
+            return Err(Error::numerical(
+                "mbs::beam::basis",
+                format!(
+                    "mode shape entry {i} = {} (L = {l} m, ρA = {} kg/m)",
+                    shapes[i], self.rho_a
+                ),
+            ));
+        }
+        Ok(ModalBasis {
+            nodes: xs.iter().map(|&x| Vector3::new(x, 0.0, 0.0)).collect(),
+            node_mass,
+            node_inertia: vec![Vector3::zeros(); nn],
+            n_modes: n,
+            shapes,
+            eigenvalues,
+            derivatives: Vec::new(),
+        })
+    }
+
+    /// Static deflection `(v(x), v'(x))` (m, rad) in `plane` of the
+    /// clamped-free beam under `load`, with `EI` of that plane (rotation
+    /// about z is `+v'` in plane Y, about y is `−v'` in plane Z).
+    /// Solutions of `EI v'''' = p` with `v(0) = v'(0) = 0`,
+    /// `v''(L) = 0`, `EI v'''(L) = −F`, derived by integrating the beam
+    /// equation; the tip values are those of Gere & Timoshenko,
+    /// *Mechanics of Materials*, App. G, Table G-1 (cantilever beams):
+    /// - tip force `F`: `v = F x² (3L − x) / (6 EI)`, tip `F L³ / (3 EI)`;
+    /// - uniform `q`: `v = q x² (6L² − 4Lx + x²) / (24 EI)`, tip
+    ///   `q L⁴ / (8 EI)`;
+    /// - linear `p_L x / L`: `v = p_L x² (20L³ − 10L²x + x³) / (120 L EI)`,
+    ///   tip `11 p_L L⁴ / (120 EI)`. Derivation: `v = p_L x⁵/(120 L EI)
+    ///   + c₃x³ + c₂x²`; `v'''(L) = 0` gives `c₃ = −p_L L/(12 EI)`,
+    ///   `v''(L) = 0` gives `c₂ = p_L L²/(6 EI)`. Check by superposition
+    ///   with Table G-1: uniform `p_L` minus the load decreasing linearly
+    ///   from `p_L` at the root to 0 at the tip, `(1/8 − 1/30) p_L L⁴/EI`.
+    pub fn static_deflection(&self, plane: Plane, load: StaticLoad, x: f64) -> (f64, f64) {
+        let (l, ei) = (self.length, self.stiffness(plane));
+        match load {
+            StaticLoad::Tip(f) => (
+                f * x * x * (3.0 * l - x) / (6.0 * ei),
+                f * x * (2.0 * l - x) / (2.0 * ei),
+            ),
+            StaticLoad::Uniform(q) => (
+                q * x * x * (6.0 * l * l - 4.0 * l * x + x * x) / (24.0 * ei),
+                q * x * (3.0 * l * l - 3.0 * l * x + x * x) / (6.0 * ei),
+            ),
+            StaticLoad::Linear(p) => (
+                p * x * x * (20.0 * l.powi(3) - 10.0 * l * l * x + x.powi(3)) / (120.0 * l * ei),
+                p * x * (8.0 * l.powi(3) - 6.0 * l * l * x + x.powi(3)) / (24.0 * l * ei),
+            ),
+        }
+    }
+
+    /// Tip deflection under a tip force `F` (N): `F L³ / (3 EI)` (m).
+    pub fn tip_deflection_tip_load(&self, plane: Plane, force: f64) -> f64 {
+        self.static_deflection(plane, StaticLoad::Tip(force), self.length)
+            .0
+    }
+
+    /// Tip deflection under a uniform load `q` (N/m): `q L⁴ / (8 EI)` (m).
+    pub fn tip_deflection_uniform_load(&self, plane: Plane, q: f64) -> f64 {
+        self.static_deflection(plane, StaticLoad::Uniform(q), self.length)
+            .0
+    }
+
+    /// Tip deflection under `p(x) = p_L x / L` (N/m):
+    /// `11 p_L L⁴ / (120 EI)` (m). A spin-up about the root's z axis with
+    /// angular acceleration `α` loads the beam (in the body frame) with
+    /// `p_L = −ρA α L` along y.
+    pub fn tip_deflection_linear_load(&self, plane: Plane, p_l: f64) -> f64 {
+        self.static_deflection(plane, StaticLoad::Linear(p_l), self.length)
+            .0
+    }
+}
+
+/// `β_j L`, the `j`-th (0-based) positive root of
+/// `1 + cos βL cosh βL = 0` (cantilever frequency equation; 1.8751,
+/// 4.6941, 7.8548, …; tends to `(j + ½)π`). Solved as
+/// `cos b + 1/cosh b = 0` (same roots, bounded terms) by Newton's method
+/// safeguarded with bisection in the bracket `[jπ, (j+1)π]`, which holds
+/// exactly one root; converges to rounding for every `j`.
+pub fn cantilever_root(j: usize) -> f64 {
+    let f = |b: f64| {
+        let sech = 1.0 / b.cosh();
+        (b.cos() + sech, -b.sin() - sech * b.tanh())
+    };
+    let (mut lo, mut hi) = (j as f64 * PI, (j + 1) as f64 * PI);
+    let lo_positive = f(lo).0 > 0.0;
+    let mut b = if j == 0 { 1.875 } else { (j as f64 + 0.5) * PI };
+    for _ in 0..200 {
+        let (fb, db) = f(b);
+        if fb == 0.0 {
+            return b;
+        }
+        if (fb > 0.0) == lo_positive {
+            lo = b;
+        } else {
+            hi = b;
+        }
+        let mut next = b - fb / db;
+        if !(next > lo && next < hi) {
+            next = 0.5 * (lo + hi);
+        }
+        if (next - b).abs() <= 2.0 * f64::EPSILON * b {
+            return next;
+        }
+        b = next;
+    }
+    b
+}
+
+/// Nodes `ξ_i` (increasing) and weights `w_i` of the `n`-point
+/// Gauss–Legendre rule on `[−1, 1]`: roots of `P_n` by Newton's method
+/// from Tricomi's estimate `cos(π(i + ¾)/(n + ½))`, `w_i = 2 / ((1 − ξ²)
+/// P_n'(ξ)²)` (Abramowitz & Stegun 25.4.29).
+fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut xs = vec![0.0; n];
+    let mut ws = vec![0.0; n];
+    let legendre = |x: f64| {
+        // (P_n(x), P_n'(x)) by the three-term recurrence.
+        let (mut p0, mut p1) = (1.0, x);
+        for k in 2..=n {
+            let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+            p0 = p1;
+            p1 = p2;
+        }
+        let pn = if n == 0 { 1.0 } else { p1 };
+        (pn, n as f64 * (x * pn - p0) / (x * x - 1.0))
+    };
+    for i in 0..n {
+        let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        for _ in 0..100 {
+            let (p, dp) = legendre(x);
+            let dx = p / dp;
+            x -= dx;
+            if dx.abs() <= 1e-16 {
+                break;
+            }
+        }
+        let (_, dp) = legendre(x);
+        xs[n - 1 - i] = x;
+        ws[n - 1 - i] = 2.0 / ((1.0 - x * x) * dp * dp);
+    }
+    (xs, ws)
+}
+
+/// One mass-normalized cantilever mode in the stable form of the module
+/// doc.
+struct ModeFn {
+    /// `β` (1/m).
+    beta: f64,
+    /// `βL`.
+    bl: f64,
+    /// `σ`.
+    sigma: f64,
+    /// `(1 − σ) e^{βL}`.
+    ep: f64,
+    /// `±1/√(ρA L)` (sign: positive tip displacement).
+    scale: f64,
+}
+
+impl ModeFn {
+    fn new(j: usize, length: f64, rho_a: f64) -> ModeFn {
+        let bl = cantilever_root(j);
+        let e = (-bl).exp();
+        let (s, c) = bl.sin_cos();
+        let d = 1.0 - e * e + 2.0 * e * s;
+        let sigma = (1.0 + e * e + 2.0 * e * c) / d;
+        let ep = 2.0 * (s - c - e) / d;
+        // Unscaled tip value: φ''(L) = 0 gives φ(L) = 2(σ sin βL − cos βL) = ±2.
+        let tip = sigma * s - c;
+        let scale = tip.signum() / (rho_a * length).sqrt();
+        ModeFn {
+            beta: bl / length,
+            bl,
+            sigma,
+            ep,
+            scale,
+        }
+    }
+
+    /// `[φ, φ', φ'', φ''']` at `x` (per √kg, per m^k).
+    fn eval(&self, x: f64) -> [f64; 4] {
+        let z = self.beta * x;
+        let (s, c) = z.sin_cos();
+        let e_plus = self.ep * (z - self.bl).exp();
+        let e_minus = (1.0 + self.sigma) * (-z).exp();
+        let even = 0.5 * (e_plus + e_minus);
+        let odd = 0.5 * (e_plus - e_minus);
+        let (b, k) = (self.beta, self.scale);
+        [
+            k * (even - c + self.sigma * s),
+            k * b * (odd + s + self.sigma * c),
+            k * b * b * (even + c - self.sigma * s),
+            k * b * b * b * (odd - s - self.sigma * c),
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mbs::flex::Invariants;
+
+    /// A beam with unequal stiffnesses so that the two planes interleave
+    /// (ω_Z/ω_Y = √2.5).
+    fn beam() -> Beam {
+        Beam {
+            length: 2.0,
+            ei_y: 7.5e3,
+            ei_z: 3.0e3,
+            rho_a: 1.7,
+        }
+    }
+
+    /// Columns of `plane` in basis order.
+    fn columns(b: &Beam, m: usize, plane: Plane) -> Vec<usize> {
+        b.mode_order(m)
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.0 == plane)
+            .map(|(c, _)| c)
+            .collect()
+    }
+
+    #[test]
+    fn roots_match_blevins() {
+        // Blevins, Formulas for Natural Frequency and Mode Shape (1979),
+        // Table 8-1, clamped-free beam, λ_i = β_i L, i = 1..5.
+        let blevins = [1.87510407, 4.69409113, 7.85475744, 10.99554073, 14.13716839];
+        for (j, r) in blevins.iter().enumerate() {
+            let b = cantilever_root(j);
+            assert!((b - r).abs() < 6e-9, "root {j}: {b} vs {r}");
+        }
+        // Residual of the frequency equation and the asymptote (j + ½)π
+        // (same table, i > 5) for high roots.
+        for j in [5, 10, 40, 300] {
+            let b = cantilever_root(j);
+            assert!((b.cos() + 1.0 / b.cosh()).abs() < 1e-14 * b, "root {j}");
+            assert!((b - (j as f64 + 0.5) * PI).abs() < 1e-6, "root {j}: {b}");
+        }
+    }
+
+    #[test]
+    fn gauss_legendre_is_exact_to_degree_eleven() {
+        // ∫₋₁¹ x^k dx = 2/(k+1) for even k, 0 for odd k (closed form).
+        let (x, w) = gauss_legendre(GAUSS_POINTS);
+        for k in 0..=11 {
+            let q: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(k)).sum();
+            let exact = if k % 2 == 0 {
+                2.0 / (k + 1) as f64
+            } else {
+                0.0
+            };
+            assert!((q - exact).abs() < 1e-15, "degree {k}: {q} vs {exact}");
+        }
+        assert!(x.windows(2).all(|p| p[0] < p[1]));
+    }
+
+    #[test]
+    fn stable_form_matches_textbook_form_and_boundary_conditions() {
+        let b = beam();
+        let l = b.length;
+        // Low modes: the textbook cosh/sinh form (Blevins Table 8-1) is
+        // accurate there; compare at the stations.
+        for j in 0..4 {
+            let bl = cantilever_root(j);
+            let sigma = (bl.cosh() + bl.cos()) / (bl.sinh() + bl.sin());
+            let raw = |x: f64| {
+                let z = bl * x / l;
+                z.cosh() - z.cos() - sigma * (z.sinh() - z.sin())
+            };
+            let sign = raw(l).signum();
+            let c = sign / (b.rho_a * l).sqrt();
+            for k in 0..=10 {
+                let x = k as f64 * l / 10.0;
+                let (phi, _) = b.mode(j, x);
+                assert!(
+                    (phi - c * raw(x)).abs() < 1e-10 * c.abs(),
+                    "mode {j} at {x}"
+                );
+            }
+        }
+        // All modes (up to βL ≈ 95, where the textbook form has no digit
+        // left): φ(0) = φ'(0) = 0, φ''(L) = φ'''(L) = 0 relative to the
+        // amplitude β^k/√(ρA L), and the tip value +2/√(ρA L).
+        for j in 0..30 {
+            let f = ModeFn::new(j, l, b.rho_a);
+            let amp = 1.0 / (b.rho_a * l).sqrt();
+            let (d0, dl) = (f.eval(0.0), f.eval(l));
+            for (k, v) in [(0, d0[0]), (1, d0[1]), (2, dl[2]), (3, dl[3])] {
+                let rel = v.abs() / (amp * f.beta.powi(k));
+                assert!(rel < 1e-11, "mode {j}, derivative {k}: {rel:e}");
+            }
+            assert!((dl[0] - 2.0 * amp).abs() < 1e-11 * amp, "mode {j} tip");
+        }
+    }
+
+    #[test]
+    fn basis_is_orthonormal_with_the_lumped_masses() {
+        // ∫ ρA φ_i φ_j dx = δ_ij (module doc), by the lumped quadrature;
+        // both planes, cross-plane products are zero by construction.
+        let b = beam();
+        for m in [8, 20] {
+            let basis = b.basis(m, Beam::segments_for(m)).unwrap();
+            basis.validate("beam").unwrap();
+            let inv = Invariants::new(&basis);
+            let n = basis.n_modes;
+            let mut worst = 0.0f64;
+            for i in 0..n {
+                for j in 0..n {
+                    let d = if i == j { 1.0 } else { 0.0 };
+                    worst = worst.max((inv.mww[i * n + j] - d).abs());
+                }
+            }
+            println!("{m} modes/plane: |mww − I| = {worst:.2e}");
+            assert!(worst < 1e-10, "{m} modes/plane: |mww − I| = {worst:e}");
+            // Sorted by frequency, both planes present.
+            assert!(basis.eigenvalues.windows(2).all(|p| p[0] <= p[1]));
+            assert_eq!(columns(&b, m, Plane::Y).len(), m);
+        }
+        // Equal stiffnesses: ties in the order Y, Z.
+        let mut round = b;
+        round.ei_y = round.ei_z;
+        let order = round.mode_order(3);
+        assert_eq!(order[0], (Plane::Y, 0));
+        assert_eq!(order[1], (Plane::Z, 0));
+        assert_eq!(order[5], (Plane::Z, 2));
+    }
+
+    #[test]
+    fn invariants_match_closed_forms() {
+        let b = beam();
+        let (l, ra) = (b.length, b.rho_a);
+        let m = 6;
+        let basis = b.basis(m, Beam::segments_for(m)).unwrap();
+        let inv = Invariants::new(&basis);
+        let n = inv.n;
+        // Rigid-body integrals (closed forms): ρA L, ρA L²/2 x̂, ρA L³/3.
+        assert!((inv.mass - ra * l).abs() < 1e-12 * ra * l);
+        assert!((inv.s0.x - ra * l * l / 2.0).abs() < 1e-12 * ra * l * l);
+        assert!(inv.s0.y == 0.0 && inv.s0.z == 0.0);
+        assert!((inv.e0[(0, 0)] - ra * l.powi(3) / 3.0).abs() < 1e-12 * ra * l.powi(3));
+        assert!(inv.e0.iter().skip(1).all(|v| *v == 0.0));
+        // Modal integrals, derived in this test from φ'''' = β⁴φ and the
+        // boundary conditions: ∫φ dx = −φ'''(0)/β⁴, ∫xφ dx = φ''(0)/β⁴.
+        // i3 = Σ m Φ, ls = Σ m s × Φ with s × (0, φ, 0) = (0, 0, xφ) and
+        // s × (0, 0, φ) = (0, −xφ, 0).
+        for (c, &(plane, j)) in b.mode_order(m).iter().enumerate() {
+            let f = ModeFn::new(j, l, ra);
+            let d0 = f.eval(0.0);
+            let int_phi = -ra * d0[3] / f.beta.powi(4);
+            let int_x_phi = ra * d0[2] / f.beta.powi(4);
+            let scale = (ra * l).sqrt().recip() * l;
+            let (ci, cl, sl) = match plane {
+                Plane::Y => (1, 2, 1.0),
+                Plane::Z => (2, 1, -1.0),
+            };
+            assert!((inv.i3[ci * n + c] - int_phi).abs() < 1e-12 * ra * scale);
+            assert!((inv.ls[cl * n + c] - sl * int_x_phi).abs() < 1e-12 * ra * scale * l);
+            // No axial motion: no x component of i3 and no torsion in ls.
+            assert!(inv.i3[c] == 0.0 && inv.ls[c] == 0.0);
+        }
+    }
+
+    /// Static response `Σ_c X_(node, comp),c f_c / λ_c` over the columns
+    /// `cols` with modal forces `f`.
+    fn modal_static(
+        basis: &ModalBasis,
+        node: usize,
+        comp: usize,
+        cols: &[usize],
+        f: &[f64],
+    ) -> f64 {
+        cols.iter()
+            .zip(f)
+            .map(|(&c, fc)| basis.shape(node, comp, c) * fc / basis.eigenvalues[c])
+            .sum()
+    }
+
+    #[test]
+    fn tip_load_modal_superposition_converges_to_closed_form() {
+        // Closed forms (Gere & Timoshenko, Mechanics of Materials, App. G, Table G-1,
+        // cantilever with a tip load): tip deflection
+        // F L³/(3 EI), tip slope F L²/(2 EI). Modal force of a tip load:
+        // f_j = F φ_j(L).
+        let b = beam();
+        let m = 8;
+        let basis = b.basis(m, Beam::segments_for(m)).unwrap();
+        let force = 40.0;
+        for (plane, comp, rot, rsign) in [(Plane::Y, 1, 5, 1.0), (Plane::Z, 2, 4, -1.0)] {
+            let cols = columns(&b, m, plane);
+            let f: Vec<f64> = cols
+                .iter()
+                .map(|&c| force * basis.shape(TIP_NODE, comp, c))
+                .collect();
+            let (exact, slope) = b.static_deflection(plane, StaticLoad::Tip(force), b.length);
+            assert!((exact - b.tip_deflection_tip_load(plane, force)).abs() < 1e-15 * exact);
+            let mut last = f64::INFINITY;
+            for k in 1..=m {
+                let err = (modal_static(&basis, TIP_NODE, comp, &cols[..k], &f[..k]) - exact).abs()
+                    / exact;
+                println!("{plane:?} tip load, {k} modes: rel. error {err:.3e}");
+                assert!(
+                    err < last,
+                    "{plane:?}: error {err:e} with {k} modes after {last:e}"
+                );
+                last = err;
+            }
+            assert!(
+                last < 1e-3,
+                "{plane:?}: tip deflection error {last:e} with {m} modes"
+            );
+            let rot_err =
+                (rsign * modal_static(&basis, TIP_NODE, rot, &cols, &f) - slope).abs() / slope;
+            println!("{plane:?} tip load, tip rotation rel. error {rot_err:.3e}");
+            assert!(rot_err < 3e-3, "{plane:?}: tip rotation error {rot_err:e}");
+        }
+    }
+
+    #[test]
+    fn spin_up_load_modal_superposition_converges_to_closed_form() {
+        // A spin-up with angular acceleration α about z loads the beam with
+        // p(x) = ρA α x = p_L x/L, p_L = ρA α L. Modal forces
+        // ∫ p φ_j dx = α Σ m x φ_j = α ls_z,j (plane Y) and, for the same
+        // load along z, −α ls_y,j (plane Z). Closed form 11 p_L L⁴/(120 EI)
+        // and the deflection curve of `static_deflection` (derived there,
+        // tip value checked against Gere & Timoshenko Table G-1 by
+        // superposition).
+        let b = beam();
+        let m = 8;
+        let basis = b.basis(m, Beam::segments_for(m)).unwrap();
+        let inv = Invariants::new(&basis);
+        let n = inv.n;
+        let alpha = 3.0;
+        let p_l = b.rho_a * alpha * b.length;
+        for (plane, comp, ls_row, sign) in [(Plane::Y, 1, 2, 1.0), (Plane::Z, 2, 1, -1.0)] {
+            let cols = columns(&b, m, plane);
+            let f: Vec<f64> = cols
+                .iter()
+                .map(|&c| sign * alpha * inv.ls[ls_row * n + c])
+                .collect();
+            let exact = b.tip_deflection_linear_load(plane, p_l);
+            let ei = b.stiffness(plane);
+            assert!((exact - 11.0 * p_l * b.length.powi(4) / (120.0 * ei)).abs() < 1e-15 * exact);
+            let mut last = f64::INFINITY;
+            for k in 1..=m {
+                let err = (modal_static(&basis, TIP_NODE, comp, &cols[..k], &f[..k]) - exact).abs()
+                    / exact;
+                println!("{plane:?} linear load, {k} modes: rel. error {err:.3e}");
+                assert!(
+                    err < last,
+                    "{plane:?}: error {err:e} with {k} modes after {last:e}"
+                );
+                last = err;
+            }
+            assert!(
+                last < 1e-4,
+                "{plane:?}: tip deflection error {last:e} with {m} modes"
+            );
+            // The whole deflection curve at the stations.
+            for s in 1..=10 {
+                let x = s as f64 * b.length / 10.0;
+                let node = station_node(s).unwrap();
+                assert!((basis.nodes[node].x - x).abs() < 1e-15);
+                let v = modal_static(&basis, node, comp, &cols, &f);
+                let (ve, _) = b.static_deflection(plane, StaticLoad::Linear(p_l), x);
+                assert!(
+                    (v - ve).abs() < 1e-4 * exact,
+                    "{plane:?} at x = {x}: {v} vs {ve}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn uniform_load_modal_superposition_converges_to_closed_form() {
+        // Uniform load q: modal forces q ∫φ_j dx = q i3_y,j / ρA; closed
+        // form q L⁴/(8 EI) (Gere & Timoshenko, App. G,
+        // Table G-1, cantilever with a uniform load).
+        let b = beam();
+        let m = 8;
+        let basis = b.basis(m, Beam::segments_for(m)).unwrap();
+        let inv = Invariants::new(&basis);
+        let q = 25.0;
+        let cols = columns(&b, m, Plane::Y);
+        let f: Vec<f64> = cols
+            .iter()
+            .map(|&c| q * inv.i3[inv.n + c] / b.rho_a)
+            .collect();
+        let exact = b.tip_deflection_uniform_load(Plane::Y, q);
+        assert!((exact - q * b.length.powi(4) / (8.0 * b.ei_z)).abs() < 1e-15 * exact);
+        let err = (modal_static(&basis, TIP_NODE, 1, &cols, &f) - exact).abs() / exact;
+        println!("uniform load, {m} modes: rel. error {err:.3e}");
+        assert!(err < 3e-6, "uniform load: tip deflection error {err:e}");
+    }
+
+    #[test]
+    fn static_curves_satisfy_the_beam_equation() {
+        // Central finite differences (step h) of v against v', and of
+        // EI v'''' against the load p(x); v(0) = v'(0) = 0.
+        let b = beam();
+        let (l, ei) = (b.length, b.ei_z);
+        let h = 1e-2;
+        let x = 0.7 * l;
+        for (load, p) in [
+            (StaticLoad::Tip(7.0), 0.0),
+            (StaticLoad::Uniform(5.0), 5.0),
+            (StaticLoad::Linear(4.0), 4.0 * x / l),
+        ] {
+            let v = |x: f64| b.static_deflection(Plane::Y, load, x);
+            assert_eq!(v(0.0), (0.0, 0.0));
+            let d1 = (v(x + h).0 - v(x - h).0) / (2.0 * h);
+            assert!((d1 - v(x).1).abs() < 1e-5 * v(l).1.abs(), "{load:?}: slope");
+            let d4 = (v(x + 2.0 * h).0 - 4.0 * v(x + h).0 + 6.0 * v(x).0 - 4.0 * v(x - h).0
+                + v(x - 2.0 * h).0)
+                / h.powi(4);
+            assert!(
+                (ei * d4 - p).abs() < 1e-4 * (1.0 + p),
+                "{load:?}: EI v'''' = {}",
+                ei * d4
+            );
+            // Free end: the bending moment EI v''(L) vanishes.
+            let d2 = (v(l).0 - 2.0 * v(l - h).0 + v(l - 2.0 * h).0) / (h * h);
+            let d2_next = (v(l - h).0 - 2.0 * v(l - 2.0 * h).0 + v(l - 3.0 * h).0) / (h * h);
+            // Linear extrapolation of the backward second difference to x = L.
+            let at_l = 2.0 * d2 - d2_next;
+            assert!(
+                at_l.abs() < 1e-3 * v(l).1.abs() / l,
+                "{load:?}: v''(L) = {at_l}"
+            );
+        }
+    }
+
+    #[test]
+    fn bad_input_names_the_key() {
+        let ok = beam();
+        for (beam, key) in [
+            (Beam { length: 0.0, ..ok }, "bodies[1].beam.length"),
+            (Beam { ei_y: -1.0, ..ok }, "bodies[1].beam.ei_y"),
+            (
+                Beam {
+                    ei_z: f64::NAN,
+                    ..ok
+                },
+                "bodies[1].beam.ei_z",
+            ),
+            (
+                Beam {
+                    rho_a: f64::INFINITY,
+                    ..ok
+                },
+                "bodies[1].beam.rho_a",
+            ),
+        ] {
+            match beam.validate("bodies[1].beam") {
+                Err(Error::Input { key: k, .. }) => assert_eq!(k, key),
+                other => panic!("{key}: {other:?}"),
+            }
+            assert!(matches!(beam.basis(2, 4), Err(Error::Input { .. })));
+        }
+        for (m, s, key) in [(0, 4, "modes_per_plane"), (2, 0, "segments")] {
+            match ok.basis(m, s) {
+                Err(Error::Input { key: k, .. }) => assert_eq!(k, key),
+                other => panic!("{key}: {other:?}"),
+            }
+        }
+    }
+}
