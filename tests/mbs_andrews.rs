@@ -119,7 +119,7 @@ fn scene_text(method: Method, rtol: f64) -> String {
         SD * ga.sin() - SC * ga.cos() + YB,
     ];
     let mut s =
-        String::from("[scene]\neffects = [\"springs\", \"actuators\"]\nbaumgarte = 100.0\n");
+        String::from("[scene]\neffects = [\"springs\", \"actuators\", \"quadratic_velocity\"]\nbaumgarte = 100.0\n");
     for k in 0..7 {
         let i = I[k];
         s += &format!(

@@ -61,7 +61,7 @@ fn constant_load_gives_uniform_acceleration() {
     // (closed form derived in this test; no gyroscopic term for ω ∥ e_z).
     let text = r#"
 [scene]
-effects = ["loads"]
+effects = ["loads", "quadratic_velocity"]
 [[scene.bodies]]
 name = "box"
 mass = 2.0

@@ -110,6 +110,11 @@ fn effects_not_listed_are_not_built_or_evaluated() {
     let (sys_b, sim_b) = simulate(&load_scene(&without).unwrap()).unwrap();
     assert!(sys_a.counters.gravity.get() > 0);
     assert_eq!(sys_b.counters.gravity.get(), 0);
+    // Gyroscopic terms only when `quadratic_velocity` is listed.
+    assert_eq!(sys_a.counters.quadratic.get(), 0);
+    assert!(!sys_a.model.quadratic_velocity);
+    // A rigid scene never builds a flexible body.
+    assert_eq!(sys_a.counters.flexible.get(), 0);
     assert!(sys_b.model.forces.is_empty());
     // Without gravity the pendulum stays at rest; with it, it swings.
     assert!(sim_b.rows.iter().all(|r| r[1].abs() < 1e-12));
@@ -124,7 +129,7 @@ fn effects_not_listed_are_not_built_or_evaluated() {
         "c.toml",
         // (the breakpoint sensitivity needs the law: leave it out)
         &sar.replace(
-            "effects = [\"actuators\", \"damping\"]",
+            "effects = [\"actuators\", \"damping\", \"quadratic_velocity\"]",
             "effects = [\"damping\"]",
         )
         .replace("sensitivities = [", "# sensitivities = ["),

@@ -63,9 +63,9 @@ fn perturbed_positions_are_projected_and_reported() {
     let sys = sar_system();
     let mut y = sys.initial_state();
     let s2 = sys.slot[sys.model.body("B2").unwrap()].unwrap();
-    y[7 * s2] += 1e-3;
+    y[sys.pos_off(s2)] += 1e-3;
     let s8 = sys.slot[sys.model.body("B8").unwrap()].unwrap();
-    y[7 * s8 + 4] += 1e-3;
+    y[sys.pos_off(s8) + 4] += 1e-3;
     let p = sys.project(0.0, &mut y).unwrap();
     println!("{p:?}");
     assert!(p.phi_before > 5e-4);
@@ -83,7 +83,7 @@ fn driven_rotor_follows_law_and_reaction_torque_is_inertial() {
     // Closed form derived in this test.
     let text = r#"
 [scene]
-effects = []
+effects = ["quadratic_velocity"]
 [[scene.bodies]]
 name = "rotor"
 mass = 3.0

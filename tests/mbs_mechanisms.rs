@@ -77,7 +77,7 @@ fn four_bar(a: f64, b: f64, c: f64, d: f64, phi0: f64, extra: [&str; 3]) -> Stri
 fn crank_rocker_passes_dead_points_conserving_energy() {
     // Grashof crank-rocker (s + l = 0.8 < p + q = 0.9), gravity −y.
     let mut s = String::from(
-        "[scene]\neffects = [\"gravity\"]\ngravity = [0.0, -9.81, 0.0]\nbaumgarte = 10.0\n",
+        "[scene]\neffects = [\"gravity\", \"quadratic_velocity\"]\ngravity = [0.0, -9.81, 0.0]\nbaumgarte = 10.0\n",
     );
     s += &four_bar(
         0.2,
@@ -140,7 +140,9 @@ fn bricard_linkage_is_mobile_and_stable() {
         Vector3::new(0.0, 1.0, 1.0),
         Vector3::new(0.0, 0.0, 1.0),
     ];
-    let mut s = String::from("[scene]\neffects = [\"gravity\"]\nbaumgarte = 10.0\n");
+    let mut s = String::from(
+        "[scene]\neffects = [\"gravity\", \"quadratic_velocity\"]\nbaumgarte = 10.0\n",
+    );
     for k in 0..5 {
         s += &rod(&format!("L{k}"), v[k], v[k + 1], 1.0, "");
     }

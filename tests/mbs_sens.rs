@@ -9,7 +9,7 @@ use plyscape::mbs::{Force, Model, Param, System};
 /// on the pin with a one-segment law `M = 0.2 + 1.5 (0.3 − θ)`.
 const SCENE: &str = r#"
 [scene]
-effects = ["gravity", "springs", "damping", "actuators"]
+effects = ["gravity", "springs", "damping", "actuators", "quadratic_velocity"]
 [[scene.bodies]]
 name = "rod"
 mass = 1.2

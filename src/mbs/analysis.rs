@@ -2,7 +2,7 @@
 //! per-state outputs: joint angles and rates, reactions, energy and
 //! constraint violation.
 
-use super::dynamics::{angle_of, System, Workspace};
+use super::dynamics::{angle_of, BodyKin, System, Workspace};
 use super::linalg::Scalar;
 use super::model::{Force, JointKind};
 use crate::error::{Error, Result};
@@ -74,21 +74,26 @@ impl System {
                 r.gamma = -r.phi;
             }
             let dx = self.correction(&mut ws);
-            for (s, d) in dx.iter().enumerate() {
+            for s in 0..nb {
+                let (p, o, n) = (self.pos_off(s), self.vel_local(s), self.modes[s]);
+                let d = &dx[o..o + 6 + n];
                 poscorr += d.iter().map(|v| v * v).sum::<f64>();
                 for c in 0..3 {
-                    y[7 * s + c] += d[c];
+                    y[p + c] += d[c];
                 }
-                let p = &y[7 * s + 3..7 * s + 7];
-                let q = UnitQuaternion::from_quaternion(Quaternion::new(p[0], p[1], p[2], p[3]));
+                for j in 0..n {
+                    y[p + 7 + j] += d[6 + j];
+                }
+                let e = &y[p + 3..p + 7];
+                let q = UnitQuaternion::from_quaternion(Quaternion::new(e[0], e[1], e[2], e[3]));
                 let dq = UnitQuaternion::from_quaternion(Quaternion::new(
                     1.0,
                     0.5 * d[3],
                     0.5 * d[4],
                     0.5 * d[5],
                 ));
-                let n = q * dq;
-                y[7 * s + 3..7 * s + 7].copy_from_slice(&[n.w, n.i, n.j, n.k]);
+                let r = q * dq;
+                y[p + 3..p + 7].copy_from_slice(&[r.w, r.i, r.j, r.k]);
             }
         }
         let before = before.unwrap_or(0.0);
@@ -105,14 +110,10 @@ impl System {
             r.gamma = -r.phidot;
         }
         let dv = self.correction(&mut ws);
-        let mut velcorr = 0.0;
-        for (s, d) in dv.iter().enumerate() {
-            for c in 0..6 {
-                y[vo + 6 * s + c] += d[c];
-                velcorr += d[c] * d[c];
-            }
+        let velcorr = dv.iter().map(|v| v * v).sum::<f64>();
+        for (k, d) in dv.iter().enumerate() {
+            y[vo + k] += d;
         }
-        let _ = nb;
         Ok(Projection {
             phi_before: before,
             phi_after: after,
@@ -126,16 +127,16 @@ impl System {
 
     /// Kinematics and constraint rows of `y` at `t` into `ws`.
     pub fn load(&self, t: f64, y: &[f64], ws: &mut Workspace<f64>) {
-        let mut kin = std::mem::take(&mut ws.kin);
-        self.body_kin(y, &mut kin);
-        ws.kin = kin;
+        self.kinematics(y, ws);
         self.constraints(t, ws);
     }
 
-    /// `M⁻¹Gᵀ(GM⁻¹Gᵀ)⁺γ` with the rows' `gamma` as right-hand side.
-    fn correction(&self, ws: &mut Workspace<f64>) -> Vec<[f64; 6]> {
+    /// `M⁻¹Gᵀ(GM⁻¹Gᵀ)⁺γ` with the rows' `gamma` as right-hand side
+    /// (velocity layout).
+    fn correction(&self, ws: &mut Workspace<f64>) -> Vec<f64> {
         ws.q.clear();
-        ws.q.resize(self.nb(), [0.0; 6]);
+        ws.q.resize(self.nvel(), 0.0);
+        self.mass_factors(ws);
         self.solve(ws)
     }
 
@@ -145,21 +146,41 @@ impl System {
         ws.rows.iter().fold(0.0f64, |m, r| m.max(r.phi.abs()))
     }
 
-    /// Mechanical energy: kinetic + gravity potential + linear springs (J).
+    /// Mechanical energy: kinetic + strain (`½ wᵀΛw`) + gravity potential
+    /// + linear springs (J).
     pub fn energy(&self, y: &[f64], ws: &mut Workspace<f64>) -> f64 {
-        let mut kin = std::mem::take(&mut ws.kin);
-        self.body_kin(y, &mut kin);
+        self.kinematics(y, ws);
+        self.mass_factors(ws);
         let mut e = 0.0;
         for (s, &b) in self.moving.iter().enumerate() {
             let body = &self.model.bodies[b];
-            let k = &kin[s];
-            e += 0.5 * body.mass * k.v.norm_squared() + 0.5 * k.wb.dot(&(body.inertia * k.wb));
+            let k = &ws.kin[s];
+            match ws.inv.get(s).and_then(|i| i.as_ref()) {
+                Some(inv) if self.modes[s] > 0 => {
+                    // ½ vᵀ M v with M = L Lᵀ: ½ |Lᵀ v|².
+                    let d = self.dof(s);
+                    let o = self.vel_off(s);
+                    let v = &y[o..o + d];
+                    let l = &ws.mfac[s];
+                    for c in 0..d {
+                        let ltv: f64 = (c..d).map(|r| l[r * d + c] * v[r]).sum();
+                        e += 0.5 * ltv * ltv;
+                    }
+                    for (j, w) in k.q.iter().enumerate() {
+                        e += 0.5 * inv.lambda[j] * w * w;
+                    }
+                }
+                _ => {
+                    e += 0.5 * body.mass * k.v.norm_squared()
+                        + 0.5 * k.wb.dot(&(body.inertia * k.wb));
+                }
+            }
         }
         for f in &self.model.forces {
             match f {
                 Force::Gravity { g } => {
-                    for (s, &b) in self.moving.iter().enumerate() {
-                        e -= self.model.bodies[b].mass * g.dot(&kin[s].r);
+                    for s in 0..self.nb() {
+                        e -= g.dot(&self.mass_centre(s, ws)) * self.body_mass(s, ws);
                     }
                 }
                 Force::SpringDamper {
@@ -169,14 +190,84 @@ impl System {
                     length,
                     ..
                 } => {
-                    let l = (self.marker_kin(&kin, *j).x - self.marker_kin(&kin, *i).x).norm();
+                    let l = (ws.mk[*j].x - ws.mk[*i].x).norm();
                     e += 0.5 * stiffness * (l - length).powi(2);
                 }
                 _ => {}
             }
         }
-        ws.kin = kin;
         e
+    }
+
+    /// Mass of slot `s` (kg).
+    fn body_mass(&self, s: usize, ws: &Workspace<f64>) -> f64 {
+        match ws.inv.get(s).and_then(|i| i.as_ref()) {
+            Some(inv) if self.modes[s] > 0 => inv.mass,
+            _ => self.model.bodies[self.moving[s]].mass,
+        }
+    }
+
+    /// Global position of the (deformed) centre of mass of slot `s`, from
+    /// the kinematics in `ws`.
+    pub fn mass_centre(&self, s: usize, ws: &Workspace<f64>) -> Vector3<f64> {
+        let k = &ws.kin[s];
+        match ws.inv.get(s).and_then(|i| i.as_ref()) {
+            Some(inv) if self.modes[s] > 0 => k.r + k.a * (inv.first_moment(&k.q) / inv.mass),
+            _ => k.r,
+        }
+    }
+
+    /// Elastic displacement `Φ_k w` (body frame axes, m) of marker `m`
+    /// (zero for a marker that is not on a flexible node).
+    pub fn deflection(&self, y: &[f64], m: usize) -> Vector3<f64> {
+        let mut kin = Vec::new();
+        self.body_kin(y, &[], &mut kin);
+        self.deflection_kin(&kin, m)
+    }
+
+    /// [`System::deflection`] from body kinematics (any scalar).
+    pub fn deflection_kin<T: Scalar>(&self, kin: &[BodyKin<T>], m: usize) -> Vector3<T> {
+        let mk = &self.model.markers[m];
+        let (Some(b), Some(node)) = (mk.body, mk.node) else {
+            return Vector3::zeros();
+        };
+        let Some(s) = self.slot[b] else {
+            return Vector3::zeros();
+        };
+        let (phi, _) = self.node_shapes(&kin[s], b, node);
+        phi.iter()
+            .zip(&kin[s].q)
+            .fold(Vector3::zeros(), |acc, (p, w)| acc + p * *w)
+    }
+
+    /// Strain energy of flexible slot `s` in any scalar, with design seeds
+    /// `(variable, δ)` applied to Λ.
+    pub fn strain_energy_dual<T: Scalar>(&self, y: &[T], s: usize, design: &[(usize, T)]) -> T {
+        let b = self.moving[s];
+        let Some(flex) = self.model.bodies[b].flex.as_ref() else {
+            return T::zero();
+        };
+        let p = self.pos_off(s) + 7;
+        let half = nalgebra::convert::<f64, T>(0.5);
+        (0..self.modes[s]).fold(T::zero(), |acc, j| {
+            let mut l = nalgebra::convert::<f64, T>(flex.inv.lambda[j]);
+            for (var, d) in design {
+                l += nalgebra::convert::<f64, T>(flex.dinv[*var].lambda[j]) * *d;
+            }
+            acc + half * l * y[p + j] * y[p + j]
+        })
+    }
+
+    /// Strain energy `½ wᵀΛw` of flexible slot `s` (J).
+    pub fn strain_energy(&self, y: &[f64], s: usize) -> f64 {
+        let b = self.moving[s];
+        let Some(flex) = self.model.bodies[b].flex.as_ref() else {
+            return 0.0;
+        };
+        let p = self.pos_off(s) + 7;
+        (0..self.modes[s])
+            .map(|j| 0.5 * flex.inv.lambda[j] * y[p + j] * y[p + j])
+            .sum()
     }
 
     /// Whether [`System::energy`] is conserved by the exact flow: no
@@ -187,37 +278,52 @@ impl System {
             Force::SpringDamper { damping, .. } => *damping == 0.0,
             _ => false,
         });
+        let modal_ok = self
+            .model
+            .bodies
+            .iter()
+            .all(|b| b.flex.as_ref().is_none_or(|f| f.zeta == 0.0));
         let joints_ok = self
             .model
             .joints
             .iter()
             .all(|j| !matches!(j.kind, JointKind::Driven(ref d) if d.coefficients.len() > 1));
-        forces_ok && joints_ok
+        forces_ok && joints_ok && modal_ok
     }
 
     /// Angular momentum about the global origin (N·m·s), meaningful for
     /// free systems.
     pub fn angular_momentum(&self, y: &[f64], ws: &mut Workspace<f64>) -> Vector3<f64> {
-        let mut kin = std::mem::take(&mut ws.kin);
-        self.body_kin(y, &mut kin);
+        self.kinematics(y, ws);
+        self.mass_factors(ws);
         let mut h = Vector3::zeros();
         for (s, &b) in self.moving.iter().enumerate() {
             let body = &self.model.bodies[b];
-            let k = &kin[s];
-            h += k.r.cross(&(k.v * body.mass)) + k.a * (body.inertia * k.wb);
+            let k = &ws.kin[s];
+            match ws.inv.get(s).and_then(|i| i.as_ref()) {
+                Some(_) if self.modes[s] > 0 => {
+                    // H = r × p + A·(∂T/∂ω'), p = ∂T/∂ṙ: rows 0..6 of M v.
+                    let d = self.dof(s);
+                    let o = self.vel_off(s);
+                    let v = &y[o..o + d];
+                    let mv = self.flex_mass_times(s, ws, v);
+                    let p = Vector3::new(mv[0], mv[1], mv[2]);
+                    let hw = Vector3::new(mv[3], mv[4], mv[5]);
+                    h += k.r.cross(&p) + k.a * hw;
+                }
+                _ => {
+                    h += k.r.cross(&(k.v * body.mass)) + k.a * (body.inertia * k.wb);
+                }
+            }
         }
-        ws.kin = kin;
         h
     }
 
     /// Relative angle (rad) and rate (rad/s) of a revolute joint.
     pub fn angle(&self, y: &[f64], joint: usize, ws: &mut Workspace<f64>) -> (f64, f64) {
-        let mut kin = std::mem::take(&mut ws.kin);
-        self.body_kin(y, &mut kin);
+        self.kinematics(y, ws);
         let j = &self.model.joints[joint];
-        let r = angle_of(&self.marker_kin(&kin, j.i), &self.marker_kin(&kin, j.j));
-        ws.kin = kin;
-        r
+        angle_of(&ws.mk[j.i], &ws.mk[j.j])
     }
 
     /// Reactions of every joint at `(t, y)` (one right-hand-side solve).
@@ -228,8 +334,8 @@ impl System {
         let mut r0 = 0;
         for joint in &self.model.joints {
             let ne = joint.kind.equations();
-            let mj = self.marker_kin(&ws.kin, joint.j);
-            let mi = self.marker_kin(&ws.kin, joint.i);
+            let mj = ws.mk[joint.j];
+            let mi = ws.mk[joint.i];
             // Use the moving side; the ground side gets the opposite.
             let (side, mk, sign) = if mj.slot.is_some() {
                 (1, mj, 1.0)
@@ -269,7 +375,12 @@ impl<T: Scalar> Workspace<T> {
             scale: Vec::new(),
             tmp: Vec::new(),
             kin: Vec::new(),
+            mk: Vec::new(),
             by_body: Vec::new(),
+            arena: Vec::new(),
+            mjac: Vec::new(),
+            mfac: Vec::new(),
+            inv: Vec::new(),
             inv_order: Vec::new(),
             col: Vec::new(),
             nz: Vec::new(),

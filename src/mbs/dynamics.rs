@@ -1,13 +1,17 @@
-//! Equations of motion with Lagrange multipliers (paper Eqs. 2–4, rigid
-//! part) solved at every right-hand-side evaluation.
+//! Equations of motion with Lagrange multipliers (paper Eqs. 2–4, 6)
+//! solved at every right-hand-side evaluation, for rigid bodies and
+//! floating-frame flexible bodies.
 //!
-//! State vector `y` (length `13·nb` for `nb` moving bodies):
-//! `[r_1, p_1, …, r_nb, p_nb, ṙ_1, ω'_1, …, ṙ_nb, ω'_nb]`
-//! (3 + 4 position coordinates, 3 + 3 velocities per body).
+//! State vector `y`: the positions of every moving body, then their
+//! velocities. Body `s` has positions `[r, p, w]` (3 + 4 + n: frame
+//! origin, Euler parameters, modal coordinates; `n = 0` for a rigid body)
+//! at [`System::pos_off`] and velocities `v_s = [ṙ, ω', ẇ]` (3 + 3 + n)
+//! at [`System::vel_off`].
 //!
-//! With `v = [ṙ, ω']` per body the Newton–Euler equations are
-//! `M v̇ = Q + Gᵀλ`, `M = diag(m I, J')`, `Q = [f, n' − ω'×J'ω']`, and the
-//! constraints are imposed at acceleration level with Baumgarte
+//! The equations are `M v̇ = Q + Gᵀλ` with `M` block diagonal (per body:
+//! `diag(m I, J')` for a rigid body with its frame at the centre of mass,
+//! the dense `(6+n)²` matrix of [`super::flexdyn`] for a flexible one),
+//! and the constraints imposed at acceleration level with Baumgarte
 //! stabilisation: `G v̇ = γ − 2αΦ̇ − α²Φ`. Because `M` is block diagonal,
 //! `v̇ = M⁻¹(Q + Gᵀλ)` and `λ` solves the constraint-space system
 //! `(G M⁻¹ Gᵀ) λ = γ − 2αΦ̇ − α²Φ − G M⁻¹ Q`, which is formed from the
@@ -17,14 +21,26 @@
 //! Tikhonov shift ([`RANK_REG`]). Redundant equations give pivots at the
 //! shift level and are counted ([`RANK_TOL`]); their multipliers take the
 //! minimum-norm split, and the accelerations, which do not depend on that
-//! split, stay unique. One factorization per evaluation; the dual-number
-//! evaluation differentiates the same factorization (no finite differences).
+//! split, stay unique. One factorization per evaluation (plus one small
+//! Cholesky per flexible body); the dual-number evaluation differentiates
+//! the same factorizations (no finite differences).
+//!
+//! Markers on nodes of flexible bodies move with the modes
+//! (`x = r + A(s_k + Φ_k w)`) and rotate with them (frame
+//! `A R(Ψ_k w) F₀`, `R` the rotation of the rotation vector); their
+//! angular velocity is taken as `ω + A Ψ_k ẇ`, exact to first order in
+//! the elastic rotation, as in the linear finite element model. Point
+//! constraints are exact; frame constraints on flexible markers carry a
+//! second-order inconsistency `O(|Ψw|·|Ψẇ|)` that the stabilisation keeps
+//! bounded.
 //!
 //! Everything is generic over the scalar `T` so that `num_dual::Dual64`
 //! gives exact Jacobian-vector products of the right-hand side.
 
+use super::flexdyn::{flex_terms, FlexEffects, FlexState, InvT};
 use super::linalg::{
-    cholesky_solve, cst, euler_rate, min_degree_order, ordered_cholesky, rotation, Scalar,
+    cholesky_solve, cst, dense_cholesky, dense_cholesky_solve, euler_rate, min_degree_order,
+    ordered_cholesky, rotation, rotation_vector, Scalar,
 };
 use super::model::{Force, JointKind, Model, Param};
 use nalgebra::{Matrix3, Vector3};
@@ -45,18 +61,22 @@ pub const RANK_TOL: f64 = 1e-8;
 /// well-conditioned mechanism by a relative `O(1e-12/σ²_min)`.
 pub const RANK_REG: f64 = 1e-12;
 
-/// One constraint row: value, velocity residual, `γ` and up to two
-/// body blocks `(slot, [∂/∂ṙ; ∂/∂ω'])`.
+/// Marks a row side without modal Jacobian entries.
+pub const RIGID: usize = usize::MAX;
+
+/// One constraint row: value, velocity residual, `γ`, up to two body
+/// blocks `(slot, [∂/∂ṙ; ∂/∂ω'])`, the markers of the two sides, and the
+/// offsets of the modal Jacobian entries `∂/∂ẇ` of flexible sides in
+/// [`Workspace::mjac`] ([`RIGID`] otherwise).
 #[derive(Debug, Clone, Copy)]
 pub struct Row<T: Scalar> {
     pub phi: T,
     pub phidot: T,
     pub gamma: T,
     pub blocks: [(Option<usize>, [T; 6]); 2],
+    pub markers: [usize; 2],
+    pub modal: [usize; 2],
 }
-
-/// A row's block on one body: `(row index, d, M⁻¹ d)`.
-pub type RowBlock<T> = (usize, [T; 6], [T; 6]);
 
 /// Scratch storage reused across evaluations (one per scalar type).
 #[derive(Debug, Clone)]
@@ -67,13 +87,26 @@ pub struct Workspace<T: Scalar> {
     pub(crate) scale: Vec<T>,
     pub(crate) tmp: Vec<T>,
     pub kin: Vec<BodyKin<T>>,
-    /// Per moving body: the rows touching it as `(row, d, M⁻¹d)`.
-    pub(crate) by_body: Vec<Vec<RowBlock<T>>>,
+    /// Kinematics of every marker at the current state.
+    pub mk: Vec<MarkerKin<T>>,
+    /// Per moving body: the rows touching it as `(row, offset)`; the
+    /// arena holds `d` then `M⁻¹d` (each `dof` long) at the offset.
+    pub(crate) by_body: Vec<Vec<(usize, usize)>>,
+    pub(crate) arena: Vec<T>,
+    /// Modal Jacobian entries of the rows' flexible sides.
+    pub mjac: Vec<T>,
     /// Position of each row in the fill-reducing order.
     pub(crate) inv_order: Vec<usize>,
     pub(crate) col: Vec<T>,
     pub(crate) nz: Vec<usize>,
-    pub q: Vec<[T; 6]>,
+    /// Applied generalized forces, all bodies (velocity layout).
+    pub q: Vec<T>,
+    /// Per moving body: the Cholesky factor of a flexible body's mass
+    /// matrix (empty for rigid bodies).
+    pub(crate) mfac: Vec<Vec<T>>,
+    /// Per moving body: its invariants in `T` (flexible bodies), rebuilt
+    /// when design seeds are active.
+    pub(crate) inv: Vec<Option<InvT<T>>>,
     /// Rank of the last factorization.
     pub rank: usize,
     /// Parameter values overriding the model's (sensitivity analysis);
@@ -82,7 +115,7 @@ pub struct Workspace<T: Scalar> {
 }
 
 /// Kinematics of one body at the current state.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct BodyKin<T: Scalar> {
     pub r: Vector3<T>,
     pub a: Matrix3<T>,
@@ -91,6 +124,12 @@ pub struct BodyKin<T: Scalar> {
     pub w: Vector3<T>,
     /// Body-frame angular velocity.
     pub wb: Vector3<T>,
+    /// Modal coordinates and rates (empty for rigid bodies).
+    pub q: Vec<T>,
+    pub qd: Vec<T>,
+    /// Design seeds `(variable, δ)` of a flexible body's basis (dual
+    /// parts of [`Param::Design`] values; empty in plain evaluations).
+    pub design: Vec<(usize, T)>,
 }
 
 /// Global kinematics of a marker.
@@ -101,12 +140,20 @@ pub struct MarkerKin<T: Scalar> {
     pub x: Vector3<T>,
     /// Global velocity.
     pub v: Vector3<T>,
-    /// Lever arm from the centre of mass (global).
+    /// Lever arm from the body frame origin (global).
     pub s: Vector3<T>,
     /// Global frame columns.
     pub frame: Matrix3<T>,
-    /// Global angular velocity of the carrier body.
+    /// Global angular velocity of the marker.
     pub w: Vector3<T>,
+    /// Velocity-dependent part of the point's acceleration:
+    /// `ω×(ω×s) + 2ω×(AΦẇ)`.
+    pub acc: Vector3<T>,
+    /// Velocity-dependent part of the marker's angular acceleration:
+    /// `ω×(AΨẇ)` (zero on rigid bodies).
+    pub alpha: Vector3<T>,
+    /// `(body, node)` of a marker on a flexible node.
+    pub node: Option<(usize, usize)>,
 }
 
 /// Evaluation counters (what is not built is never evaluated).
@@ -117,6 +164,16 @@ pub struct Counters {
     pub actuators: Cell<u64>,
     pub springs: Cell<u64>,
     pub loads: Cell<u64>,
+    /// Flexible-body mass matrices and elastic forces built.
+    pub flexible: Cell<u64>,
+    /// Quadratic-velocity terms evaluated (per body).
+    pub quadratic: Cell<u64>,
+    /// Modal damping forces evaluated (per flexible body).
+    pub modal_damping: Cell<u64>,
+}
+
+fn bump(c: &Cell<u64>) {
+    c.set(c.get() + 1);
 }
 
 /// The assembled system: model + state layout.
@@ -127,6 +184,12 @@ pub struct System {
     pub slot: Vec<Option<usize>>,
     /// Slot → body index.
     pub moving: Vec<usize>,
+    /// Slot → number of modal coordinates (0 for rigid bodies).
+    pub modes: Vec<usize>,
+    pos: Vec<usize>,
+    vel: Vec<usize>,
+    npos: usize,
+    nvel: usize,
     pub counters: Counters,
 }
 
@@ -135,18 +198,32 @@ impl System {
     pub fn new(model: Model) -> System {
         let mut slot = Vec::with_capacity(model.bodies.len());
         let mut moving = Vec::new();
+        let mut modes = Vec::new();
+        let (mut pos, mut vel) = (Vec::new(), Vec::new());
+        let (mut npos, mut nvel) = (0, 0);
         for (k, b) in model.bodies.iter().enumerate() {
             if b.fixed {
                 slot.push(None);
             } else {
                 slot.push(Some(moving.len()));
                 moving.push(k);
+                let n = b.flex.as_ref().map_or(0, |f| f.n());
+                modes.push(n);
+                pos.push(npos);
+                vel.push(nvel);
+                npos += 7 + n;
+                nvel += 6 + n;
             }
         }
         System {
             model,
             slot,
             moving,
+            modes,
+            pos,
+            vel,
+            npos,
+            nvel,
             counters: Counters::default(),
         }
     }
@@ -155,45 +232,135 @@ impl System {
     pub fn nb(&self) -> usize {
         self.moving.len()
     }
-    /// State length `13·nb`.
+    /// State length (positions + velocities).
     pub fn nstates(&self) -> usize {
-        13 * self.nb()
+        self.npos + self.nvel
     }
     /// Offset of the velocity part of the state.
     pub fn voff(&self) -> usize {
-        7 * self.nb()
+        self.npos
+    }
+    /// Number of generalized velocities.
+    pub fn nvel(&self) -> usize {
+        self.nvel
+    }
+    /// Offset of body slot `s`'s positions `[r, p, w]` in the state.
+    pub fn pos_off(&self, s: usize) -> usize {
+        self.pos[s]
+    }
+    /// Offset of body slot `s`'s velocities `[ṙ, ω', ẇ]` in the state.
+    pub fn vel_off(&self, s: usize) -> usize {
+        self.npos + self.vel[s]
+    }
+    /// Offset of slot `s` in the velocity vector.
+    pub(crate) fn vel_local(&self, s: usize) -> usize {
+        self.vel[s]
+    }
+    /// Generalized velocities of slot `s` (`6 + modes`).
+    pub fn dof(&self, s: usize) -> usize {
+        6 + self.modes[s]
     }
 
-    /// Initial state from the bodies' initial pose and velocity.
+    /// Initial state from the bodies' initial pose and velocity (modal
+    /// coordinates and rates zero: undeformed at rest relative to the
+    /// frame).
     pub fn initial_state(&self) -> Vec<f64> {
-        let nb = self.nb();
-        let mut y = vec![0.0; 13 * nb];
+        let mut y = vec![0.0; self.nstates()];
         for (s, &b) in self.moving.iter().enumerate() {
             let body = &self.model.bodies[b];
-            y[7 * s..7 * s + 3].copy_from_slice(body.r0.as_slice());
-            y[7 * s + 3..7 * s + 7].copy_from_slice(&body.p0);
-            let o = 7 * nb + 6 * s;
+            let p = self.pos_off(s);
+            y[p..p + 3].copy_from_slice(body.r0.as_slice());
+            y[p + 3..p + 7].copy_from_slice(&body.p0);
+            let o = self.vel_off(s);
             y[o..o + 3].copy_from_slice(body.v0.as_slice());
             y[o + 3..o + 6].copy_from_slice(body.w0.as_slice());
         }
         y
     }
 
-    /// Body kinematics for every moving body.
-    pub fn body_kin<T: Scalar>(&self, y: &[T], out: &mut Vec<BodyKin<T>>) {
-        out.clear();
-        let vo = self.voff();
+    /// Body kinematics for every moving body; `params` supplies the design
+    /// seeds of flexible bodies ([`Param::Design`]).
+    pub fn body_kin<T: Scalar>(&self, y: &[T], params: &[(Param, T)], out: &mut Vec<BodyKin<T>>) {
+        out.truncate(self.nb());
         for s in 0..self.nb() {
-            let a = rotation(&y[7 * s + 3..7 * s + 7]);
-            let wb = Vector3::new(y[vo + 6 * s + 3], y[vo + 6 * s + 4], y[vo + 6 * s + 5]);
-            out.push(BodyKin {
-                r: Vector3::new(y[7 * s], y[7 * s + 1], y[7 * s + 2]),
-                a,
-                v: Vector3::new(y[vo + 6 * s], y[vo + 6 * s + 1], y[vo + 6 * s + 2]),
-                w: a * wb,
-                wb,
-            });
+            let p = self.pos_off(s);
+            let o = self.vel_off(s);
+            let a = rotation(&y[p + 3..p + 7]);
+            let wb = Vector3::new(y[o + 3], y[o + 4], y[o + 5]);
+            let n = self.modes[s];
+            let r = Vector3::new(y[p], y[p + 1], y[p + 2]);
+            let v = Vector3::new(y[o], y[o + 1], y[o + 2]);
+            if s == out.len() {
+                out.push(BodyKin {
+                    r,
+                    a,
+                    v,
+                    w: a * wb,
+                    wb,
+                    q: Vec::new(),
+                    qd: Vec::new(),
+                    design: Vec::new(),
+                });
+            }
+            let k = &mut out[s];
+            k.r = r;
+            k.a = a;
+            k.v = v;
+            k.w = a * wb;
+            k.wb = wb;
+            k.q.clear();
+            k.q.extend_from_slice(&y[p + 7..p + 7 + n]);
+            k.qd.clear();
+            k.qd.extend_from_slice(&y[o + 6..o + 6 + n]);
+            k.design.clear();
+            if n > 0 {
+                let b = self.moving[s];
+                for (par, val) in params {
+                    if let Param::Design(pb, var) = *par {
+                        if pb == b {
+                            let re = cst::<T>(val.to_subset().unwrap_or(0.0));
+                            let delta = *val - re;
+                            if !delta.is_exact_zero() {
+                                k.design.push((var, delta));
+                            }
+                        }
+                    }
+                }
+            }
         }
+    }
+
+    /// Translational and rotational mode-shape rows `(Φ_k, Ψ_k)` of node
+    /// `node` of body `b` (n columns each), with the design seeds of `kin`.
+    pub fn node_shapes<T: Scalar>(
+        &self,
+        kin: &BodyKin<T>,
+        b: usize,
+        node: usize,
+    ) -> (Vec<Vector3<T>>, Vec<Vector3<T>>) {
+        let flex = self.model.bodies[b]
+            .flex
+            .as_ref()
+            .expect("node markers exist only on flexible bodies");
+        let basis = &flex.basis;
+        let n = basis.n_modes;
+        let mut phi = vec![Vector3::<T>::zeros(); n];
+        let mut psi = vec![Vector3::<T>::zeros(); n];
+        for c in 0..6 {
+            for j in 0..n {
+                let i = (node * 6 + c) * n + j;
+                let mut e = cst::<T>(basis.shapes[i]);
+                for (var, d) in &kin.design {
+                    e += cst::<T>(basis.derivatives[*var].shapes[i]) * *d;
+                }
+                if c < 3 {
+                    phi[j][c] = e;
+                } else {
+                    psi[j][c - 3] = e;
+                }
+            }
+        }
+        (phi, psi)
     }
 
     /// Global kinematics of marker `m`.
@@ -226,20 +393,64 @@ impl System {
                     s: Vector3::zeros(),
                     frame: f,
                     w: Vector3::zeros(),
+                    acc: Vector3::zeros(),
+                    alpha: Vector3::zeros(),
+                    node: None,
                 }
             }
             Some(s) => {
                 let k = &kin[s];
-                let sg = k.a * pos;
-                MarkerKin {
-                    slot: Some(s),
-                    x: k.r + sg,
-                    v: k.v + k.w.cross(&sg),
-                    s: sg,
-                    frame: k.a * frame,
-                    w: k.w,
+                match (mk.node, mk.body) {
+                    (Some(node), Some(b)) if !k.q.is_empty() => {
+                        let (phi, psi) = self.node_shapes(k, b, node);
+                        let (mut du, mut th) = (Vector3::zeros(), Vector3::zeros());
+                        let (mut vd, mut wd) = (Vector3::zeros(), Vector3::zeros());
+                        for j in 0..phi.len() {
+                            du += phi[j] * k.q[j];
+                            vd += phi[j] * k.qd[j];
+                            th += psi[j] * k.q[j];
+                            wd += psi[j] * k.qd[j];
+                        }
+                        let sg = k.a * (pos + du);
+                        let vdg = k.a * vd;
+                        let wdg = k.a * wd;
+                        MarkerKin {
+                            slot: Some(s),
+                            x: k.r + sg,
+                            v: k.v + k.w.cross(&sg) + vdg,
+                            s: sg,
+                            frame: k.a * rotation_vector(&th) * frame,
+                            w: k.w + wdg,
+                            acc: k.w.cross(&k.w.cross(&sg)) + k.w.cross(&vdg) * cst::<T>(2.0),
+                            alpha: k.w.cross(&wdg),
+                            node: Some((b, node)),
+                        }
+                    }
+                    _ => {
+                        let sg = k.a * pos;
+                        MarkerKin {
+                            slot: Some(s),
+                            x: k.r + sg,
+                            v: k.v + k.w.cross(&sg),
+                            s: sg,
+                            frame: k.a * frame,
+                            w: k.w,
+                            acc: k.w.cross(&k.w.cross(&sg)),
+                            alpha: Vector3::zeros(),
+                            node: None,
+                        }
+                    }
                 }
             }
+        }
+    }
+
+    /// Kinematics of every marker into `ws.mk` (from `ws.kin`).
+    pub fn markers_kin<T: Scalar>(&self, ws: &mut Workspace<T>) {
+        ws.mk.clear();
+        for m in 0..self.model.markers.len() {
+            let k = self.marker_kin(&ws.kin, m);
+            ws.mk.push(k);
         }
     }
 
@@ -251,92 +462,246 @@ impl System {
         angle_of(&mi, &mj)
     }
 
-    /// Assemble all constraint rows at time `t` into `ws.rows`.
+    /// Assemble all constraint rows at time `t` into `ws.rows` (marker
+    /// kinematics from `ws.mk`).
     pub fn constraints<T: Scalar>(&self, t: f64, ws: &mut Workspace<T>) {
         ws.rows.clear();
+        ws.mjac.clear();
         let alpha = self.model.baumgarte;
         for joint in &self.model.joints {
-            let mi = self.marker_kin(&ws.kin, joint.i);
-            let mj = self.marker_kin(&ws.kin, joint.j);
+            let mi = &ws.mk[joint.i];
+            let mj = &ws.mk[joint.j];
+            let first = ws.rows.len();
             for k in 0..3 {
-                ws.rows.push(point_row(&mi, &mj, k));
+                ws.rows.push(point_row(mi, mj, k));
             }
             let (xi, yi) = (mi.frame.column(0).into(), mi.frame.column(1).into());
             let (yj, zj) = (mj.frame.column(1).into(), mj.frame.column(2).into());
             match &joint.kind {
                 JointKind::Spherical => {}
                 JointKind::Revolute => {
-                    ws.rows.push(dot_row(&mi, &mj, &xi, &zj));
-                    ws.rows.push(dot_row(&mi, &mj, &yi, &zj));
+                    ws.rows.push(dot_row(mi, mj, &xi, &zj));
+                    ws.rows.push(dot_row(mi, mj, &yi, &zj));
                 }
                 JointKind::Fixed => {
-                    ws.rows.push(dot_row(&mi, &mj, &xi, &zj));
-                    ws.rows.push(dot_row(&mi, &mj, &yi, &zj));
-                    ws.rows.push(dot_row(&mi, &mj, &xi, &yj));
+                    ws.rows.push(dot_row(mi, mj, &xi, &zj));
+                    ws.rows.push(dot_row(mi, mj, &yi, &zj));
+                    ws.rows.push(dot_row(mi, mj, &xi, &yj));
                 }
                 JointKind::Driven(drive) => {
-                    ws.rows.push(dot_row(&mi, &mj, &xi, &zj));
-                    ws.rows.push(dot_row(&mi, &mj, &yi, &zj));
+                    ws.rows.push(dot_row(mi, mj, &xi, &zj));
+                    ws.rows.push(dot_row(mi, mj, &yi, &zj));
                     let (f, df, ddf) = drive.eval(t);
-                    ws.rows.push(angle_row(&mi, &mj, (f, df, ddf)));
+                    ws.rows.push(angle_row(mi, mj, (f, df, ddf)));
                 }
             }
+            for row in &mut ws.rows[first..] {
+                row.markers = [joint.i, joint.j];
+            }
         }
-        // Convert ω-global blocks to ω' body-frame blocks and add Φ̇.
-        for row in ws.rows.iter_mut() {
+        // Modal entries of flexible sides, ω-global blocks to ω' body-frame
+        // blocks, and Φ̇.
+        let mut rows = std::mem::take(&mut ws.rows);
+        for row in rows.iter_mut() {
             let mut phidot = -row.phidot; // holds −ν on entry
-            for (slot, blk) in row.blocks.iter_mut() {
-                if let Some(s) = slot {
-                    let k = &ws.kin[*s];
-                    let wg = Vector3::new(blk[3], blk[4], blk[5]);
-                    let wb = k.a.transpose() * wg;
-                    blk[3] = wb[0];
-                    blk[4] = wb[1];
-                    blk[5] = wb[2];
-                    phidot += blk[0] * k.v[0] + blk[1] * k.v[1] + blk[2] * k.v[2];
-                    phidot += wg.dot(&k.w);
+            for side in 0..2 {
+                let (slot, blk) = &mut row.blocks[side];
+                let Some(s) = *slot else { continue };
+                let k = &ws.kin[s];
+                let dv = Vector3::new(blk[0], blk[1], blk[2]);
+                let wg = Vector3::new(blk[3], blk[4], blk[5]);
+                let mk = &ws.mk[row.markers[side]];
+                if let Some((b, node)) = mk.node {
+                    // ∂/∂ẇ_j = (Aᵀdv)·Φ_kj + (Aᵀ(dw_g − s×dv))·Ψ_kj.
+                    let (phi, psi) = self.node_shapes(k, b, node);
+                    let av = k.a.transpose() * dv;
+                    let aw = k.a.transpose() * (wg - mk.s.cross(&dv));
+                    row.modal[side] = ws.mjac.len();
+                    for j in 0..phi.len() {
+                        let e = av.dot(&phi[j]) + aw.dot(&psi[j]);
+                        phidot += e * k.qd[j];
+                        ws.mjac.push(e);
+                    }
                 }
+                let wb = k.a.transpose() * wg;
+                blk[3] = wb[0];
+                blk[4] = wb[1];
+                blk[5] = wb[2];
+                phidot += dv.dot(&k.v) + wg.dot(&k.w);
             }
             row.phidot = phidot;
             // Stabilised acceleration right-hand side.
             let a = cst::<T>(alpha);
             row.gamma -= cst::<T>(2.0) * a * phidot + a * a * row.phi;
         }
+        ws.rows = rows;
     }
 
-    /// Applied generalized forces `Q = [f, n' − ω'×J'ω']` per moving body
-    /// at time `t` (into `ws.q`).
-    pub(crate) fn applied<T: Scalar>(&self, ws: &mut Workspace<T>) {
-        ws.q.clear();
-        for (s, &b) in self.moving.iter().enumerate() {
-            let body = &self.model.bodies[b];
-            let k = &ws.kin[s];
-            let jw = body.inertia.map(cst::<T>) * k.wb;
-            let gyro = -k.wb.cross(&jw);
-            ws.q.push([T::zero(), T::zero(), T::zero(), gyro[0], gyro[1], gyro[2]]);
+    /// The invariants of flexible slot `s` in `T` (cached when no design
+    /// seed is active).
+    fn invariants<T: Scalar>(&self, s: usize, ws: &mut Workspace<T>) {
+        let flex = self.model.bodies[self.moving[s]].flex.as_ref();
+        let Some(flex) = flex else { return };
+        ws.inv.resize_with(self.nb(), || None);
+        let seeded = !ws.kin[s].design.is_empty();
+        if seeded || ws.inv[s].is_none() {
+            ws.inv[s] = Some(InvT::lift(flex, &ws.kin[s].design));
         }
+    }
+
+    /// Mass matrices of the flexible bodies (factored into `ws.mfac`) and,
+    /// when `forces` is set, their inertia, elastic and damping forces
+    /// (added to `ws.q`). `ws.q` must be sized.
+    fn flex_bodies<T: Scalar>(&self, ws: &mut Workspace<T>, forces: bool) {
+        ws.mfac.resize_with(self.nb(), Vec::new);
+        for s in 0..self.nb() {
+            let n = self.modes[s];
+            if n == 0 {
+                continue;
+            }
+            bump(&self.counters.flexible);
+            self.invariants(s, ws);
+            let body = &self.model.bodies[self.moving[s]];
+            let zeta = body.flex.as_ref().map_or(0.0, |f| f.zeta);
+            let eff = FlexEffects {
+                quadratic: self.model.quadratic_velocity && forces,
+                zeta: if forces { zeta } else { 0.0 },
+            };
+            if eff.quadratic {
+                bump(&self.counters.quadratic);
+            }
+            if eff.zeta != 0.0 {
+                bump(&self.counters.modal_damping);
+            }
+            let d = 6 + n;
+            let o = self.vel_local(s);
+            let mut fq = vec![T::zero(); d];
+            let mut mass = std::mem::take(&mut ws.mfac[s]);
+            {
+                let k = &ws.kin[s];
+                let inv = ws.inv[s].as_ref().expect("invariants built above");
+                let st = FlexState {
+                    a: &k.a,
+                    wb: &k.wb,
+                    w: &k.q,
+                    wd: &k.qd,
+                };
+                flex_terms(inv, &st, eff, &mut mass, &mut fq);
+            }
+            // A non-positive pivot leaves a NaN in the factor, which the
+            // integrator reports with the time.
+            if !dense_cholesky(&mut mass, d) {
+                mass[0] = cst::<T>(f64::NAN);
+            }
+            ws.mfac[s] = mass;
+            if forces {
+                for (q, f) in ws.q[o..o + d].iter_mut().zip(&fq) {
+                    *q += *f;
+                }
+            }
+        }
+    }
+
+    /// Factored mass matrices of the flexible bodies at the kinematics in
+    /// `ws` (no forces).
+    pub(crate) fn mass_factors<T: Scalar>(&self, ws: &mut Workspace<T>) {
+        self.flex_bodies(ws, false);
+    }
+
+    /// `M v` of flexible slot `s` from its factor (`M = L Lᵀ`).
+    pub(crate) fn flex_mass_times(&self, s: usize, ws: &Workspace<f64>, v: &[f64]) -> Vec<f64> {
+        let d = self.dof(s);
+        let l = &ws.mfac[s];
+        let ltv: Vec<f64> = (0..d)
+            .map(|c| (c..d).map(|r| l[r * d + c] * v[r]).sum())
+            .collect();
+        (0..d)
+            .map(|r| (0..=r).map(|c| l[r * d + c] * ltv[c]).sum())
+            .collect()
+    }
+
+    /// Applied generalized forces (inertia, elastic, gravity, force
+    /// elements) of every moving body at time `t` (into `ws.q`), and the
+    /// factored mass matrices of flexible bodies.
+    pub(crate) fn applied<T: Scalar>(&self, t: f64, ws: &mut Workspace<T>) {
+        ws.q.clear();
+        ws.q.resize(self.nvel, T::zero());
+        if self.model.quadratic_velocity {
+            for (s, &b) in self.moving.iter().enumerate() {
+                if self.modes[s] > 0 {
+                    continue;
+                }
+                bump(&self.counters.quadratic);
+                let body = &self.model.bodies[b];
+                let k = &ws.kin[s];
+                let jw = body.inertia.map(cst::<T>) * k.wb;
+                let gyro = -k.wb.cross(&jw);
+                let o = self.vel_local(s);
+                for c in 0..3 {
+                    ws.q[o + 3 + c] += gyro[c];
+                }
+            }
+        }
+        self.flex_bodies(ws, true);
         for (fi, force) in self.model.forces.iter().enumerate() {
             match force {
                 Force::Gravity { g } => {
-                    self.counters.gravity.set(self.counters.gravity.get() + 1);
+                    bump(&self.counters.gravity);
                     for (s, &b) in self.moving.iter().enumerate() {
-                        let m = pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass);
-                        for c in 0..3 {
-                            ws.q[s][c] += m * cst::<T>(g[c]);
+                        let o = self.vel_local(s);
+                        let gt = g.map(cst::<T>);
+                        match &ws.inv.get(s).and_then(|i| i.as_ref()) {
+                            Some(inv) if self.modes[s] > 0 => {
+                                let k = &ws.kin[s];
+                                let gb = k.a.transpose() * gt;
+                                let sm = inv.first_moment(&k.q);
+                                let tq = sm.cross(&gb);
+                                let modal = inv.i3t(&gb);
+                                for c in 0..3 {
+                                    ws.q[o + c] += inv.mass * gt[c];
+                                    ws.q[o + 3 + c] += tq[c];
+                                }
+                                for (j, f) in modal.iter().enumerate() {
+                                    ws.q[o + 6 + j] += *f;
+                                }
+                            }
+                            _ => {
+                                let m = pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass);
+                                for c in 0..3 {
+                                    ws.q[o + c] += m * gt[c];
+                                }
+                            }
                         }
                     }
                 }
-                Force::BodyLoad {
-                    body,
-                    force,
-                    torque,
-                } => {
-                    self.counters.loads.set(self.counters.loads.get() + 1);
+                Force::BodyLoad { body, load } => {
+                    bump(&self.counters.loads);
                     if let Some(s) = self.slot[*body] {
+                        let (force, torque) = load.eval(t);
                         let tb = ws.kin[s].a.transpose() * torque.map(cst::<T>);
+                        let o = self.vel_local(s);
+                        // A flexible body's frame origin is not its centre
+                        // of mass: the force acts at the centre of mass.
+                        let arm = match ws.inv.get(s).and_then(|i| i.as_ref()) {
+                            Some(inv) if self.modes[s] > 0 => {
+                                Some(inv.first_moment(&ws.kin[s].q) / inv.mass)
+                            }
+                            _ => None,
+                        };
+                        let fb = ws.kin[s].a.transpose() * force.map(cst::<T>);
+                        let extra = arm.map_or(Vector3::zeros(), |c| c.cross(&fb));
                         for c in 0..3 {
-                            ws.q[s][c] += cst::<T>(force[c]);
-                            ws.q[s][3 + c] += tb[c];
+                            ws.q[o + c] += cst::<T>(force[c]);
+                            ws.q[o + 3 + c] += tb[c] + extra[c];
+                        }
+                        if let Some(inv) = ws.inv.get(s).and_then(|i| i.as_ref()) {
+                            if self.modes[s] > 0 {
+                                let modal = inv.i3t(&fb);
+                                let m = inv.mass;
+                                for (j, f) in modal.iter().enumerate() {
+                                    ws.q[o + 6 + j] += *f / m;
+                                }
+                            }
                         }
                     }
                 }
@@ -345,12 +710,10 @@ impl System {
                     law,
                     damping,
                 } => {
-                    self.counters
-                        .actuators
-                        .set(self.counters.actuators.get() + 1);
+                    bump(&self.counters.actuators);
                     let jt = &self.model.joints[*joint];
-                    let mi = self.marker_kin(&ws.kin, jt.i);
-                    let mj = self.marker_kin(&ws.kin, jt.j);
+                    let mi = ws.mk[jt.i];
+                    let mj = ws.mk[jt.j];
                     let (th, thd) = angle_of(&mi, &mj);
                     let mut m = pval(&ws.params, Param::Damping(fi), *damping) * thd;
                     if let Some(law) = law {
@@ -361,8 +724,8 @@ impl System {
                     }
                     let axis: Vector3<T> = mi.frame.column(2).into();
                     let tau = axis * (-m);
-                    apply_torque(ws, mj.slot, &tau);
-                    apply_torque(ws, mi.slot, &(-tau));
+                    self.apply_torque(ws, &mj, &tau);
+                    self.apply_torque(ws, &mi, &(-tau));
                 }
                 Force::SpringDamper {
                     i,
@@ -371,9 +734,9 @@ impl System {
                     damping,
                     length,
                 } => {
-                    self.counters.springs.set(self.counters.springs.get() + 1);
-                    let mi = self.marker_kin(&ws.kin, *i);
-                    let mj = self.marker_kin(&ws.kin, *j);
+                    bump(&self.counters.springs);
+                    let mi = ws.mk[*i];
+                    let mj = ws.mk[*j];
                     let d = mj.x - mi.x;
                     let l = d.norm();
                     let u = d / l;
@@ -382,78 +745,144 @@ impl System {
                     let c = pval(&ws.params, Param::Damping(fi), *damping);
                     let tension = k * (l - cst::<T>(*length)) + c * ldot;
                     let f = u * tension; // on i, towards j
-                    apply_force(ws, &mi, &f);
-                    apply_force(ws, &mj, &(-f));
+                    self.apply_force(ws, &mi, &f);
+                    self.apply_force(ws, &mj, &(-f));
                 }
             }
         }
+    }
+
+    /// Add a global torque on the carrier of marker `mk` (and on the modes
+    /// through `Ψ_kᵀ` for a flexible node).
+    fn apply_torque<T: Scalar>(&self, ws: &mut Workspace<T>, mk: &MarkerKin<T>, tau: &Vector3<T>) {
+        let Some(s) = mk.slot else { return };
+        let o = self.vel_local(s);
+        let tb = ws.kin[s].a.transpose() * tau;
+        for c in 0..3 {
+            ws.q[o + 3 + c] += tb[c];
+        }
+        if let Some((b, node)) = mk.node {
+            let (_, psi) = self.node_shapes(&ws.kin[s], b, node);
+            for (j, p) in psi.iter().enumerate() {
+                ws.q[o + 6 + j] += p.dot(&tb);
+            }
+        }
+    }
+
+    /// Add a global force at marker `mk` (and on the modes through `Φ_kᵀ`).
+    fn apply_force<T: Scalar>(&self, ws: &mut Workspace<T>, mk: &MarkerKin<T>, f: &Vector3<T>) {
+        let Some(s) = mk.slot else { return };
+        let o = self.vel_local(s);
+        let at = ws.kin[s].a.transpose();
+        let tb = at * mk.s.cross(f);
+        for c in 0..3 {
+            ws.q[o + c] += f[c];
+            ws.q[o + 3 + c] += tb[c];
+        }
+        if let Some((b, node)) = mk.node {
+            let fb = at * f;
+            let (phi, _) = self.node_shapes(&ws.kin[s], b, node);
+            for (j, p) in phi.iter().enumerate() {
+                ws.q[o + 6 + j] += p.dot(&fb);
+            }
+        }
+    }
+
+    /// Kinematics (bodies and markers) of `y` into `ws`.
+    pub fn kinematics<T: Scalar>(&self, y: &[T], ws: &mut Workspace<T>) {
+        let mut kin = std::mem::take(&mut ws.kin);
+        self.body_kin(y, &ws.params, &mut kin);
+        ws.kin = kin;
+        self.markers_kin(ws);
     }
 
     /// Right-hand side `ẏ = f(t, y)`; also leaves the multipliers in
     /// `ws.rhs` (length = number of equations) and the rank in `ws.rank`.
     /// `t` is a plain `f64`: time never carries a derivative here.
     pub fn rhs<T: Scalar>(&self, t: f64, y: &[T], dy: &mut [T], ws: &mut Workspace<T>) {
-        self.counters.rhs.set(self.counters.rhs.get() + 1);
-        let nb = self.nb();
-        let vo = self.voff();
-        let mut kin = std::mem::take(&mut ws.kin);
-        self.body_kin(y, &mut kin);
-        ws.kin = kin;
-        // Position derivatives.
-        for s in 0..nb {
+        bump(&self.counters.rhs);
+        self.kinematics(y, ws);
+        for s in 0..self.nb() {
+            let p = self.pos_off(s);
+            let o = self.vel_off(s);
             let k = &ws.kin[s];
-            dy[7 * s] = k.v[0];
-            dy[7 * s + 1] = k.v[1];
-            dy[7 * s + 2] = k.v[2];
-            let pd = euler_rate(&y[7 * s + 3..7 * s + 7], &k.wb);
-            dy[7 * s + 3..7 * s + 7].copy_from_slice(&pd);
+            dy[p] = k.v[0];
+            dy[p + 1] = k.v[1];
+            dy[p + 2] = k.v[2];
+            let pd = euler_rate(&y[p + 3..p + 7], &k.wb);
+            dy[p + 3..p + 7].copy_from_slice(&pd);
+            let n = self.modes[s];
+            dy[p + 7..p + 7 + n].copy_from_slice(&y[o + 6..o + 6 + n]);
         }
         self.constraints(t, ws);
-        self.applied(ws);
+        self.applied(t, ws);
         let acc = self.solve(ws);
-        for s in 0..nb {
-            dy[vo + 6 * s..vo + 6 * s + 6].copy_from_slice(&acc[s]);
+        let vo = self.voff();
+        dy[vo..vo + self.nvel].copy_from_slice(&acc);
+    }
+
+    /// `M⁻¹ x` for slot `s` (in place).
+    fn apply_minv<T: Scalar>(
+        &self,
+        ws_mfac: &[Vec<T>],
+        params: &[(Param, T)],
+        s: usize,
+        x: &mut [T],
+    ) {
+        if self.modes[s] > 0 {
+            dense_cholesky_solve(&ws_mfac[s], self.dof(s), x);
+            return;
+        }
+        let b = self.moving[s];
+        let body = &self.model.bodies[b];
+        let im = T::one() / pval(params, Param::Mass(b), body.mass);
+        let w = body.inv_inertia.map(cst::<T>) * Vector3::new(x[3], x[4], x[5]);
+        for c in 0..3 {
+            x[c] *= im;
+            x[3 + c] = w[c];
         }
     }
 
-    /// Solve for the multipliers and accelerations with the rows and
-    /// applied forces in `ws`. Returns `v̇` per body; `ws.rhs` = λ.
-    pub(crate) fn solve<T: Scalar>(&self, ws: &mut Workspace<T>) -> Vec<[T; 6]> {
+    /// Solve for the multipliers and accelerations with the rows, applied
+    /// forces and mass factors in `ws`. Returns `v̇` (velocity layout);
+    /// `ws.rhs` = λ.
+    pub(crate) fn solve<T: Scalar>(&self, ws: &mut Workspace<T>) -> Vec<T> {
         let m = ws.rows.len();
-        let minv: Vec<(T, Matrix3<T>)> = self
-            .moving
-            .iter()
-            .map(|&b| {
-                let body = &self.model.bodies[b];
-                let m = pval(&ws.params, Param::Mass(b), body.mass);
-                (T::one() / m, body.inv_inertia.map(cst::<T>))
-            })
-            .collect();
-        let apply_minv = |s: usize, x: &[T; 6]| -> [T; 6] {
-            let (im, ij) = &minv[s];
-            let w = *ij * Vector3::new(x[3], x[4], x[5]);
-            [x[0] * *im, x[1] * *im, x[2] * *im, w[0], w[1], w[2]]
-        };
-        let mq: Vec<[T; 6]> =
-            ws.q.iter()
-                .enumerate()
-                .map(|(s, q)| apply_minv(s, q))
-                .collect();
-        // Rows touching each body, with M⁻¹ dᵀ.
         let nb = self.nb();
+        let mut mq = ws.q.clone();
+        for s in 0..nb {
+            let o = self.vel_local(s);
+            self.apply_minv(&ws.mfac, &ws.params, s, &mut mq[o..o + self.dof(s)]);
+        }
+        // Rows touching each body, with d and M⁻¹d in the arena.
         let mut by_body = std::mem::take(&mut ws.by_body);
         by_body.resize_with(nb, Vec::new);
         for list in by_body.iter_mut() {
             list.clear();
         }
+        let mut arena = std::mem::take(&mut ws.arena);
+        arena.clear();
         ws.rhs.clear();
         for (r, row) in ws.rows.iter().enumerate() {
             let mut b = row.gamma;
-            for (slot, blk) in &row.blocks {
-                if let Some(s) = slot {
-                    b -= dot6(blk, &mq[*s]);
-                    by_body[*s].push((r, *blk, apply_minv(*s, blk)));
+            for (side, (slot, blk)) in row.blocks.iter().enumerate() {
+                let Some(s) = *slot else { continue };
+                let d = self.dof(s);
+                let off = arena.len();
+                arena.extend_from_slice(blk);
+                if d > 6 {
+                    let mo = row.modal[side];
+                    if mo == RIGID {
+                        arena.extend(std::iter::repeat_n(T::zero(), d - 6));
+                    } else {
+                        arena.extend_from_slice(&ws.mjac[mo..mo + d - 6]);
+                    }
                 }
+                arena.extend_from_within(off..off + d);
+                self.apply_minv(&ws.mfac, &ws.params, s, &mut arena[off + d..off + 2 * d]);
+                let o = self.vel_local(s);
+                b -= dot(&arena[off..off + d], &mq[o..o + d]);
+                by_body[s].push((r, off));
             }
             ws.rhs.push(b);
         }
@@ -462,8 +891,8 @@ impl System {
         if ws.inv_order.len() != m {
             let mut edges = Vec::new();
             for list in &by_body {
-                for (x, (r, _, _)) in list.iter().enumerate() {
-                    for (c, _, _) in list.iter().take(x) {
+                for (x, (r, _)) in list.iter().enumerate() {
+                    for (c, _) in list.iter().take(x) {
                         edges.push((*r, *c));
                     }
                 }
@@ -477,12 +906,13 @@ impl System {
         let inv = &ws.inv_order;
         ws.a.clear();
         ws.a.resize(m * m, T::zero());
-        for list in &by_body {
-            for (x, (r, d, _)) in list.iter().enumerate() {
-                for (c, _, w) in list.iter().take(x + 1) {
+        for (s, list) in by_body.iter().enumerate() {
+            let d = self.dof(s);
+            for (x, (r, od)) in list.iter().enumerate() {
+                for (c, ow) in list.iter().take(x + 1) {
                     let (pr, pc) = (inv[*r], inv[*c]);
                     let (hi, lo) = if pr >= pc { (pr, pc) } else { (pc, pr) };
-                    ws.a[hi * m + lo] += dot6(d, w);
+                    ws.a[hi * m + lo] += dot(&arena[*od..*od + d], &arena[ow + d..ow + 2 * d]);
                 }
             }
         }
@@ -508,14 +938,18 @@ impl System {
         std::mem::swap(&mut lam, &mut ws.tmp);
         let mut acc = mq;
         for (s, list) in by_body.iter().enumerate() {
-            for (r, _, w) in list {
-                for c in 0..6 {
-                    acc[s][c] += w[c] * lam[*r];
+            let d = self.dof(s);
+            let o = self.vel_local(s);
+            for (r, off) in list {
+                let w = &arena[off + d..off + 2 * d];
+                for c in 0..d {
+                    acc[o + c] += w[c] * lam[*r];
                 }
             }
         }
         ws.rhs = lam;
         ws.by_body = by_body;
+        ws.arena = arena;
         acc
     }
 }
@@ -530,27 +964,8 @@ fn pval<T: Scalar>(params: &[(Param, T)], which: Param, default: f64) -> T {
         .map_or_else(|| cst::<T>(default), |(_, v)| *v)
 }
 
-fn dot6<T: Scalar>(a: &[T; 6], b: &[T; 6]) -> T {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
-}
-
-fn apply_torque<T: Scalar>(ws: &mut Workspace<T>, slot: Option<usize>, tau: &Vector3<T>) {
-    if let Some(s) = slot {
-        let tb = ws.kin[s].a.transpose() * tau;
-        for c in 0..3 {
-            ws.q[s][3 + c] += tb[c];
-        }
-    }
-}
-
-fn apply_force<T: Scalar>(ws: &mut Workspace<T>, mk: &MarkerKin<T>, f: &Vector3<T>) {
-    if let Some(s) = mk.slot {
-        let tb = ws.kin[s].a.transpose() * mk.s.cross(f);
-        for c in 0..3 {
-            ws.q[s][c] += f[c];
-            ws.q[s][3 + c] += tb[c];
-        }
-    }
+fn dot<T: Scalar>(a: &[T], b: &[T]) -> T {
+    a.iter().zip(b).fold(T::zero(), |acc, (x, y)| acc + *x * *y)
 }
 
 /// `θ = atan2(z_i·(x_i × x_j), x_i·x_j)` and `θ̇ = z_i·(ω_j − ω_i)`.
@@ -568,23 +983,26 @@ fn block<T: Scalar>(mk: &MarkerKin<T>, dr: Vector3<T>, dw: Vector3<T>) -> (Optio
 }
 
 /// Component `k` of `x_i − x_j = 0`. Velocity: `ṙ + ω × s`, so the ω
-/// block is `e_kᵀ(−s̃) = (s × e_k)ᵀ`; `γ = −e_k·(ω_i×(ω_i×s_i) − ω_j×(ω_j×s_j))`.
+/// block is `e_kᵀ(−s̃) = (s × e_k)ᵀ`; `γ = −e_k·(a_i − a_j)` with the
+/// velocity-dependent accelerations [`MarkerKin::acc`]
+/// (`ω×(ω×s)` on rigid bodies).
 fn point_row<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, k: usize) -> Row<T> {
     let mut e = Vector3::zeros();
     e[k] = T::one();
-    let ci = mi.w.cross(&mi.w.cross(&mi.s));
-    let cj = mj.w.cross(&mj.w.cross(&mj.s));
     Row {
         phi: mi.x[k] - mj.x[k],
         phidot: T::zero(),
-        gamma: -(ci[k] - cj[k]),
+        gamma: -(mi.acc[k] - mj.acc[k]),
         blocks: [block(mi, e, mi.s.cross(&e)), block(mj, -e, -mj.s.cross(&e))],
+        markers: [0, 0],
+        modal: [RIGID, RIGID],
     }
 }
 
 /// `a·b = 0` with `a` fixed in body i and `b` in body j:
 /// `d/dt(a·b) = ω_i·(a×b) + ω_j·(b×a)`,
-/// `γ = −[b·(ω_i×(ω_i×a)) + 2(ω_i×a)·(ω_j×b) + a·(ω_j×(ω_j×b))]`.
+/// `γ = −[b·(ω_i×(ω_i×a)) + 2(ω_i×a)·(ω_j×b) + a·(ω_j×(ω_j×b))
+///       + (α_i − α_j)·(a×b)]` (`α` = [`MarkerKin::alpha`]).
 fn dot_row<T: Scalar>(
     mi: &MarkerKin<T>,
     mj: &MarkerKin<T>,
@@ -594,7 +1012,10 @@ fn dot_row<T: Scalar>(
     let axb = a.cross(b);
     let wa = mi.w.cross(a);
     let wb = mj.w.cross(b);
-    let quad = b.dot(&mi.w.cross(&wa)) + cst::<T>(2.0) * wa.dot(&wb) + a.dot(&mj.w.cross(&wb));
+    let quad = b.dot(&mi.w.cross(&wa))
+        + cst::<T>(2.0) * wa.dot(&wb)
+        + a.dot(&mj.w.cross(&wb))
+        + (mi.alpha - mj.alpha).dot(&axb);
     Row {
         phi: a.dot(b),
         phidot: T::zero(),
@@ -603,11 +1024,14 @@ fn dot_row<T: Scalar>(
             block(mi, Vector3::zeros(), axb),
             block(mj, Vector3::zeros(), -axb),
         ],
+        markers: [0, 0],
+        modal: [RIGID, RIGID],
     }
 }
 
 /// Prescribed angle `θ − f(t) = 0` (wrapped to (−π, π]):
-/// `θ̇ = z_i·(ω_j − ω_i)`, `γ = f̈ − (ω_i×z_i)·(ω_j − ω_i)`, `ν = ḟ`.
+/// `θ̇ = z_i·(ω_j − ω_i)`, `γ = f̈ − (ω_i×z_i)·(ω_j − ω_i) − z_i·(α_j − α_i)`,
+/// `ν = ḟ`.
 fn angle_row<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, drive: (f64, f64, f64)) -> Row<T> {
     let (th, _) = angle_of(mi, mj);
     let zi: Vector3<T> = mi.frame.column(2).into();
@@ -624,10 +1048,14 @@ fn angle_row<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, drive: (f64, f64, 
         phi: d,
         // ν enters with a minus sign: phidot holds −ν until assembled.
         phidot: cst::<T>(drive.1),
-        gamma: cst::<T>(drive.2) - mi.w.cross(&zi).dot(&(mj.w - mi.w)),
+        gamma: cst::<T>(drive.2)
+            - mi.w.cross(&zi).dot(&(mj.w - mi.w))
+            - zi.dot(&(mj.alpha - mi.alpha)),
         blocks: [
             block(mi, Vector3::zeros(), -zi),
             block(mj, Vector3::zeros(), zi),
         ],
+        markers: [0, 0],
+        modal: [RIGID, RIGID],
     }
 }

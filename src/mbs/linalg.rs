@@ -236,6 +236,70 @@ pub fn cholesky_solve<T: Scalar>(
     }
 }
 
+/// In-place dense Cholesky `A = L Lᵀ` of a symmetric positive definite
+/// row-major `n × n` matrix (lower triangle read and overwritten).
+/// Returns `false` at a non-positive pivot. For the small mass matrices
+/// of flexible bodies (`6 + modes`).
+pub fn dense_cholesky<T: Scalar>(a: &mut [T], n: usize) -> bool {
+    for k in 0..n {
+        let mut d = a[k * n + k];
+        for j in 0..k {
+            d -= a[k * n + j] * a[k * n + j];
+        }
+        if d.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) {
+            return false;
+        }
+        let l = d.sqrt();
+        a[k * n + k] = l;
+        for r in k + 1..n {
+            let mut v = a[r * n + k];
+            for j in 0..k {
+                v -= a[r * n + j] * a[k * n + j];
+            }
+            a[r * n + k] = v / l;
+        }
+    }
+    true
+}
+
+/// Solve `L Lᵀ x = b` in place with the factor of [`dense_cholesky`].
+pub fn dense_cholesky_solve<T: Scalar>(l: &[T], n: usize, b: &mut [T]) {
+    for k in 0..n {
+        let mut s = b[k];
+        for j in 0..k {
+            s -= l[k * n + j] * b[j];
+        }
+        b[k] = s / l[k * n + k];
+    }
+    for k in (0..n).rev() {
+        let mut s = b[k];
+        for r in k + 1..n {
+            s -= l[r * n + k] * b[r];
+        }
+        b[k] = s / l[k * n + k];
+    }
+}
+
+/// Rotation matrix of the rotation vector `θ` (Rodrigues:
+/// `I + (sin φ/φ) θ̃ + ((1 − cos φ)/φ²) θ̃²`, `φ = |θ|`), with the
+/// coefficients from their Taylor series for `φ² < 1e-4` (error below
+/// 1e-22) so that dual numbers stay finite at `θ = 0`.
+pub fn rotation_vector<T: Scalar>(th: &Vector3<T>) -> Matrix3<T> {
+    let p2 = th.norm_squared();
+    let (a, b) = if p2 < cst::<T>(1e-4) {
+        let c = |k: f64| cst::<T>(k);
+        (
+            T::one() - p2 / c(6.0) + p2 * p2 / c(120.0) - p2 * p2 * p2 / c(5040.0),
+            c(0.5) - p2 / c(24.0) + p2 * p2 / c(720.0) - p2 * p2 * p2 / c(40320.0),
+        )
+    } else {
+        let phi = p2.sqrt();
+        (phi.sin() / phi, (T::one() - phi.cos()) / p2)
+    };
+    let k = th.cross_matrix();
+    Matrix3::identity() + k * a + k * k * b
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -291,5 +355,42 @@ mod tests {
         let r = q.to_rotation_matrix().into_inner();
         assert!((a - r).norm() < 1e-14);
         assert!((a.transpose() * a - Matrix3::identity()).norm() < 1e-14);
+    }
+
+    #[test]
+    fn rotation_vector_matches_axis_angle_on_both_branches() {
+        // Reference: nalgebra's Rotation3::from_scaled_axis.
+        for th in [
+            Vector3::new(0.001, -0.002, 0.003),
+            Vector3::new(0.3, -0.5, 0.7),
+        ] {
+            let r = nalgebra::Rotation3::from_scaled_axis(th).into_inner();
+            assert!((rotation_vector(&th) - r).norm() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn dense_cholesky_solves_spd_system() {
+        // A = B Bᵀ + I (SPD by construction); residual check.
+        let n = 5;
+        let b: Vec<f64> = (0..n * n)
+            .map(|k| ((k * 7 % 11) as f64 - 5.0) / 3.0)
+            .collect();
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                a[i * n + j] = (0..n).map(|k| b[i * n + k] * b[j * n + k]).sum::<f64>()
+                    + if i == j { 1.0 } else { 0.0 };
+            }
+        }
+        let a0 = a.clone();
+        let rhs: Vec<f64> = (0..n).map(|k| k as f64 - 1.5).collect();
+        let mut x = rhs.clone();
+        assert!(dense_cholesky(&mut a, n));
+        dense_cholesky_solve(&a, n, &mut x);
+        for i in 0..n {
+            let r: f64 = (0..n).map(|j| a0[i * n + j] * x[j]).sum::<f64>() - rhs[i];
+            assert!(r.abs() < 1e-12);
+        }
     }
 }

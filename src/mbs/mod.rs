@@ -43,6 +43,7 @@ pub mod beam;
 pub mod bench;
 pub mod dynamics;
 pub mod flex;
+pub mod flexdyn;
 pub mod linalg;
 pub mod model;
 pub mod scene;

@@ -11,8 +11,45 @@
 //!   markers' z axes; the relative angle `θ` is the rotation of `j`
 //!   relative to `i` about `z_i`, `θ = atan2(z_i·(x_i × x_j), x_i·x_j)`.
 
+use super::flex::{Invariants, ModalBasis};
 use crate::error::{Error, Result};
 use nalgebra::{Matrix3, Vector3};
+use std::sync::Arc;
+
+/// The flexible part of a floating-frame body (paper Eqs. 5–6): its modal
+/// basis, the inertia invariants and their design derivatives, and the
+/// modal damping.
+#[derive(Debug, Clone)]
+pub struct Flex {
+    pub basis: Arc<ModalBasis>,
+    pub inv: Invariants,
+    /// `d(invariants)/d(design variable)`, one per `basis.derivatives`.
+    pub dinv: Vec<Invariants>,
+    /// Modal damping ratio ζ of every mode (modal force `−2ζω_j ẇ_j`);
+    /// zero unless the scene lists the `damping` effect.
+    pub zeta: f64,
+    /// Current values of the basis's design variables (rad), for
+    /// [`Param::Design`].
+    pub design: Vec<f64>,
+}
+
+impl Flex {
+    /// Invariants (and derivatives) of `basis`.
+    pub fn new(basis: ModalBasis, zeta: f64, design: Vec<f64>) -> Flex {
+        let (inv, dinv) = Invariants::with_derivatives(&basis);
+        Flex {
+            basis: Arc::new(basis),
+            inv,
+            dinv,
+            zeta,
+            design,
+        }
+    }
+    /// Number of modes.
+    pub fn n(&self) -> usize {
+        self.basis.n_modes
+    }
+}
 
 /// A rigid body (or a fixed one, which is part of the ground).
 #[derive(Debug, Clone)]
@@ -34,6 +71,10 @@ pub struct Body {
     pub w0: Vector3<f64>,
     /// Fixed bodies are ground: no coordinates, markers are global.
     pub fixed: bool,
+    /// Floating-frame flexibility; `None` for a rigid body. For a flexible
+    /// body `r0` is the initial position of the frame origin (the basis's
+    /// reference point), not of the centre of mass.
+    pub flex: Option<Flex>,
 }
 
 impl Body {
@@ -76,7 +117,18 @@ impl Body {
             v0: Vector3::zeros(),
             w0: Vector3::zeros(),
             fixed: false,
+            flex: None,
         })
+    }
+}
+
+impl Body {
+    /// Initial rotation matrix `A(p0)` (body → global).
+    pub fn orientation(&self) -> Matrix3<f64> {
+        let p = self.p0;
+        nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(p[0], p[1], p[2], p[3]))
+            .to_rotation_matrix()
+            .into_inner()
     }
 }
 
@@ -91,6 +143,9 @@ pub struct Marker {
     pub pos: Vector3<f64>,
     /// Orthonormal frame (columns x, y, z) in body axes.
     pub frame: Matrix3<f64>,
+    /// Node of a flexible body's basis the marker sits on (it then moves
+    /// and rotates with the modes); `None` on rigid bodies.
+    pub node: Option<usize>,
 }
 
 /// A prescribed relative angle `θ(t) = Σ c_k t^k` (rad, t in s); a locked
@@ -230,6 +285,10 @@ pub enum Param {
     /// Anchor (breakpoint) of segment `k` of the law of the actuator
     /// `forces[i]`: the `3.12` in `0.10 + 9.00(3.12 − θ)` (rad).
     Anchor(usize, usize),
+    /// Design variable `k` (a ply angle, rad) of the modal basis of the
+    /// flexible body `bodies[i]`: its exact effect on Λ and the mode
+    /// shapes comes from the basis's derivatives (`dΛ/dθ`, `dX/dθ`).
+    Design(usize, usize),
 }
 
 impl Param {
@@ -250,11 +309,18 @@ impl Param {
                 Some(Force::Rotational { law: Some(l), .. }) => l.segments.get(k).map(|s| s.anchor),
                 _ => None,
             },
+            Param::Design(b, k) => model
+                .bodies
+                .get(b)
+                .and_then(|b| b.flex.as_ref())
+                .and_then(|f| f.design.get(k).copied()),
         }
     }
 
-    /// A copy of `model` with this parameter set to `v` (for finite
-    /// differences and studies).
+    /// Set this parameter to `v` in `model` (for finite differences and
+    /// studies). A [`Param::Design`] variable only records `v`: the modal
+    /// basis must be rebuilt for the new design (its derivatives describe
+    /// the old one).
     pub fn set(&self, model: &mut Model, v: f64) {
         match *self {
             Param::Mass(b) => model.bodies[b].mass = v,
@@ -272,6 +338,11 @@ impl Param {
             Param::Anchor(f, k) => {
                 if let Force::Rotational { law: Some(l), .. } = &mut model.forces[f] {
                     l.segments[k].anchor = v;
+                }
+            }
+            Param::Design(b, k) => {
+                if let Some(f) = model.bodies[b].flex.as_mut() {
+                    f.design[k] = v;
                 }
             }
         }
@@ -300,13 +371,55 @@ pub enum Force {
         damping: f64,
         length: f64,
     },
-    /// Constant global force (N) at the centre of mass and global torque
-    /// (N·m) on a body.
-    BodyLoad {
-        body: usize,
+    /// Global force (N) at the centre of mass and global torque (N·m) on
+    /// a body, constant or tabulated in time. On a flexible body the force
+    /// is distributed in proportion to mass (as a uniform acceleration
+    /// field `f/m`, so it also loads the modes through `i3ᵀ`); the torque
+    /// acts on the frame.
+    BodyLoad { body: usize, load: Load },
+}
+
+/// A force and torque, constant or piecewise linear in time.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Load {
+    Constant {
         force: Vector3<f64>,
         torque: Vector3<f64>,
     },
+    /// Rows `(t, [fx, fy, fz, tx, ty, tz])` with increasing `t`; linear
+    /// between rows, held at the first and last row outside them.
+    Table(Vec<(f64, [f64; 6])>),
+}
+
+impl Load {
+    /// Force and torque at time `t` (s).
+    pub fn eval(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let split = |v: &[f64; 6]| {
+            (
+                Vector3::new(v[0], v[1], v[2]),
+                Vector3::new(v[3], v[4], v[5]),
+            )
+        };
+        match self {
+            Load::Constant { force, torque } => (*force, *torque),
+            Load::Table(rows) => {
+                let k = rows.partition_point(|(tk, _)| *tk <= t);
+                if k == 0 {
+                    return split(&rows[0].1);
+                }
+                if k == rows.len() {
+                    return split(&rows[k - 1].1);
+                }
+                let ((t0, a), (t1, b)) = (&rows[k - 1], &rows[k]);
+                let f = (t - t0) / (t1 - t0);
+                let mut v = [0.0; 6];
+                for c in 0..6 {
+                    v[c] = a[c] + f * (b[c] - a[c]);
+                }
+                split(&v)
+            }
+        }
+    }
 }
 
 impl Force {
@@ -331,6 +444,10 @@ pub struct Model {
     /// Baumgarte rate α (1/s): the constraint acceleration equation is
     /// `Φ̈ + 2αΦ̇ + α²Φ = 0` (critically damped drift).
     pub baumgarte: f64,
+    /// Quadratic-velocity inertia terms (gyroscopic `ω×Jω` of rigid
+    /// bodies; centrifugal and Coriolis couplings of flexible ones): the
+    /// scene's `quadratic_velocity` effect.
+    pub quadratic_velocity: bool,
 }
 
 impl Model {

@@ -28,9 +28,12 @@
 //! Bodies start with their axes along the global axes, so `inertia` is
 //! both the global and the body-frame tensor at `t = 0`.
 
+use super::beam::Beam;
+use super::flex::ModalBasis;
+use super::linalg::euler_from_rotation;
 use super::model::{
-    axis_angle, frame_from_axis, Body, Drive, Force, Joint, JointKind, Marker, Model, Param,
-    PiecewiseLaw, Segment,
+    axis_angle, frame_from_axis, Body, Drive, Flex, Force, Joint, JointKind, Load, Marker, Model,
+    Param, PiecewiseLaw, Segment,
 };
 use crate::error::{Error, Result};
 use crate::integrate::{Method, Options};
@@ -38,7 +41,15 @@ use nalgebra::{Matrix3, Vector3};
 use serde::Deserialize;
 
 /// Effects a scene may list.
-pub const EFFECTS: [&str; 5] = ["gravity", "actuators", "damping", "springs", "loads"];
+pub const EFFECTS: [&str; 7] = [
+    "gravity",
+    "actuators",
+    "damping",
+    "springs",
+    "loads",
+    "flexibility",
+    "quadratic_velocity",
+];
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -78,16 +89,67 @@ fn default_baumgarte() -> f64 {
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
     pub name: String,
-    pub mass: f64,
-    pub com: [f64; 3],
-    pub inertia: [[f64; 3]; 3],
+    /// Rigid mass properties: required for rigid bodies, and for flexible
+    /// ones when the scene does not list `flexibility` (then they are
+    /// simulated rigid).
+    pub mass: Option<f64>,
+    pub com: Option<[f64; 3]>,
+    pub inertia: Option<[[f64; 3]; 3]>,
     #[serde(default)]
     pub fixed: bool,
     #[serde(default)]
     pub velocity: [f64; 3],
     #[serde(default)]
     pub angular_velocity: [f64; 3],
+    /// A floating-frame flexible body (used when `flexibility` is listed).
+    pub flexible: Option<FlexSpec>,
 }
+
+/// `flexible = { kind = "beam" | "panel", modes, origin, .. }`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlexSpec {
+    /// `beam` (closed-form cantilever modes) or `panel` (finite element
+    /// modes of a `[[panels]]` entry).
+    pub kind: String,
+    /// Number of modes kept.
+    pub modes: usize,
+    /// Global position of the basis frame's origin at t = 0 (m): the
+    /// beam's root, the panel's centre.
+    pub origin: [f64; 3],
+    /// Global directions of the basis frame's x and y axes at t = 0.
+    #[serde(default = "unit_x")]
+    pub x_axis: [f64; 3],
+    #[serde(default = "unit_y")]
+    pub y_axis: [f64; 3],
+    /// Modal damping ratio ζ of every mode (with the `damping` effect).
+    #[serde(default)]
+    pub damping: f64,
+    /// Beam: length (m), bending stiffnesses for deflection along y
+    /// (`ei_z`) and z (`ei_y`) (N·m²), mass per length (kg/m), polar mass
+    /// moment per length (kg·m, rotary inertia about the beam axis).
+    pub length: Option<f64>,
+    pub ei_y: Option<f64>,
+    pub ei_z: Option<f64>,
+    pub rho_a: Option<f64>,
+    pub rho_ip: Option<f64>,
+    /// Panel: the `name` of a `[[panels]]` entry of the study.
+    pub panel: Option<String>,
+    /// Panel: design derivatives of the modes for ply-angle sensitivities,
+    /// `fixed` (Eq. 19) or `updated` (Eq. 18).
+    pub derivatives: Option<String>,
+}
+
+fn unit_x() -> [f64; 3] {
+    [1.0, 0.0, 0.0]
+}
+fn unit_y() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// Builds the modal basis of a `kind = "panel"` body: `(panel name,
+/// modes, derivatives)` → basis; errors name the study's keys.
+pub type PanelBases<'a> = &'a dyn Fn(&str, usize, Option<&str>) -> Result<ModalBasis>;
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -126,6 +188,7 @@ pub struct SegmentSpec {
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields, tag = "type", rename_all = "lowercase")]
+#[allow(clippy::large_enum_variant)]
 pub enum ForceSpec {
     Actuator {
         joint: String,
@@ -148,6 +211,9 @@ pub enum ForceSpec {
         force: [f64; 3],
         #[serde(default)]
         torque: [f64; 3],
+        /// Time table `[[t, fx, fy, fz, tx, ty, tz], ..]` (s, N, N·m),
+        /// linear between rows; replaces `force` and `torque`.
+        table: Option<Vec<[f64; 7]>>,
     },
 }
 
@@ -191,8 +257,16 @@ pub enum Quantity {
     Rate(usize),
     /// Reaction force (3) and torque (3) of a joint.
     Reaction(usize),
-    /// Global position of a body's centre of mass.
+    /// Global position of a body's centre of mass (of a flexible body:
+    /// of its frame origin).
     Position(usize),
+    /// Modal coordinates `w` of a flexible body (body, n: n columns).
+    Modal(usize, usize),
+    /// Strain energy `½ wᵀΛw` of a flexible body (J).
+    Strain(usize),
+    /// Elastic displacement `Φ_k w` of a marker on a flexible node, in
+    /// the body's frame axes (m).
+    Deflection(usize),
     Energy,
     Violation,
 }
@@ -234,6 +308,14 @@ impl Quantity {
                 .iter()
                 .map(|c| format!("{label}_{c} [m]"))
                 .collect(),
+            Quantity::Modal(_, n) => (1..=*n)
+                .map(|j| format!("{label}_{j} [kg^0.5*m]"))
+                .collect(),
+            Quantity::Strain(_) => vec![format!("{label} [J]")],
+            Quantity::Deflection(_) => ["x", "y", "z"]
+                .iter()
+                .map(|c| format!("{label}_{c} [m]"))
+                .collect(),
             Quantity::Energy => vec!["energy [J]".into()],
             Quantity::Violation => vec!["violation [m|rad]".into()],
         }
@@ -253,9 +335,22 @@ fn finite3(key: String, a: [f64; 3]) -> Result<Vector3<f64>> {
 }
 
 impl SceneSpec {
-    /// Build the model. Errors name the key below `scene` (e.g.
-    /// `joints[2].body_i`); callers attach the file with `Error::in_file`.
+    /// Build the model of a scene without panel bodies. Errors name the
+    /// key below `scene` (e.g. `joints[2].body_i`); callers attach the
+    /// file with `Error::in_file`.
     pub fn build(&self) -> Result<Scene> {
+        self.build_with(&|name, _, _| {
+            Err(Error::input(
+                "flexible.panel",
+                name,
+                "a scene loaded from a study with a [[panels]] section",
+            ))
+        })
+    }
+
+    /// Build the model; `panels` supplies the bases of panel bodies (only
+    /// called when the scene lists `flexibility`).
+    pub fn build_with(&self, panels: PanelBases) -> Result<Scene> {
         for (k, e) in self.effects.iter().enumerate() {
             if !EFFECTS.contains(&e.as_str()) {
                 return Err(Error::input(
@@ -275,6 +370,7 @@ impl SceneSpec {
         }
         let mut model = Model {
             baumgarte: self.baumgarte,
+            quadratic_velocity: has("quadratic_velocity"),
             ..Model::default()
         };
         for (k, b) in self.bodies.iter().enumerate() {
@@ -286,12 +382,37 @@ impl SceneSpec {
                     "a unique body name other than 'ground'",
                 ));
             }
-            let inertia = Matrix3::from_fn(|r, c| b.inertia[r][c]);
-            let com = finite3(format!("{key}.com"), b.com)?;
-            let mut body = Body::new(&key, &b.name, b.mass, inertia, (com, [1.0, 0.0, 0.0, 0.0]))?;
+            let mut body = match (&b.flexible, has("flexibility")) {
+                (Some(f), true) => {
+                    if b.fixed {
+                        return Err(Error::input(
+                            format!("{key}.fixed"),
+                            "true",
+                            "a moving body (a fixed body cannot be flexible)",
+                        ));
+                    }
+                    flexible_body(&key, &b.name, f, has("damping"), panels)?
+                }
+                _ => {
+                    let need = |what: &str| {
+                        Error::input(
+                            format!("{key}.{what}"),
+                            "(missing)",
+                            "mass, com and inertia of a rigid body (or a `flexible` table \
+                             with `flexibility` in scene.effects)",
+                        )
+                    };
+                    let mass = b.mass.ok_or_else(|| need("mass"))?;
+                    let com = finite3(format!("{key}.com"), b.com.ok_or_else(|| need("com"))?)?;
+                    let i = b.inertia.ok_or_else(|| need("inertia"))?;
+                    let inertia = Matrix3::from_fn(|r, c| i[r][c]);
+                    Body::new(&key, &b.name, mass, inertia, (com, [1.0, 0.0, 0.0, 0.0]))?
+                }
+            };
             body.fixed = b.fixed;
             body.v0 = finite3(format!("{key}.velocity"), b.velocity)?;
-            body.w0 = finite3(format!("{key}.angular_velocity"), b.angular_velocity)?;
+            body.w0 = body.orientation().transpose()
+                * finite3(format!("{key}.angular_velocity"), b.angular_velocity)?;
             model.bodies.push(body);
         }
         let find_body = |key: String, name: &str, model: &Model| -> Result<Option<usize>> {
@@ -310,9 +431,14 @@ impl SceneSpec {
             let key = format!("markers[{k}]");
             let body = find_body(format!("{key}.body"), &m.body, &model)?;
             let p = finite3(format!("{key}.point"), m.point)?;
-            model
-                .markers
-                .push(make_marker(&model, &m.name, body, p, Matrix3::identity()));
+            let mk = make_marker(
+                &model,
+                &format!("{key}.point"),
+                (&m.name, body),
+                p,
+                Matrix3::identity(),
+            )?;
+            model.markers.push(mk);
         }
         for (k, j) in self.joints.iter().enumerate() {
             let key = format!("joints[{k}]");
@@ -386,8 +512,9 @@ impl SceneSpec {
             let fi = frame_from_axis(&axis);
             let fj = axis_angle(&axis.normalize(), j.angle) * fi;
             let n = model.markers.len();
-            let mi = make_marker(&model, &format!("{}.i", j.name), bi, point, fi);
-            let mj = make_marker(&model, &format!("{}.j", j.name), bj, point, fj);
+            let pk = format!("{key}.point");
+            let mi = make_marker(&model, &pk, (&format!("{}.i", j.name), bi), point, fi)?;
+            let mj = make_marker(&model, &pk, (&format!("{}.j", j.name), bj), point, fj)?;
             model.markers.push(mi);
             model.markers.push(mj);
             if model.joint(&j.name).is_some() {
@@ -520,21 +647,22 @@ impl SceneSpec {
                     body,
                     force,
                     torque,
+                    table,
                 } => {
                     let b = find_body(format!("{key}.body"), body, &model)?.ok_or_else(|| {
                         Error::input(format!("{key}.body"), body, "a body (not ground)")
                     })?;
                     let force = finite3(format!("{key}.force"), *force)?;
                     let torque = finite3(format!("{key}.torque"), *torque)?;
+                    let load = match table {
+                        None => Load::Constant { force, torque },
+                        Some(rows) => Load::Table(load_table(&format!("{key}.table"), rows)?),
+                    };
                     if !has("loads") {
                         continue;
                     }
                     force_index[k] = Some(model.forces.len());
-                    model.forces.push(Force::BodyLoad {
-                        body: b,
-                        force,
-                        torque,
-                    });
+                    model.forces.push(Force::BodyLoad { body: b, load });
                 }
             }
         }
@@ -610,8 +738,9 @@ impl SceneSpec {
                 Error::input(
                     &key,
                     name,
-                    "<body>.mass, forces[i].stiffness, forces[i].damping or \
-                         forces[i].segments[k].anchor of a force the effects list builds",
+                    "<body>.mass (rigid body), <body>.design.<variable> (flexible body), \
+                     forces[i].stiffness, forces[i].damping or \
+                     forces[i].segments[k].anchor of a force the effects list builds",
                 )
             })?;
             if params.iter().any(|(_, q)| *q == p) {
@@ -642,7 +771,14 @@ fn parse_param(
     name: &str,
 ) -> Option<Param> {
     if let Some(body) = name.strip_suffix(".mass") {
-        return model.body(body).map(Param::Mass);
+        let b = model.body(body)?;
+        return model.bodies[b].flex.is_none().then_some(Param::Mass(b));
+    }
+    if let Some((body, var)) = name.split_once(".design.") {
+        let b = model.body(body)?;
+        let flex = model.bodies[b].flex.as_ref()?;
+        let k = flex.basis.derivatives.iter().position(|d| d.name == var)?;
+        return Some(Param::Design(b, k));
     }
     let rest = name.strip_prefix("forces[")?;
     let (idx, rest) = rest.split_once(']')?;
@@ -684,7 +820,8 @@ fn parse_quantity(model: &Model, key: &str, q: &str) -> Result<Quantity> {
         Error::input(
             key,
             q,
-            "energy, violation, <joint>.angle|rate|reaction or <body>.position",
+            "energy, violation, <joint>.angle|rate|reaction, <body>.position, \
+             <flexible body>.modal|strain_energy or <marker on a flexible node>.deflection",
         )
     };
     let (name, what) = q.rsplit_once('.').ok_or_else(bad)?;
@@ -708,34 +845,224 @@ fn parse_quantity(model: &Model, key: &str, q: &str) -> Result<Quantity> {
             let b = model.body(name).ok_or_else(bad)?;
             Ok(Quantity::Position(b))
         }
+        "modal" | "strain_energy" => {
+            let b = model.body(name).ok_or_else(bad)?;
+            let n = model.bodies[b]
+                .flex
+                .as_ref()
+                .map(|f| f.n())
+                .ok_or_else(bad)?;
+            Ok(match what {
+                "modal" => Quantity::Modal(b, n),
+                _ => Quantity::Strain(b),
+            })
+        }
+        "deflection" => {
+            let m = model.marker(name).ok_or_else(bad)?;
+            model.markers[m].node.ok_or_else(bad)?;
+            Ok(Quantity::Deflection(m))
+        }
         _ => Err(bad()),
     }
 }
 
-/// A marker at the global point `p` with global frame `frame`, expressed in
-/// the body's initial frame (bodies start aligned with the global axes).
+/// A marker `(name, body)` at the global point `p` with global frame
+/// `frame`, expressed in the body's initial frame. On a flexible body the
+/// point must be a node of its basis (within 1e-6 of the body's size);
+/// `key` names the point in errors.
 fn make_marker(
     model: &Model,
-    name: &str,
-    body: Option<usize>,
+    key: &str,
+    named: (&str, Option<usize>),
     p: Vector3<f64>,
     frame: Matrix3<f64>,
-) -> Marker {
-    let pos = match body {
-        Some(b) => p - model.bodies[b].r0,
-        None => p,
+) -> Result<Marker> {
+    let (name, body) = named;
+    let Some(b) = body else {
+        return Ok(Marker {
+            name: name.to_string(),
+            body,
+            pos: p,
+            frame,
+            node: None,
+        });
     };
-    Marker {
+    let bd = &model.bodies[b];
+    let a0 = bd.orientation();
+    let local = a0.transpose() * (p - bd.r0);
+    let mut marker = Marker {
         name: name.to_string(),
         body,
-        pos,
-        frame,
+        pos: local,
+        frame: a0.transpose() * frame,
+        node: None,
+    };
+    if let Some(flex) = &bd.flex {
+        let (k, dist) = flex.basis.nearest_node(&local);
+        let size = flex
+            .basis
+            .nodes
+            .iter()
+            .fold(0.0f64, |m, s| m.max(s.norm()))
+            .max(1e-3);
+        if dist > 1e-6 * size {
+            return Err(Error::input(
+                key,
+                format!("{:?}", p.as_slice()),
+                format!(
+                    "a node of flexible body '{}' (nearest node {k} is {dist:.3e} m away)",
+                    bd.name
+                ),
+            ));
+        }
+        marker.pos = flex.basis.nodes[k];
+        marker.node = Some(k);
     }
+    Ok(marker)
+}
+
+/// Validate a load table: rows `[t, fx, fy, fz, tx, ty, tz]`, finite,
+/// strictly increasing times.
+fn load_table(key: &str, rows: &[[f64; 7]]) -> Result<Vec<(f64, [f64; 6])>> {
+    if rows.is_empty() {
+        return Err(Error::input(
+            key,
+            "[]",
+            "at least one row [t, fx, fy, fz, tx, ty, tz]",
+        ));
+    }
+    let mut out: Vec<(f64, [f64; 6])> = Vec::with_capacity(rows.len());
+    for (k, r) in rows.iter().enumerate() {
+        let increasing = out.last().is_none_or(|(t, _)| r[0] > *t);
+        if r.iter().any(|v| !v.is_finite()) || !increasing {
+            return Err(Error::input(
+                format!("{key}[{k}]"),
+                format!("{r:?}"),
+                "finite rows [t (s), fx, fy, fz (N), tx, ty, tz (N·m)] with increasing t",
+            ));
+        }
+        let mut v = [0.0; 6];
+        v.copy_from_slice(&r[1..]);
+        out.push((r[0], v));
+    }
+    Ok(out)
+}
+
+/// A flexible body from its `flexible` table: basis, invariants, frame
+/// placement.
+fn flexible_body(
+    key: &str,
+    name: &str,
+    f: &FlexSpec,
+    damping: bool,
+    panels: PanelBases,
+) -> Result<Body> {
+    let fk = format!("{key}.flexible");
+    if f.modes == 0 {
+        return Err(Error::input(format!("{fk}.modes"), 0, "at least one mode"));
+    }
+    if !(f.damping.is_finite() && (0.0..1.0).contains(&f.damping)) {
+        return Err(Error::input(
+            format!("{fk}.damping"),
+            f.damping,
+            "a modal damping ratio in [0, 1)",
+        ));
+    }
+    let basis = match f.kind.as_str() {
+        "beam" => {
+            let get = |what: &str, v: Option<f64>| {
+                v.ok_or_else(|| {
+                    Error::input(format!("{fk}.{what}"), "(missing)", "a beam property")
+                })
+            };
+            let beam = Beam {
+                length: get("length", f.length)?,
+                ei_y: get("ei_y", f.ei_y)?,
+                ei_z: get("ei_z", f.ei_z)?,
+                rho_a: get("rho_a", f.rho_a)?,
+            };
+            beam.validate(&fk)?;
+            let rho_ip = f.rho_ip.unwrap_or(0.0);
+            if !(rho_ip.is_finite() && rho_ip > 0.0) {
+                return Err(Error::input(
+                    format!("{fk}.rho_ip"),
+                    rho_ip,
+                    "a polar mass moment per length > 0 (kg·m): the frame needs a rotary inertia about the beam axis",
+                ));
+            }
+            let mut b = beam
+                .basis(f.modes, Beam::segments_for(f.modes))?
+                .truncated(f.modes);
+            // Rotary inertia about the beam axis, lumped like the mass.
+            for (k, m) in b.node_mass.iter().enumerate() {
+                b.node_inertia[k].x = rho_ip * m / beam.rho_a;
+            }
+            b
+        }
+        "panel" => {
+            let panel = f.panel.as_deref().ok_or_else(|| {
+                Error::input(
+                    format!("{fk}.panel"),
+                    "(missing)",
+                    "the name of a [[panels]] entry",
+                )
+            })?;
+            if let Some(d) = f.derivatives.as_deref() {
+                if d != "fixed" && d != "updated" {
+                    return Err(Error::input(
+                        format!("{fk}.derivatives"),
+                        d,
+                        "fixed (Eq. 19) or updated (Eq. 18)",
+                    ));
+                }
+            }
+            panels(panel, f.modes, f.derivatives.as_deref())?
+        }
+        other => {
+            return Err(Error::input(format!("{fk}.kind"), other, "beam or panel"));
+        }
+    };
+    basis.validate(&fk)?;
+    let origin = finite3(format!("{fk}.origin"), f.origin)?;
+    let x = finite3(format!("{fk}.x_axis"), f.x_axis)?;
+    let y = finite3(format!("{fk}.y_axis"), f.y_axis)?;
+    if x.norm() < 1e-12
+        || (y - x * (x.dot(&y) / x.norm_squared())).norm() < 1e-9 * y.norm().max(1e-300)
+    {
+        return Err(Error::input(
+            format!("{fk}.y_axis"),
+            format!("{:?} with x_axis {:?}", f.y_axis, f.x_axis),
+            "non-zero, non-parallel x and y axis directions",
+        ));
+    }
+    let ex = x.normalize();
+    let ey = (y - ex * ex.dot(&y)).normalize();
+    let a0 = Matrix3::from_columns(&[ex, ey, ex.cross(&ey)]);
+    let design = vec![0.0; basis.derivatives.len()];
+    let flex = Flex::new(basis, if damping { f.damping } else { 0.0 }, design);
+    let inv = &flex.inv;
+    let c = inv.s0 / inv.mass;
+    // Inertia about the centre of mass (frame axes), for reports.
+    let j_o = Matrix3::identity() * inv.e0.trace() - inv.e0 + inv.j_rot;
+    let j_c = j_o - (Matrix3::identity() * c.norm_squared() - c * c.transpose()) * inv.mass;
+    let inv_inertia = j_c.try_inverse().unwrap_or_else(Matrix3::zeros);
+    Ok(Body {
+        name: name.to_string(),
+        mass: inv.mass,
+        inertia: j_c,
+        inv_inertia,
+        r0: origin,
+        p0: euler_from_rotation(&a0),
+        v0: Vector3::zeros(),
+        w0: Vector3::zeros(),
+        fixed: false,
+        flex: Some(flex),
+    })
 }
 
 fn initial_distance(model: &Model, i: usize, j: usize) -> f64 {
     let g = |m: &Marker| match m.body {
-        Some(b) => model.bodies[b].r0 + m.pos,
+        Some(b) => model.bodies[b].r0 + model.bodies[b].orientation() * m.pos,
         None => m.pos,
     };
     (g(&model.markers[j]) - g(&model.markers[i])).norm()

@@ -68,7 +68,12 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         .filter(|(_, q)| {
             matches!(
                 q,
-                Quantity::Angle(_) | Quantity::Rate(_) | Quantity::Position(_)
+                Quantity::Angle(_)
+                    | Quantity::Rate(_)
+                    | Quantity::Position(_)
+                    | Quantity::Modal(..)
+                    | Quantity::Strain(_)
+                    | Quantity::Deflection(_)
             )
         })
         .cloned()
@@ -88,9 +93,9 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
     let mut observe = |t: f64, y: &[f64], s: &[f64]| {
         if !scene.params.is_empty() {
             let mut row = vec![t];
-            for i in 0..scene.params.len() {
+            for (i, (_, p)) in scene.params.iter().enumerate() {
                 let lane = &s[i * n..(i + 1) * n];
-                row.extend(output_sensitivities(&sys, &sens_quantities, y, lane));
+                row.extend(output_sensitivities(&sys, &sens_quantities, y, (lane, *p)));
             }
             sens_rows.push(row);
         }
@@ -123,9 +128,23 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
                     row.extend(r.force.iter().chain(r.torque.iter()));
                 }
                 Quantity::Position(b) => match sys.slot[*b] {
-                    Some(s) => row.extend_from_slice(&y[7 * s..7 * s + 3]),
+                    Some(s) => {
+                        let p = sys.pos_off(s);
+                        row.extend_from_slice(&y[p..p + 3])
+                    }
                     None => row.extend(sys.model.bodies[*b].r0.iter()),
                 },
+                Quantity::Modal(b, n) => match sys.slot[*b] {
+                    Some(s) => {
+                        let p = sys.pos_off(s) + 7;
+                        row.extend_from_slice(&y[p..p + n])
+                    }
+                    None => row.extend(std::iter::repeat_n(0.0, *n)),
+                },
+                Quantity::Strain(b) => {
+                    row.push(sys.slot[*b].map_or(0.0, |s| sys.strain_energy(y, s)))
+                }
+                Quantity::Deflection(m) => row.extend(sys.deflection(y, *m).iter()),
                 Quantity::Energy => row.push(sys.energy(y, &mut ws)),
                 Quantity::Violation => row.push(viol),
             }
@@ -163,27 +182,54 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
     Ok((sys, sim))
 }
 
-/// Exact derivatives of the angle, rate and position outputs along the
-/// state sensitivity `s = ∂y/∂p`: one dual-number evaluation of each output
-/// at `y + ε s`.
+/// Exact derivatives of the outputs along the state sensitivity
+/// `s = ∂y/∂p` of parameter `p`: one dual-number evaluation of each output
+/// at `y + ε s` (with the design seed of `p` when it is a ply-angle
+/// variable, so that `dX/dθ` and `dΛ/dθ` enter explicitly).
 fn output_sensitivities(
     sys: &System,
     quantities: &[(String, Quantity)],
     y: &[f64],
-    s: &[f64],
+    lane: (&[f64], Param),
 ) -> Vec<f64> {
+    let (s, param) = lane;
     let yd: Vec<Dual64> = y.iter().zip(s).map(|(&a, &b)| Dual64::new(a, b)).collect();
+    let seeds: Vec<(Param, Dual64)> = match param {
+        Param::Design(..) => vec![(
+            param,
+            Dual64::new(param.value(&sys.model).unwrap_or(0.0), 1.0),
+        )],
+        _ => Vec::new(),
+    };
     let mut kin = Vec::new();
-    sys.body_kin(&yd, &mut kin);
+    sys.body_kin(&yd, &seeds, &mut kin);
     let mut out = Vec::new();
     for (_, q) in quantities {
         match q {
             Quantity::Angle(j) => out.push(sys.joint_angle(&kin, *j).0.eps),
             Quantity::Rate(j) => out.push(sys.joint_angle(&kin, *j).1.eps),
             Quantity::Position(b) => match sys.slot[*b] {
-                Some(k) => out.extend_from_slice(&s[7 * k..7 * k + 3]),
+                Some(k) => {
+                    let p = sys.pos_off(k);
+                    out.extend_from_slice(&s[p..p + 3])
+                }
                 None => out.extend([0.0; 3]),
             },
+            Quantity::Modal(b, n) => match sys.slot[*b] {
+                Some(k) => {
+                    let p = sys.pos_off(k) + 7;
+                    out.extend_from_slice(&s[p..p + n])
+                }
+                None => out.extend(std::iter::repeat_n(0.0, *n)),
+            },
+            Quantity::Strain(b) => out.push(match sys.slot[*b] {
+                Some(k) => sys.strain_energy_dual(&yd, k, &kin[k].design).eps,
+                None => 0.0,
+            }),
+            Quantity::Deflection(m) => {
+                let d = sys.deflection_kin(&kin, *m);
+                out.extend(d.iter().map(|v| v.eps));
+            }
             _ => {}
         }
     }
