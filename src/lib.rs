@@ -25,7 +25,8 @@
 //!   derivatives.
 //! - [`fe`]: panel mesh, laminated shell triangle, sparse assembly, supports.
 //! - [`modal`]: lowest modes, eigenvalue and eigenvector derivatives.
-//! - [`panels`]: the panel modal-analysis study (`plyscape modes`).
+//! - [`panels`]: the panel modal-analysis study (`plyscape modes`), and the
+//!   panel's modal basis for a flexible body ([`panels::panel_basis`]).
 //! - [`optimize`]: the evaluation interface, MMFD, CMA-ES.
 //! - [`explore`]: multistart, evolutionary comparison, maps, sharding.
 //! - [`report`]: CSV, SVG and terminal output (observers only).

@@ -19,6 +19,13 @@
 //! twisting mode (w ∝ xy) is `AA`; the first symmetric bending mode is `SS`.
 //! Where the mesh has no mirror nodes (an asymmetric set of attachment
 //! points) or the correlation is weak, the symmetry is `-`.
+//!
+//! [`basis`] turns a panel's modes (and their derivatives) into the
+//! [`crate::mbs::ModalBasis`] of a floating-frame flexible body.
+
+pub mod basis;
+
+pub use basis::{basis_for_study, panel_basis, BasisBuilder};
 
 use crate::error::{Error, Result};
 use crate::fe::{Derivatives, Panel, PanelSystem};
