@@ -381,6 +381,7 @@ impl<T: Scalar> Workspace<T> {
             mjac: Vec::new(),
             mfac: Vec::new(),
             inv: Vec::new(),
+            inv_seeded: Vec::new(),
             inv_order: Vec::new(),
             col: Vec::new(),
             nz: Vec::new(),

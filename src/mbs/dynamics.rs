@@ -107,6 +107,9 @@ pub struct Workspace<T: Scalar> {
     /// Per moving body: its invariants in `T` (flexible bodies), rebuilt
     /// when design seeds are active.
     pub(crate) inv: Vec<Option<InvT<T>>>,
+    /// Whether `inv[s]` carries design seeds (then it is rebuilt at the
+    /// next evaluation).
+    pub(crate) inv_seeded: Vec<bool>,
     /// Rank of the last factorization.
     pub rank: usize,
     /// Parameter values overriding the model's (sensitivity analysis);
@@ -543,9 +546,11 @@ impl System {
         let flex = self.model.bodies[self.moving[s]].flex.as_ref();
         let Some(flex) = flex else { return };
         ws.inv.resize_with(self.nb(), || None);
+        ws.inv_seeded.resize(self.nb(), false);
         let seeded = !ws.kin[s].design.is_empty();
-        if seeded || ws.inv[s].is_none() {
+        if seeded || ws.inv_seeded[s] || ws.inv[s].is_none() {
             ws.inv[s] = Some(InvT::lift(flex, &ws.kin[s].design));
+            ws.inv_seeded[s] = seeded;
         }
     }
 

@@ -697,15 +697,21 @@ impl SceneSpec {
             times,
         };
         options.validate()?;
+        let flex_names: Vec<&str> = self
+            .bodies
+            .iter()
+            .filter(|b| b.flexible.is_some())
+            .map(|b| b.name.as_str())
+            .collect();
         let mut outputs = Vec::new();
         for (k, q) in self.outputs.quantities.iter().enumerate() {
             outputs.push((
                 q.clone(),
-                parse_quantity(&model, &format!("outputs.quantities[{k}]"), q)?,
+                parse_quantity(&model, &flex_names, &format!("outputs.quantities[{k}]"), q)?,
             ));
         }
         if let Some(p) = &self.outputs.plot {
-            match parse_quantity(&model, "outputs.plot", p)? {
+            match parse_quantity(&model, &flex_names, "outputs.plot", p)? {
                 Quantity::Angle(_) | Quantity::Rate(_) | Quantity::Energy | Quantity::Violation => {
                 }
                 _ => {
@@ -810,7 +816,10 @@ fn parse_param(
     p.value(model).map(|_| p)
 }
 
-fn parse_quantity(model: &Model, key: &str, q: &str) -> Result<Quantity> {
+/// An output name → [`Quantity`]. Bodies named in `flex_names` have a
+/// `flexible` table: their modal outputs stay valid when the scene runs
+/// them rigid (no columns for `modal`, zero strain energy and deflection).
+fn parse_quantity(model: &Model, flex_names: &[&str], key: &str, q: &str) -> Result<Quantity> {
     match q {
         "energy" => return Ok(Quantity::Energy),
         "violation" => return Ok(Quantity::Violation),
@@ -847,11 +856,11 @@ fn parse_quantity(model: &Model, key: &str, q: &str) -> Result<Quantity> {
         }
         "modal" | "strain_energy" => {
             let b = model.body(name).ok_or_else(bad)?;
-            let n = model.bodies[b]
-                .flex
-                .as_ref()
-                .map(|f| f.n())
-                .ok_or_else(bad)?;
+            let n = match &model.bodies[b].flex {
+                Some(f) => f.n(),
+                None if flex_names.contains(&name) => 0,
+                None => return Err(bad()),
+            };
             Ok(match what {
                 "modal" => Quantity::Modal(b, n),
                 _ => Quantity::Strain(b),
@@ -859,7 +868,12 @@ fn parse_quantity(model: &Model, key: &str, q: &str) -> Result<Quantity> {
         }
         "deflection" => {
             let m = model.marker(name).ok_or_else(bad)?;
-            model.markers[m].node.ok_or_else(bad)?;
+            let on_flex = model.markers[m]
+                .body
+                .is_some_and(|b| flex_names.contains(&model.bodies[b].name.as_str()));
+            if model.markers[m].node.is_none() && !on_flex {
+                return Err(bad());
+            }
             Ok(Quantity::Deflection(m))
         }
         _ => Err(bad()),

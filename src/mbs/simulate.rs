@@ -36,10 +36,19 @@ pub struct Simulation {
     pub sens_rows: Vec<Vec<f64>>,
 }
 
-/// Read the `[scene]` section of a study and build it.
+/// Read the `[scene]` section of a study and build it. Panel bodies take
+/// their modal basis from the study's `[[panels]]` (built only when the
+/// scene lists `flexibility`).
 pub fn load_scene(study: &Study) -> Result<Scene> {
     let spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
-    spec.build().map_err(study.locate("scene"))
+    let panels = |name: &str, modes: usize, derivatives: Option<&str>| {
+        let update = derivatives.map(|d| match d {
+            "fixed" => crate::modal::ModeUpdate::Fixed,
+            _ => crate::modal::ModeUpdate::Updated,
+        });
+        crate::panels::basis_for_study(study, name, modes, update)
+    };
+    spec.build_with(&panels).map_err(study.locate("scene"))
 }
 
 /// Simulate a built scene (no files written).
