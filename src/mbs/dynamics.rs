@@ -28,11 +28,9 @@
 //! Markers on nodes of flexible bodies move with the modes
 //! (`x = r + A(s_k + Φ_k w)`) and rotate with them (frame
 //! `A R(Ψ_k w) F₀`, `R` the rotation of the rotation vector); their
-//! angular velocity is taken as `ω + A Ψ_k ẇ`, exact to first order in
-//! the elastic rotation, as in the linear finite element model. Point
-//! constraints are exact; frame constraints on flexible markers carry a
-//! second-order inconsistency `O(|Ψw|·|Ψẇ|)` that the stabilisation keeps
-//! bounded.
+//! angular velocity is exactly `ω + A T(Ψ_k w) Ψ_k ẇ` with the tangent
+//! operator `T` ([`rotation_tangent`]), so that every constraint's
+//! Jacobian is the exact derivative of its position-level equation.
 //!
 //! Everything is generic over the scalar `T` so that `num_dual::Dual64`
 //! gives exact Jacobian-vector products of the right-hand side.
@@ -40,7 +38,7 @@
 use super::flexdyn::{flex_terms, FlexEffects, FlexState, InvT};
 use super::linalg::{
     cholesky_solve, cst, dense_cholesky, dense_cholesky_solve, euler_rate, min_degree_order,
-    ordered_cholesky, rotation, rotation_vector, Scalar,
+    ordered_cholesky, rotation, rotation_tangent, rotation_vector, Scalar,
 };
 use super::model::{Force, JointKind, Model, Param};
 use nalgebra::{Matrix3, Vector3};
@@ -157,6 +155,9 @@ pub struct MarkerKin<T: Scalar> {
     pub alpha: Vector3<T>,
     /// `(body, node)` of a marker on a flexible node.
     pub node: Option<(usize, usize)>,
+    /// Tangent operator `T(Ψ_k w)` of the node rotation (identity on
+    /// rigid bodies): the marker's angular velocity is `ω + A T Ψ_k ẇ`.
+    pub tangent: Matrix3<T>,
 }
 
 /// Evaluation counters (what is not built is never evaluated).
@@ -399,6 +400,7 @@ impl System {
                     acc: Vector3::zeros(),
                     alpha: Vector3::zeros(),
                     node: None,
+                    tangent: Matrix3::identity(),
                 }
             }
             Some(s) => {
@@ -416,7 +418,10 @@ impl System {
                         }
                         let sg = k.a * (pos + du);
                         let vdg = k.a * vd;
-                        let wdg = k.a * wd;
+                        // Exact angular velocity of the node frame
+                        // A R(θ) F₀: ω + A T(θ) θ̇, and its rate terms.
+                        let (tm, tdot) = rotation_tangent(&th, &wd);
+                        let wdg = k.a * (tm * wd);
                         MarkerKin {
                             slot: Some(s),
                             x: k.r + sg,
@@ -425,8 +430,9 @@ impl System {
                             frame: k.a * rotation_vector(&th) * frame,
                             w: k.w + wdg,
                             acc: k.w.cross(&k.w.cross(&sg)) + k.w.cross(&vdg) * cst::<T>(2.0),
-                            alpha: k.w.cross(&wdg),
+                            alpha: k.w.cross(&wdg) + k.a * tdot,
                             node: Some((b, node)),
+                            tangent: tm,
                         }
                     }
                     _ => {
@@ -441,6 +447,7 @@ impl System {
                             acc: k.w.cross(&k.w.cross(&sg)),
                             alpha: Vector3::zeros(),
                             node: None,
+                            tangent: Matrix3::identity(),
                         }
                     }
                 }
@@ -515,10 +522,10 @@ impl System {
                 let wg = Vector3::new(blk[3], blk[4], blk[5]);
                 let mk = &ws.mk[row.markers[side]];
                 if let Some((b, node)) = mk.node {
-                    // ∂/∂ẇ_j = (Aᵀdv)·Φ_kj + (Aᵀ(dw_g − s×dv))·Ψ_kj.
+                    // ∂/∂ẇ_j = (Aᵀdv)·Φ_kj + (Tᵀ Aᵀ(dw_g − s×dv))·Ψ_kj.
                     let (phi, psi) = self.node_shapes(k, b, node);
                     let av = k.a.transpose() * dv;
-                    let aw = k.a.transpose() * (wg - mk.s.cross(&dv));
+                    let aw = mk.tangent.transpose() * (k.a.transpose() * (wg - mk.s.cross(&dv)));
                     row.modal[side] = ws.mjac.len();
                     for j in 0..phi.len() {
                         let e = av.dot(&phi[j]) + aw.dot(&psi[j]);
@@ -768,8 +775,9 @@ impl System {
         }
         if let Some((b, node)) = mk.node {
             let (_, psi) = self.node_shapes(&ws.kin[s], b, node);
+            let tt = mk.tangent.transpose() * tb;
             for (j, p) in psi.iter().enumerate() {
-                ws.q[o + 6 + j] += p.dot(&tb);
+                ws.q[o + 6 + j] += p.dot(&tt);
             }
         }
     }

@@ -300,6 +300,46 @@ pub fn rotation_vector<T: Scalar>(th: &Vector3<T>) -> Matrix3<T> {
     Matrix3::identity() + k * a + k * k * b
 }
 
+/// Tangent operator of the rotation vector and its rate term: for
+/// `R(θ) = exp(θ̃)`, `Ṙ Rᵀ = (T(θ) θ̇)~` with
+/// `T = I + b θ̃ + c θ̃²`, `b = (1 − cos φ)/φ²`, `c = (φ − sin φ)/φ³`,
+/// and `Ṫ θ̇ = ḃ (θ×θ̇) + ċ θ×(θ×θ̇) + c θ̇×(θ×θ̇)` with
+/// `ḃ = 2 b'(φ²)(θ·θ̇)`, `ċ = 2 c'(φ²)(θ·θ̇)` (derivatives with respect to
+/// `u = φ²`). Returns `(T, Ṫ θ̇)`. Series in `u` for `φ < 0.1`
+/// (truncation below 1e-16), closed forms above.
+pub fn rotation_tangent<T: Scalar>(th: &Vector3<T>, thd: &Vector3<T>) -> (Matrix3<T>, Vector3<T>) {
+    let u = th.norm_squared();
+    let c = |k: f64| cst::<T>(k);
+    let (b, cc, db, dc) = if u < c(1e-2) {
+        let u2 = u * u;
+        let u3 = u2 * u;
+        let u4 = u3 * u;
+        (
+            c(0.5) - u / c(24.0) + u2 / c(720.0) - u3 / c(40320.0) + u4 / c(3628800.0),
+            c(1.0 / 6.0) - u / c(120.0) + u2 / c(5040.0) - u3 / c(362880.0) + u4 / c(39916800.0),
+            c(-1.0 / 24.0) + u * c(2.0 / 720.0) - u2 * c(3.0 / 40320.0) + u3 * c(4.0 / 3628800.0),
+            c(-1.0 / 120.0) + u * c(2.0 / 5040.0) - u2 * c(3.0 / 362880.0)
+                + u3 * c(4.0 / 39916800.0),
+        )
+    } else {
+        let phi = u.sqrt();
+        let (s, co) = (phi.sin(), phi.cos());
+        let phi5 = u * u * phi;
+        (
+            (T::one() - co) / u,
+            (phi - s) / (u * phi),
+            (phi * s * c(0.5) - (T::one() - co)) / (u * u),
+            ((T::one() - co) * phi * c(0.5) - (phi - s) * c(1.5)) / phi5,
+        )
+    };
+    let k = th.cross_matrix();
+    let tmat = Matrix3::identity() + k * b + k * k * cc;
+    let two_dot = c(2.0) * th.dot(thd);
+    let txd = th.cross(thd);
+    let rate = txd * (db * two_dot) + th.cross(&txd) * (dc * two_dot) + thd.cross(&txd) * cc;
+    (tmat, rate)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -366,6 +406,31 @@ mod tests {
         ] {
             let r = nalgebra::Rotation3::from_scaled_axis(th).into_inner();
             assert!((rotation_vector(&th) - r).norm() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn rotation_tangent_matches_finite_differences_on_both_branches() {
+        // Ṙ Rᵀ = (T θ̇)~ and d/dt(T θ̇) at fixed θ̇ = Ṫ θ̇, by central
+        // differences along θ(t) = θ0 + t θ̇.
+        for (th, thd) in [
+            (
+                Vector3::new(0.01, -0.02, 0.03),
+                Vector3::new(0.5, 0.2, -0.7),
+            ),
+            (Vector3::new(0.4, -0.5, 0.7), Vector3::new(0.5, 0.2, -0.7)),
+        ] {
+            let h = 1e-6;
+            let rp = rotation_vector(&(th + thd * h));
+            let rm = rotation_vector(&(th - thd * h));
+            let w = (rp - rm) / (2.0 * h) * rotation_vector(&th).transpose();
+            let axial = Vector3::new(w[(2, 1)], w[(0, 2)], w[(1, 0)]);
+            let (t, rate) = rotation_tangent(&th, &thd);
+            assert!((axial - t * thd).norm() < 1e-8, "{:?}", axial - t * thd);
+            let (tp, _) = rotation_tangent(&(th + thd * h), &thd);
+            let (tm, _) = rotation_tangent(&(th - thd * h), &thd);
+            let fd = (tp - tm) / (2.0 * h) * thd;
+            assert!((fd - rate).norm() < 1e-8, "{:?}", fd - rate);
         }
     }
 
