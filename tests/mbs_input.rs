@@ -75,6 +75,13 @@ fn each_bad_input_names_file_key_and_value() {
             "nowhere",
         ),
         (
+            BASE.replace("effects = [\"gravity\"]", "effects = [\"loads\"]")
+                + "[[scene.forces]]\ntype = \"load\"\nbody = \"rod\"\n"
+                + "table = [[0.0, 0, 0, 0, 0, 0, 0], [0.0, 1, 0, 0, 0, 0, 0]]\n",
+            "scene.forces[0].table[1]",
+            "[0.0, 1.0",
+        ),
+        (
             // A fixed joint and a joint driven to another angle about the
             // same axis: contradictory, cannot be projected.
             BASE.to_string()
