@@ -151,6 +151,11 @@ quantities = ["box.position"]
     };
     for r in &sim.rows {
         let e = exact(r[0]);
-        assert!((r[1] - e).abs() < 1e-7 * (1.0 + e.abs()), "t {}: {} vs {e}", r[0], r[1]);
+        assert!(
+            (r[1] - e).abs() < 1e-7 * (1.0 + e.abs()),
+            "t {}: {} vs {e}",
+            r[0],
+            r[1]
+        );
     }
 }

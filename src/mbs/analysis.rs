@@ -2,14 +2,14 @@
 //! per-state outputs: joint angles and rates, reactions, energy and
 //! constraint violation.
 
-use super::dynamics::{angle_of, BodyKin, System, Workspace};
+use super::dynamics::{angle_of, BodyKin, System, Workspace, RANK_REG, RANK_TOL};
 use super::linalg::Scalar;
 use super::model::{Force, JointKind};
 use crate::error::{Error, Result};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// Sizes of the corrections made by [`System::project`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Projection {
     /// Largest position-level residual before the projection.
     pub phi_before: f64,
@@ -26,6 +26,9 @@ pub struct Projection {
     pub rank: usize,
     /// Number of equations.
     pub equations: usize,
+    /// Equations found dependent on the others at the projected state
+    /// (row indices), for [`System::drop_rows`].
+    pub dependent: Vec<usize>,
 }
 
 /// Reaction of a joint: force (N) and torque (N·m, about the joint point)
@@ -122,7 +125,24 @@ impl System {
             iterations,
             rank: ws.rank,
             equations: ws.rows.len(),
+            dependent: self.dependent_rows(&ws),
         })
+    }
+
+    /// Rows whose pivot in the last factorization of `ws` was at the
+    /// regularisation level (dependent on the rows before them in the
+    /// elimination order), excluding rows already dropped.
+    fn dependent_rows(&self, ws: &Workspace<f64>) -> Vec<usize> {
+        let m = ws.rows.len();
+        let mut out: Vec<usize> = (0..m)
+            .filter(|&r| {
+                let k = ws.inv_order[r];
+                let l = ws.a[k * m + k];
+                !self.dropped(r) && l * l - RANK_REG <= RANK_TOL
+            })
+            .collect();
+        out.sort_unstable();
+        out
     }
 
     /// Kinematics and constraint rows of `y` at `t` into `ws`.

@@ -194,6 +194,9 @@ pub struct System {
     vel: Vec<usize>,
     npos: usize,
     nvel: usize,
+    /// Constraint rows left out of the solve (their multipliers are zero):
+    /// equations found redundant at the projected initial state.
+    drop: Vec<bool>,
     pub counters: Counters,
 }
 
@@ -228,8 +231,31 @@ impl System {
             vel,
             npos,
             nvel,
+            drop: Vec::new(),
             counters: Counters::default(),
         }
+    }
+
+    /// Leave the constraint rows `rows` out of every later solve (their
+    /// multipliers are set to zero). For equations that are redundant by
+    /// the geometry of the mechanism (found by [`System::project`]): on
+    /// the constraint manifold they are implied by the others, so the
+    /// accelerations do not change, while off the manifold (trial states
+    /// of an implicit integrator) their slightly inconsistent stabilisation
+    /// terms no longer meet a near-zero pivot. Transient singularities
+    /// are still handled by the regularisation.
+    pub fn drop_rows(&mut self, rows: &[usize]) {
+        for &r in rows {
+            if self.drop.len() <= r {
+                self.drop.resize(r + 1, false);
+            }
+            self.drop[r] = true;
+        }
+    }
+
+    /// Whether constraint row `r` is left out of the solve.
+    pub fn dropped(&self, r: usize) -> bool {
+        self.drop.get(r).copied().unwrap_or(false)
     }
 
     /// Number of moving bodies.
@@ -929,6 +955,22 @@ impl System {
                 }
             }
         }
+        let mut ndrop = 0;
+        for r in 0..m.min(self.drop.len()) {
+            if !self.drop[r] {
+                continue;
+            }
+            ndrop += 1;
+            let p = inv[r];
+            for c in 0..p {
+                ws.a[p * m + c] = T::zero();
+            }
+            for q in p + 1..m {
+                ws.a[q * m + p] = T::zero();
+            }
+            ws.a[p * m + p] = T::one();
+            ws.rhs[r] = T::zero();
+        }
         let f = ordered_cholesky(
             &mut ws.a,
             m,
@@ -937,7 +979,7 @@ impl System {
             &mut ws.col,
             &mut ws.nz,
         );
-        ws.rank = f.rank;
+        ws.rank = f.rank - ndrop;
         let mut lam = std::mem::take(&mut ws.rhs);
         ws.tmp.clear();
         ws.tmp.resize(m, T::zero());

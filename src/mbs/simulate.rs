@@ -53,9 +53,10 @@ pub fn load_scene(study: &Study) -> Result<Scene> {
 
 /// Simulate a built scene (no files written).
 pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
-    let sys = System::new(scene.model.clone());
+    let mut sys = System::new(scene.model.clone());
     let mut y0 = sys.initial_state();
     let projection = sys.project(scene.options.t0, &mut y0)?;
+    sys.drop_rows(&projection.dependent);
     let mut headers = vec!["t [s]".to_string()];
     for (label, q) in &scene.outputs {
         headers.extend(q.headers(label));
