@@ -956,10 +956,7 @@ impl System {
             }
         }
         let mut ndrop = 0;
-        for r in 0..m.min(self.drop.len()) {
-            if !self.drop[r] {
-                continue;
-            }
+        for (r, _) in self.drop.iter().enumerate().take(m).filter(|(_, d)| **d) {
             ndrop += 1;
             let p = inv[r];
             for c in 0..p {
