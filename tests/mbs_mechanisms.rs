@@ -182,3 +182,37 @@ fn bricard_linkage_is_mobile_and_stable() {
         sim.max_violation
     );
 }
+
+#[test]
+fn bricard_at_loose_tolerance_completes_with_bdf() {
+    // studies/bricard.toml at rtol 1e-4 with BDF: diffsol's whole-run cap
+    // on Newton failures used to abort this healthy run at t ≈ 0.45 s
+    // (each failure only refreshes the Jacobian and cuts the step); the
+    // cap is lifted and the redundant equation is left out of the solve.
+    // At this tolerance the energy error stays at the 1e-3 level over 10 s
+    // (measured 4.2e-4; 1.2e-2 when the redundant row was kept).
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/studies/bricard.toml"))
+            .unwrap()
+            .replace("rtol = 1e-9", "rtol = 1e-4")
+            .replace("atol = 1e-11", "atol = 1e-8");
+    assert!(
+        text.contains("rtol = 1e-4"),
+        "study tolerance changed: update this test"
+    );
+    let study = plyscape::study::Study::parse("bricard.toml", &text).unwrap();
+    let scene = plyscape::mbs::simulate::load_scene(&study).unwrap();
+    let (_, sim) = plyscape::mbs::simulate::simulate(&scene).unwrap();
+    assert_eq!(sim.rows.last().unwrap()[0], 10.0);
+    let de = sim.energy_error.expect("conservative");
+    println!(
+        "energy {de:e}, violation {:e}, {:?}",
+        sim.max_violation, sim.stats
+    );
+    assert!(de < 3e-3, "energy error {de:e}");
+    assert!(sim.max_violation < 1e-3);
+    assert!(
+        sim.stats.nonlinear_failures > 50,
+        "the run no longer exercises the lifted cap"
+    );
+}
