@@ -1,31 +1,41 @@
-//! Rigid multibody kernel (issue 3, part A): spatial bodies with Euler
-//! parameters, markers, joints (spherical, revolute, driven/locked
-//! revolute, fixed), force elements (gravity, the paper's Eq. 32
-//! spring-damper-actuator, linear spring-dampers, constant loads), the
-//! equations of motion with Lagrange multipliers, consistent initial
-//! conditions, outputs, and scenes read from TOML.
+//! Flexible multibody kernel (issue 3): rigid spatial bodies with Euler
+//! parameters, floating-frame flexible bodies with modal coordinates
+//! (paper Eqs. 5–6; [`flex`], [`flexdyn`], bases from closed-form beams
+//! [`beam`] or from composite panels [`crate::panels::panel_basis`]),
+//! markers (on flexible bodies: on mesh nodes, moving and rotating with the
+//! modes), joints (spherical, revolute, driven/locked revolute, fixed),
+//! force elements (gravity, the paper's Eq. 32 spring-damper-actuator,
+//! linear spring-dampers, constant or time-tabulated loads), the equations
+//! of motion with Lagrange multipliers, consistent initial conditions,
+//! outputs, and scenes read from TOML.
 //!
 //! ## Method
-//! The equations of motion are the index-3 DAE of the paper (Eqs. 2–4),
-//! reduced at every right-hand-side evaluation to an ODE in
-//! `y = [r, p, ṙ, ω']` by solving for accelerations and multipliers
-//! ([`dynamics`]). The mass matrix is block diagonal, so only the
+//! The equations of motion are the index-3 DAE of the paper (Eqs. 2–4, 6),
+//! reduced at every right-hand-side evaluation to an ODE in positions and
+//! velocities by solving for accelerations and multipliers ([`dynamics`]).
+//! The mass matrix is block diagonal by body (dense `(6+n)²` blocks for
+//! flexible bodies, from the inertia invariants), so only the
 //! constraint-space matrix `G M⁻¹ Gᵀ` (size = number of equations) is
 //! formed, from the sparse rows of `G`, and factored by a Cholesky in a
 //! minimum-degree order with a tiny Tikhonov shift: redundant equations are
-//! detected and counted from the pivots, the accelerations stay unique, and
-//! the solution stays smooth where the rank changes. Drift is controlled by Baumgarte stabilisation (critically
-//! damped, rate `α` from the scene), which keeps the state an ordinary ODE
-//! for any integrator (BDF, explicit and SDIRK Runge–Kutta), unlike
-//! projection, which would have to restart multistep histories.
-//! Initial conditions are projected onto the constraints ([`analysis`]).
-//! Forward sensitivities (stiffness, damping, mass, Eq. 32 breakpoints,
-//! [`Param`]) come from [`crate::integrate::integrate_sens`], with exact
-//! products from dual-number evaluations of the same right-hand side.
+//! detected and counted from the pivots, the ones redundant at the start
+//! are left out of the solve, the accelerations stay unique, and the
+//! solution stays smooth where the rank changes. Drift is controlled by
+//! Baumgarte stabilisation (critically damped, rate `α` from the scene),
+//! which keeps the state an ordinary ODE for any integrator (BDF, explicit
+//! and SDIRK Runge–Kutta), unlike projection, which would have to restart
+//! multistep histories. Initial conditions are projected onto the
+//! constraints ([`analysis`]). Forward sensitivities (stiffness, damping,
+//! mass, Eq. 32 breakpoints, ply angles of flexible bodies through
+//! `dΛ/dθ` and `dX/dθ`: [`Param`]) come from
+//! [`crate::integrate::integrate_sens`], with exact products from
+//! dual-number evaluations of the same right-hand side.
 //!
 //! ## Limitations
-//! - Rigid bodies only in this part (floating-frame flexible bodies are
-//!   issue 3, part B).
+//! - Linear elasticity in a floating frame: no geometric stiffening, so a
+//!   fast-spinning flexible body softens by about `Ω²/ω₁²` (the classic
+//!   spin-up limitation of the linear floating frame; the beam spin-up
+//!   study shows the size).
 //! - A revolute relative angle is measured in (−π, π]; marker frames are
 //!   set so that the scene's initial angle sits inside that range. A
 //!   driven joint's prescribed angle is compared modulo 2π.
@@ -35,8 +45,7 @@
 //!   guaranteed to continue on the physical branch. Singular positions of
 //!   ordinary mechanisms (rocker dead points) are fine.
 //! - Sensitivities assume an initial state independent of the
-//!   parameters; in scene files (`sensitivities = [..]`) they are written
-//!   for angle, rate and position outputs only (`sensitivities.csv`).
+//!   parameters.
 
 pub mod analysis;
 pub mod beam;

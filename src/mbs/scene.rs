@@ -2,31 +2,42 @@
 //!
 //! ```toml
 //! [scene]
-//! effects = ["gravity", "actuators", "damping"]   # what is not listed is not built
+//! effects = ["gravity", "actuators", "damping", "springs", "loads",
+//!            "flexibility", "quadratic_velocity"]   # what is not listed is not built
 //! gravity = [0.0, 0.0, -9.81]                       # m/s²
 //! baumgarte = 10.0                                  # 1/s
-//! sensitivities = ["forces[0].damping", "forces[0].segments[0].anchor", "B3.mass"]
+//! sensitivities = ["forces[0].damping", "forces[0].segments[0].anchor", "B4.mass",
+//!                  "B3.design.theta_1_4"]            # ply angle of a flexible body
 //! [[scene.bodies]]
-//! name = "B2"; mass = 8.3; com = [1.3, 0.0, -1.0]   # kg, m (global, initial)
+//! name = "B4"; mass = 1.5; com = [1.2, 0.0, -0.3]   # kg, m (global, initial)
 //! inertia = [[..], [..], [..]]                      # kg·m², about com, global axes
 //! fixed = false; velocity = [..]; angular_velocity = [..]   # m/s, rad/s (global)
+//! [[scene.bodies]]                                  # floating-frame flexible body
+//! name = "B3"; mass, com, inertia                   # rigid stand-in without "flexibility"
+//! flexible = { kind = "panel", panel = "panel3", modes = 14, origin = [..],
+//!              x_axis = [..], y_axis = [..], derivatives = "updated", damping = 0.0 }
+//! # kind = "beam": length, ei_y, ei_z, rho_a, rho_ip (closed-form cantilever modes)
 //! [[scene.joints]]
 //! name = "R3"; type = "revolute"   # spherical | revolute | locked | driven | fixed
 //! body_i = "B12"; body_j = "B8"    # "ground" allowed
 //! point = [..]; axis = [..]; angle = 3.12   # global initial point, axis, θ0 (rad)
 //! drive = [c0, c1, ..]             # driven: θ(t) = Σ c_k t^k
-//! [[scene.markers]]  name, body, point       # extra points for springs
+//! [[scene.markers]]  name, body, point       # extra points (springs, outputs)
 //! [[scene.forces]]
 //! type = "actuator"; joint = "R3"; damping = 0.5
 //! segments = [{ lower, upper, value, slope, anchor }, ..]  # Eq. 32
 //! type = "spring"; marker_i, marker_j, stiffness, damping, length
-//! type = "load"; body, force, torque
+//! type = "load"; body, force, torque       # or table = [[t, fx, fy, fz, tx, ty, tz], ..]
 //! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out
-//! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation"]
+//! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation",
+//!                                "B3.strain_energy", "B3.modal", "<marker>.deflection"]
 //!                  plot = "R3.angle"; plot_file = "theta"   # theta.svg
 //! ```
-//! Bodies start with their axes along the global axes, so `inertia` is
-//! both the global and the body-frame tensor at `t = 0`.
+//! Rigid bodies start with their axes along the global axes, so `inertia`
+//! is both the global and the body-frame tensor at `t = 0`. A flexible
+//! body's frame is its basis frame (the beam's root, the panel's centre),
+//! placed at `origin` with its x and y axes along `x_axis`, `y_axis`;
+//! points on it (joints, markers) must be nodes of its basis.
 
 use super::beam::Beam;
 use super::flex::ModalBasis;
