@@ -361,6 +361,70 @@ fn ply_angle_sensitivities_match_central_differences() {
 }
 
 #[test]
+fn strain_energy_responses_and_their_ply_angle_gradients() {
+    // Ψ₀ = ∫ 2U dt (an integrated state) and max_t U (critical time point)
+    // of the swung panel, 0–0.4 s. Values: Ψ₀ against Simpson's rule on
+    // the strain energy sampled every 2.5 ms, the peak against the largest
+    // sample (it can only be above it, by at most the sampling error).
+    // Gradients against central differences of whole simulations with the
+    // basis rebuilt at θ ± h.
+    let with_responses = |deg: f64, sens: bool| {
+        let mut t = panel_scene(deg)
+            .replace("dt_out = 0.1", "dt_out = 0.0025")
+            .replace(
+                "[scene.outputs]",
+                r#"[[scene.responses]]
+name = "psi0"
+kind = "integral"
+of = ["panel.strain_energy"]
+scale = 2.0
+[[scene.responses]]
+name = "umax"
+kind = "peak"
+of = ["panel.strain_energy"]
+[scene.outputs]"#,
+            );
+        if !sens {
+            t = t.replace("sensitivities = [\"panel.design.theta_1_4\"]\n", "");
+        }
+        simulate(&load_scene(&study(&t)).unwrap()).unwrap().1
+    };
+    let base = with_responses(30.0, true);
+    let (psi, umax) = (&base.responses[0], &base.responses[1]);
+    // Simpson on 160 intervals of the sampled U (column 1).
+    let u: Vec<f64> = base.rows.iter().map(|r| r[1]).collect();
+    let dt = 0.0025;
+    let simpson: f64 = (0..u.len() - 1)
+        .step_by(2)
+        .map(|k| dt / 3.0 * (u[k] + 4.0 * u[k + 1] + u[k + 2]))
+        .sum::<f64>()
+        * 2.0;
+    println!("psi0 {} vs Simpson {simpson}", psi.value);
+    assert!((psi.value - simpson).abs() < 1e-6 * simpson);
+    let sample_max = u.iter().cloned().fold(0.0, f64::max);
+    println!(
+        "umax {} at {:?} vs largest sample {sample_max}",
+        umax.value, umax.time
+    );
+    assert!(umax.value >= sample_max && umax.value < sample_max * (1.0 + 1e-4));
+    let h: f64 = 2e-4;
+    let (p, m) = (
+        with_responses(30.0 + h.to_degrees(), false),
+        with_responses(30.0 - h.to_degrees(), false),
+    );
+    for k in 0..2 {
+        let fd = (p.responses[k].value - m.responses[k].value) / (2.0 * h);
+        let an = base.responses[k].gradient[0];
+        println!("{}: analytic {an:e}, FD {fd:e}", base.responses[k].name);
+        assert!(
+            (fd - an).abs() < 1e-5 * an.abs(),
+            "{}: {an:e} vs {fd:e}",
+            base.responses[k].name
+        );
+    }
+}
+
+#[test]
 fn flexible_input_errors_name_the_key() {
     let cases = [
         (
@@ -390,6 +454,20 @@ fn flexible_input_errors_name_the_key() {
         (
             FREE_BEAM.replace("\"flexibility\", ", ""),
             "bodies[0].mass",
+        ),
+        (
+            FREE_BEAM.replace(
+                "[scene.integrator]",
+                "[[scene.responses]]\nname = \"r\"\nkind = \"integral\"\nof = [\"beam.energy\"]\n[scene.integrator]",
+            ),
+            "responses[0].of[0]",
+        ),
+        (
+            FREE_BEAM.replace(
+                "[scene.integrator]",
+                "[[scene.responses]]\nname = \"r\"\nkind = \"mean\"\nof = [\"beam.strain_energy\"]\n[scene.integrator]",
+            ),
+            "responses[0].kind",
         ),
     ];
     for (text, key) in cases {

@@ -262,8 +262,12 @@ impl System {
     pub fn nb(&self) -> usize {
         self.moving.len()
     }
-    /// State length (positions + velocities).
+    /// State length (positions + velocities + integrals).
     pub fn nstates(&self) -> usize {
+        self.npos + self.nvel + self.model.integrals.len()
+    }
+    /// Offset of the integral states ([`Model::integrals`](super::model::Model)).
+    pub fn integral_off(&self) -> usize {
         self.npos + self.nvel
     }
     /// Offset of the velocity part of the state.
@@ -858,6 +862,16 @@ impl System {
         let acc = self.solve(ws);
         let vo = self.voff();
         dy[vo..vo + self.nvel].copy_from_slice(&acc);
+        let io = self.integral_off();
+        for (i, integral) in self.model.integrals.iter().enumerate() {
+            let mut v = T::zero();
+            for &b in &integral.bodies {
+                if let Some(s) = self.slot[b] {
+                    v += self.strain_energy_dual(y, s, &ws.kin[s].design);
+                }
+            }
+            dy[io + i] = v * cst::<T>(integral.scale);
+        }
     }
 
     /// `M⁻¹ x` for slot `s` (in place).

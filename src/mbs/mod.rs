@@ -55,6 +55,7 @@ pub mod flex;
 pub mod flexdyn;
 pub mod linalg;
 pub mod model;
+pub mod responses;
 pub mod scene;
 pub mod simulate;
 

@@ -448,6 +448,18 @@ pub struct Model {
     /// bodies; centrifugal and Coriolis couplings of flexible ones): the
     /// scene's `quadratic_velocity` effect.
     pub quadratic_velocity: bool,
+    /// Time integrals carried as extra states (after the velocities), so
+    /// that their sensitivities come with the integration (NUMERICS.md).
+    pub integrals: Vec<Integral>,
+}
+
+/// `∫ scale · Σ_b U_b dt` over the strain energies `U_b = ½ wᵀΛw` of the
+/// flexible bodies `bodies` (the paper's objective Ψ₀ = ∫ 2U dt, Eq. 33,
+/// is `scale = 2`). Rigid bodies contribute zero.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Integral {
+    pub bodies: Vec<usize>,
+    pub scale: f64,
 }
 
 impl Model {

@@ -43,8 +43,8 @@ use super::beam::Beam;
 use super::flex::ModalBasis;
 use super::linalg::euler_from_rotation;
 use super::model::{
-    axis_angle, frame_from_axis, Body, Drive, Flex, Force, Joint, JointKind, Load, Marker, Model,
-    Param, PiecewiseLaw, Segment,
+    axis_angle, frame_from_axis, Body, Drive, Flex, Force, Integral, Joint, JointKind, Load,
+    Marker, Model, Param, PiecewiseLaw, Segment,
 };
 use crate::error::{Error, Result};
 use crate::integrate::{Method, Options};
@@ -85,6 +85,50 @@ pub struct SceneSpec {
     /// `"forces[i].segments[k].anchor"` (indices as in `scene.forces`).
     #[serde(default)]
     pub sensitivities: Vec<String>,
+    /// Functionals of the motion over time (objective and constraints of
+    /// an optimization): `[[scene.responses]]`.
+    #[serde(default)]
+    pub responses: Vec<ResponseSpec>,
+}
+
+/// `[[scene.responses]] name = "psi0"; kind = "integral" | "peak";
+/// of = ["B2.strain_energy", ..]; scale = 2.0`: the time integral (as an
+/// extra integrated state) or the largest value over the run (located
+/// from dense output) of `scale · Σ` the listed strain energies.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ResponseSpec {
+    pub name: String,
+    pub kind: String,
+    pub of: Vec<String>,
+    #[serde(default = "one")]
+    pub scale: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// A built response: the bodies whose strain energies it sums.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Response {
+    /// `∫ scale·ΣU dt`: index into [`Model::integrals`].
+    Integral { name: String, index: usize },
+    /// `max_t scale·ΣU(t)`.
+    Peak {
+        name: String,
+        bodies: Vec<usize>,
+        scale: f64,
+    },
+}
+
+impl Response {
+    /// The response's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Response::Integral { name, .. } | Response::Peak { name, .. } => name,
+        }
+    }
 }
 
 fn default_gravity() -> [f64; 3] {
@@ -294,6 +338,8 @@ pub struct Scene {
     pub effects: Vec<String>,
     /// Sensitivity parameters with their names from the scene file.
     pub params: Vec<(String, Param)>,
+    /// Response functionals.
+    pub responses: Vec<Response>,
 }
 
 impl Quantity {
@@ -748,6 +794,7 @@ impl SceneSpec {
                 ));
             }
         }
+        let responses = self.responses(&mut model, &flex_names)?;
         let mut params = Vec::new();
         for (k, name) in self.sensitivities.iter().enumerate() {
             let key = format!("sensitivities[{k}]");
@@ -773,7 +820,77 @@ impl SceneSpec {
             plot_file: self.outputs.plot_file.clone(),
             effects: self.effects.clone(),
             params,
+            responses,
         })
+    }
+
+    /// Build `[[scene.responses]]` (integrals become model states).
+    fn responses(&self, model: &mut Model, flex_names: &[&str]) -> Result<Vec<Response>> {
+        let mut out: Vec<Response> = Vec::new();
+        for (k, r) in self.responses.iter().enumerate() {
+            let key = format!("responses[{k}]");
+            if r.name.is_empty() || out.iter().any(|o| o.name() == r.name) {
+                return Err(Error::input(
+                    format!("{key}.name"),
+                    &r.name,
+                    "a unique, non-empty name",
+                ));
+            }
+            if !r.scale.is_finite() {
+                return Err(Error::input(
+                    format!("{key}.scale"),
+                    r.scale,
+                    "a finite factor",
+                ));
+            }
+            let mut bodies = Vec::new();
+            for (i, q) in r.of.iter().enumerate() {
+                let body = q
+                    .strip_suffix(".strain_energy")
+                    .filter(|b| flex_names.contains(b))
+                    .and_then(|b| model.body(b))
+                    .ok_or_else(|| {
+                        Error::input(
+                            format!("{key}.of[{i}]"),
+                            q,
+                            "<body>.strain_energy of a body with a `flexible` table",
+                        )
+                    })?;
+                bodies.push(body);
+            }
+            if bodies.is_empty() {
+                return Err(Error::input(
+                    format!("{key}.of"),
+                    "[]",
+                    "at least one strain energy",
+                ));
+            }
+            out.push(match r.kind.as_str() {
+                "integral" => {
+                    model.integrals.push(Integral {
+                        bodies,
+                        scale: r.scale,
+                    });
+                    Response::Integral {
+                        name: r.name.clone(),
+                        index: model.integrals.len() - 1,
+                    }
+                }
+                "peak" => Response::Peak {
+                    name: r.name.clone(),
+                    bodies,
+                    scale: r.scale,
+                },
+                other => {
+                    return Err(Error::input(
+                        format!("{key}.kind"),
+                        other,
+                        "integral or peak",
+                    ));
+                }
+            });
+        }
+        Ok(out)
     }
 }
 

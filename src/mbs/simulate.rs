@@ -4,7 +4,8 @@
 
 use super::analysis::Projection;
 use super::dynamics::{System, Workspace};
-use super::scene::{Quantity, Scene, SceneSpec};
+use super::responses::{peak, strain_sum, ResponseValue};
+use super::scene::{Quantity, Response, Scene, SceneSpec};
 use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Stats};
 use crate::mbs::Param;
@@ -34,6 +35,8 @@ pub struct Simulation {
     pub sens_headers: Vec<String>,
     /// One row per output time: `[t, ∂outputs/∂p_1.., ∂outputs/∂p_2..]`.
     pub sens_rows: Vec<Vec<f64>>,
+    /// The scene's response functionals with their sensitivities.
+    pub responses: Vec<ResponseValue>,
 }
 
 /// Read the `[scene]` section of a study and build it. Panel bodies take
@@ -100,7 +103,30 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
     }
     let mut sens_rows = Vec::new();
     let n = y0.len();
+    // Sampled peak responses (t, value, gradient) and the final
+    // sensitivities (for integral responses).
+    let mut peaks: Vec<Vec<(f64, f64, Vec<f64>)>> = vec![Vec::new(); scene.responses.len()];
+    let mut s_end = vec![0.0; n * scene.params.len()];
     let mut observe = |t: f64, y: &[f64], s: &[f64]| {
+        let lanes: Vec<(&[f64], Param)> = if s.is_empty() {
+            Vec::new()
+        } else {
+            scene
+                .params
+                .iter()
+                .enumerate()
+                .map(|(i, (_, p))| (&s[i * n..(i + 1) * n], *p))
+                .collect()
+        };
+        for (r, series) in scene.responses.iter().zip(peaks.iter_mut()) {
+            if let Response::Peak { bodies, scale, .. } = r {
+                let (v, g) = strain_sum(&sys, bodies, *scale, y, &lanes);
+                series.push((t, v, g));
+            }
+        }
+        if !s.is_empty() {
+            s_end.copy_from_slice(s);
+        }
         if !scene.params.is_empty() {
             let mut row = vec![t];
             for (i, (_, p)) in scene.params.iter().enumerate() {
@@ -176,6 +202,33 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
         integrate_sens(&sys, &y0, &scene.options, &params, &mut observe)?
     };
+    let io = sys.integral_off();
+    let mut responses = Vec::new();
+    for (r, series) in scene.responses.iter().zip(&peaks) {
+        responses.push(match r {
+            Response::Integral { name, index } => ResponseValue {
+                name: name.clone(),
+                kind: "integral",
+                value: y_end[io + index],
+                time: None,
+                gradient: (0..scene.params.len())
+                    .map(|i| s_end[i * n + io + index])
+                    .collect(),
+            },
+            Response::Peak { name, .. } => {
+                let (t, value, gradient) = peak(series).ok_or_else(|| {
+                    Error::numerical("simulate: responses", format!("no samples for {name}"))
+                })?;
+                ResponseValue {
+                    name: name.clone(),
+                    kind: "peak",
+                    value,
+                    time: Some(t),
+                    gradient,
+                }
+            }
+        });
+    }
     let sim = Simulation {
         headers,
         rows,
@@ -188,6 +241,7 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         energy_error: conservative.then_some(energy_error),
         sens_headers,
         sens_rows,
+        responses,
     };
     Ok((sys, sim))
 }
@@ -313,6 +367,30 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
         w.flush().map_err(|e| Error::io(&path, e))?;
         written.push(path);
     }
+    if !sim.responses.is_empty() {
+        let path = dir.join("responses.csv");
+        let mut w = csv::Writer::from_path(&path).map_err(|e| Error::csv(&path, e))?;
+        let mut head = vec![
+            "response".to_string(),
+            "kind".into(),
+            "value".into(),
+            "time [s]".into(),
+        ];
+        head.extend(scene.params.iter().map(|(p, _)| format!("d/d({p})")));
+        w.write_record(&head).map_err(|e| Error::csv(&path, e))?;
+        for r in &sim.responses {
+            let mut rec = vec![
+                r.name.clone(),
+                r.kind.to_string(),
+                format!("{:.12e}", r.value),
+                r.time.map_or(String::new(), |t| format!("{t:.6}")),
+            ];
+            rec.extend(r.gradient.iter().map(|g| format!("{g:.12e}")));
+            w.write_record(&rec).map_err(|e| Error::csv(&path, e))?;
+        }
+        w.flush().map_err(|e| Error::io(&path, e))?;
+        written.push(path);
+    }
     if let Some(name) = &scene.plot {
         let col = sim
             .headers
@@ -363,7 +441,7 @@ pub fn plot_svg(path: &Path, label: &str, rows: &[Vec<f64>], col: usize) -> Resu
 /// One-paragraph summary for the terminal.
 pub fn summary(sim: &Simulation) -> String {
     let s = &sim.stats;
-    format!(
+    let mut text = format!(
         "constraints: {} equations, {} redundant; initial |Φ| {:.2e} (position correction {:.2e}, velocity {:.2e})\n\
          max constraint violation {:.2e}; energy error {}\n\
          integrator: {} steps, {} rhs calls, {} Jacobian-vector products, {} Jacobians, {} error-test failures; wall {:.3} ms (+ {:.3} ms outputs)",
@@ -381,5 +459,16 @@ pub fn summary(sim: &Simulation) -> String {
         s.error_test_failures,
         s.wall * 1e3,
         s.observer_wall * 1e3
-    )
+    );
+    for r in &sim.responses {
+        text += &format!(
+            "\nresponse {} ({}): {:.6e}{}",
+            r.name,
+            r.kind,
+            r.value,
+            r.time
+                .map_or(String::new(), |t| format!(" at t = {t:.4} s"))
+        );
+    }
+    text
 }
