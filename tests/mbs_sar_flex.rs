@@ -36,8 +36,8 @@ fn coarse(theta_deg: f64, sens: bool, flexible: bool) -> Simulation {
     t = replace(&t, "dt_out = 0.01", "dt_out = 0.005", 1);
     t = replace(&t, "rtol = 1e-6", "rtol = 1e-10", 1);
     t = replace(&t, "atol = 1e-8", "atol = 1e-12", 1);
-    let sens_line = "sensitivities = [\"B2.design.theta_1_4\", \"B2.design.theta_2_3\", \
-                     \"B3.design.theta_1_4\", \"B3.design.theta_2_3\"]";
+    let sens_line = "sensitivities = [\"B3.design.theta_1_4\", \"B3.design.theta_2_3\", \
+                     \"B2.design.theta_1_4\", \"B2.design.theta_2_3\"]";
     let new_sens = if sens {
         "sensitivities = [\"B3.design.theta_1_4\"]"
     } else {

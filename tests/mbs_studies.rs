@@ -91,6 +91,7 @@ fn kernel_bench_table_is_consistent() {
         rtols: vec![1e-4],
         repeats: 1,
         sensitivities: true,
+        max_sensitivities: None,
     };
     let rows = run_bench(&study, &spec, |_| {}).unwrap();
     // SAR lists 2 parameters: rows without and with; Dzhanibekov none.
