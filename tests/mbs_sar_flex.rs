@@ -160,7 +160,7 @@ fn flexible_sar_runs_balances_energy_and_stays_near_rigid() {
     );
     // The strain energy is a visible part of E (so the balance tests it).
     assert!(last[cs3] > 1e-3 * scale, "B3 strain energy {:e}", last[cs3]);
-    // Measured 3e-10 relative at rtol 1e-10; bound 1e-8.
+    // Measured 1.5e-9 relative at rtol 1e-10; bound 1e-8.
     assert!(
         worst < 1e-8 * scale,
         "balance error {worst:e} of {scale:e} J"
