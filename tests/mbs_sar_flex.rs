@@ -74,13 +74,17 @@ fn col(sim: &Simulation, name: &str) -> usize {
 }
 
 /// ∫_{a}^{b} m(θ) dθ of the Eq. (32) law `m = value + slope·(anchor − θ)`
-/// on each segment (lower, upper]: exact, segment by segment (closed form
-/// derived here: the antiderivative is value·θ + slope·(anchor·θ − θ²/2)).
+/// on each segment (lower, upper] (the outermost segments extend beyond
+/// the table): exact, segment by segment (closed form derived here: the
+/// antiderivative is value·θ + slope·(anchor·θ − θ²/2)).
 fn law_integral(law: &PiecewiseLaw, a: f64, b: f64) -> f64 {
     let (lo, hi, sign) = if a <= b { (a, b, 1.0) } else { (b, a, -1.0) };
+    let last = law.segments.len() - 1;
     let mut total = 0.0;
-    for s in &law.segments {
-        let (x0, x1) = (lo.max(s.lower), hi.min(s.upper));
+    for (k, s) in law.segments.iter().enumerate() {
+        let lower = if k == 0 { f64::NEG_INFINITY } else { s.lower };
+        let upper = if k == last { f64::INFINITY } else { s.upper };
+        let (x0, x1) = (lo.max(lower), hi.min(upper));
         if x1 > x0 {
             let f = |x: f64| s.value * x + s.slope * (s.anchor * x - 0.5 * x * x);
             total += f(x1) - f(x0);
