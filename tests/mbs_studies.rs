@@ -91,6 +91,7 @@ fn kernel_bench_table_is_consistent() {
         rtols: vec![1e-4],
         repeats: 1,
         sensitivities: true,
+        max_sensitivities: None,
     };
     let rows = run_bench(&study, &spec, |_| {}).unwrap();
     // SAR lists 2 parameters: rows without and with; Dzhanibekov none.
@@ -155,4 +156,27 @@ fn kernel_bench_rejects_bad_input() {
     let spec: BenchSpec = study.require_section("kernel_bench", "bench").unwrap();
     let msg = run_bench(&study, &spec, |_| {}).unwrap_err().to_string();
     assert!(msg.contains("missing.toml"), "{msg}");
+    let text = text.replace("missing", "andrews") + "max_sensitivities = 0\n";
+    let study = Study::parse(study_path("bad_bench.toml"), &text).unwrap();
+    let spec: BenchSpec = study.require_section("kernel_bench", "bench").unwrap();
+    let msg = run_bench(&study, &spec, |_| {}).unwrap_err().to_string();
+    assert!(msg.contains("kernel_bench.max_sensitivities"), "{msg}");
+}
+
+#[test]
+fn kernel_bench_max_sensitivities_keeps_the_first_parameters() {
+    // The rigid SAR study lists 2 parameters; with max_sensitivities = 1
+    // the sensitivity case integrates only the first.
+    let study = Study::load(study_path("kernel_bench.toml")).unwrap();
+    let spec = BenchSpec {
+        scenes: vec!["sar_phase1_rigid.toml".into()],
+        methods: vec![Method::Bdf],
+        rtols: vec![1e-4],
+        repeats: 1,
+        sensitivities: true,
+        max_sensitivities: Some(1),
+    };
+    let rows = run_bench(&study, &spec, |_| {}).unwrap();
+    let n: Vec<usize> = rows.iter().map(|r| r.case.n_sens).collect();
+    assert_eq!(n, [0, 1]);
 }

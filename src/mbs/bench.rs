@@ -51,6 +51,10 @@ pub struct BenchSpec {
     /// true); every scene always runs without.
     #[serde(default = "yes")]
     pub sensitivities: bool,
+    /// Integrate at most this many of a scene's sensitivity parameters
+    /// (its first ones in `scene.sensitivities`); default: all.
+    #[serde(default)]
+    pub max_sensitivities: Option<usize>,
 }
 
 fn yes() -> bool {
@@ -269,6 +273,70 @@ pub fn time_rhs(sys: &System, t: f64, y: &[f64]) -> (f64, f64) {
     (rhs_us, jvp_us)
 }
 
+/// Fastest of 7 batches of `f`, each averaging the calls that fill about
+/// 3 ms (at least 10), in µs per call (as in [`time_rhs`]).
+fn fastest_us(f: &mut dyn FnMut()) -> f64 {
+    f();
+    (0..7)
+        .map(|_| {
+            let start = Instant::now();
+            let mut calls = 0u32;
+            while calls < 10 || start.elapsed().as_secs_f64() < 0.003 {
+                f();
+                calls += 1;
+            }
+            start.elapsed().as_secs_f64() / f64::from(calls) * 1e6
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Names of the pieces timed by [`rhs_pieces`], in order.
+pub const PIECES: [&str; 7] = [
+    "rhs (whole)",
+    "kinematics: bodies + markers",
+    "  of which node shapes",
+    "constraints: rows + Jacobian blocks",
+    "applied: forces + flexible terms",
+    "  of which flexible mass matrices + Cholesky",
+    "solve: G M^-1 G^T, Cholesky, accelerations",
+];
+
+/// Cost (µs, [`fastest_us`]) of the pieces of one right-hand side of
+/// `sys` at `(t, y)`, in the order of [`PIECES`], evaluated in the scalar
+/// type of `y` (`f64` for a plain call, `Dual64` for a Jacobian-vector
+/// product). Each piece runs on a workspace prepared by the pieces before
+/// it, so the pieces (without the "of which" lines) add up to the whole.
+/// "node shapes" is every node marker's `(Φ_k, Ψ_k)` rows once (the
+/// kinematics, constraint and force pieces each fetch them).
+pub fn rhs_pieces<T: crate::mbs::linalg::Scalar>(sys: &System, t: f64, y: &[T]) -> Vec<f64> {
+    let mut ws = Workspace::<T>::empty();
+    let mut dy = vec![T::zero(); y.len()];
+    let whole = fastest_us(&mut || sys.rhs(t, y, &mut dy, &mut ws));
+    let kin = fastest_us(&mut || sys.kinematics(y, &mut ws));
+    let nodes: Vec<(usize, usize, usize)> = sys
+        .model
+        .markers
+        .iter()
+        .filter_map(|m| {
+            let (b, node) = (m.body?, m.node?);
+            Some((sys.slot[b]?, b, node))
+        })
+        .collect();
+    let shapes = fastest_us(&mut || {
+        for &(s, b, node) in &nodes {
+            std::hint::black_box(sys.node_shapes(&ws.kin[s], b, node));
+        }
+    });
+    let rows = fastest_us(&mut || sys.constraints(t, &mut ws));
+    let applied = fastest_us(&mut || sys.applied(t, &mut ws));
+    let mass = fastest_us(&mut || sys.mass_factors(&mut ws));
+    sys.applied(t, &mut ws);
+    let solve = fastest_us(&mut || {
+        std::hint::black_box(sys.solve(&mut ws));
+    });
+    vec![whole, kin, shapes, rows, applied, mass, solve]
+}
+
 /// Run every case of the section; `progress` gets each finished row.
 pub fn run_bench(
     study: &Study,
@@ -289,7 +357,8 @@ pub fn run_bench(
         sys.project(scene.options.t0, &mut y0)
             .map_err(scene_study.locate("scene"))?;
         let (rhs_us, jvp_us) = time_rhs(&sys, scene.options.t0, &y0);
-        let params = std::mem::take(&mut scene.params);
+        let mut params = std::mem::take(&mut scene.params);
+        params.truncate(spec.max_sensitivities.unwrap_or(usize::MAX));
         let mut sens_sets = vec![Vec::new()];
         if spec.sensitivities && !params.is_empty() {
             sens_sets.push(params);
@@ -340,6 +409,13 @@ fn validate(study: &Study, spec: &BenchSpec) -> Result<()> {
         if !(r > 1e-14 && r < 1.0) {
             return Err(study.error(format!("kernel_bench.rtols[{k}]"), r, "1e-14 < rtol < 1"));
         }
+    }
+    if spec.max_sensitivities == Some(0) {
+        return Err(study.error(
+            "kernel_bench.max_sensitivities",
+            0,
+            "≥ 1 (set sensitivities = false to run without)",
+        ));
     }
     if spec.repeats == 0 {
         return Err(study.error("kernel_bench.repeats", 0, "repeats ≥ 1"));
