@@ -23,6 +23,10 @@
 //! first step after a restart (θ starts within round-off of `b`) and the
 //! jump of θ by 2π where the relative angle wraps at ±π.
 //!
+//! Limitation: a relative angle wrapping at ±π (a law whose θ range
+//! leaves (−π, π]) is not an event; the frozen segment then continues
+//! where evaluation by value would jump to the segment at −π.
+//!
 //! ## Sensitivities
 //! With the switching surface `g(y(t_e), p) = 0`, the event time moves with
 //! the parameters and the state sensitivities `s = ∂y/∂p` jump (Hiskens &

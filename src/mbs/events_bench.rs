@@ -106,6 +106,8 @@ pub fn headers(param_names: &[String]) -> Vec<String> {
         "status",
         "wall_ms",
         "rhs_calls",
+        "jvp_calls",
+        "jacobians",
         "steps",
         "error_test_failures",
         "segment_events",
@@ -221,6 +223,8 @@ pub fn run_events_bench(study: &Study, out: &Path, quiet: bool) -> Result<PathBu
                         "ok".to_string(),
                         format!("{:.4}", walls[walls.len() / 2] * 1e3),
                         s.rhs_calls.to_string(),
+                        s.jvp_calls.to_string(),
+                        s.jacobians.to_string(),
                         s.steps.to_string(),
                         s.error_test_failures.to_string(),
                         s.events.to_string(),
@@ -239,7 +243,7 @@ pub fn run_events_bench(study: &Study, out: &Path, quiet: bool) -> Result<PathBu
                     Ok(v) => row.extend(v),
                     Err(e @ Error::Numerical { .. }) => {
                         row.push(format!("failed: {e}"));
-                        row.extend(std::iter::repeat_n(String::new(), 12 + names.len()));
+                        row.extend(std::iter::repeat_n(String::new(), 14 + names.len()));
                     }
                     Err(e) => return Err(e),
                 }
