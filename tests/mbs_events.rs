@@ -11,6 +11,11 @@ use plyscape::mbs::{Model, Param, System, Workspace};
 /// `M = 2.0` on `−3 < θ ≤ 1`: a jump of 1.5 N·m at θ = 1 (when
 /// `slope = 0`). Torque `τ = −(c θ̇ + M(θ))`.
 fn rotor(slope: f64, damping: f64) -> Model {
+    rotor_spec(slope, damping, "").build().unwrap().model
+}
+
+/// The rotor's scene, with `extra` lines appended to `[scene.integrator]`.
+fn rotor_spec(slope: f64, damping: f64, extra: &str) -> SceneSpec {
     let effects = if damping != 0.0 {
         r#"["actuators", "damping"]"#
     } else {
@@ -44,11 +49,19 @@ segments = [
 [scene.integrator]
 t_end = 2.5
 dt_out = 0.1
+{extra}
 "#
     );
     let table: toml::Table = toml::from_str(&scene).unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
-    spec.build().unwrap().model
+    table["scene"].clone().try_into().unwrap()
+}
+
+#[test]
+fn scene_events_flag_defaults_to_on() {
+    let opts = |extra: &str| rotor_spec(0.0, 0.0, extra).build().unwrap().options;
+    assert!(opts("").events);
+    assert!(!opts("events = false").events);
+    assert!(opts("events = true").events);
 }
 
 fn options(method: Method, rtol: f64, events: bool, times: Vec<f64>) -> Options {
@@ -92,7 +105,7 @@ fn exact(t: f64) -> (f64, f64) {
 #[test]
 fn rotor_event_time_and_state_match_closed_form() {
     let times: Vec<f64> = (1..=25).map(|k| k as f64 * 0.1).collect();
-    for method in [Method::Bdf, Method::Tsit45] {
+    for method in [Method::Bdf, Method::Tsit45, Method::Esdirk34] {
         let opts = options(method, 1e-12, true, times.clone());
         let (out, stats) = angles(rotor(0.0, 0.0), &opts);
         // One segment change, at t_e = 2 (closed form above).
@@ -100,13 +113,31 @@ fn rotor_event_time_and_state_match_closed_form() {
         assert_eq!(stats.restarts, 1);
         let te = stats.last_event.unwrap();
         assert!((te - 2.0).abs() < 1e-9, "{method:?}: t_e = {te}");
+        // ESDIRK 3(4) has the largest global error at this rtol (measured
+        // 1.3e-9 after the event, 3.4e-10 before it, t_e off by 3.9e-10).
+        let tol = if method == Method::Esdirk34 {
+            3e-9
+        } else {
+            1e-9
+        };
+        let (mut pre, mut post) = (0.0f64, 0.0f64);
         for (&t, &(th, thd)) in times.iter().zip(&out) {
             let (e, ed) = exact(t);
+            let err = (th - e).abs().max((thd - ed).abs());
+            if t < te {
+                pre = pre.max(err);
+            } else {
+                post = post.max(err);
+            }
             assert!(
-                (th - e).abs() < 1e-9 && (thd - ed).abs() < 1e-9,
+                err < tol,
                 "{method:?} t = {t}: θ {th} vs {e}, θ̇ {thd} vs {ed}"
             );
         }
+        println!(
+            "{method:?}: t_e − 2 = {:.1e}, error before {pre:.1e}, after {post:.1e}",
+            te - 2.0
+        );
     }
 }
 
