@@ -242,3 +242,28 @@ fn sensitivities_across_the_event_match_central_differences() {
         }
     }
 }
+
+#[test]
+fn rotor_bouncing_on_a_breakpoint_crosses_both_ways() {
+    // Below θ = 1 the law pushes back (M = −2.0): the rotor bounces on the
+    // breakpoint. Closed form derived here (J = 1, c = 0): θ = 2 − t²/4
+    // reaches 1 at t = 2 with θ̇ = −1; below, θ̈ = +2 brings it back at
+    // t = 3 with θ̇ = +1; above, θ̈ = −0.5 returns it at t = 7 with θ̇ = −1;
+    // then θ = 1 − (t − 7) + (t − 7)² until t = 8. At t = 7.5: θ = 0.75,
+    // θ̇ = 0. Three events, the second one upwards.
+    let mut model = rotor(0.0, 0.0);
+    if let plyscape::mbs::Force::Rotational { law: Some(l), .. } = &mut model.forces[0] {
+        l.segments[0].value = -2.0; // the (−3, 1] segment (sorted first)
+    }
+    for method in [Method::Bdf, Method::Tsit45] {
+        let (out, stats) = angles(model.clone(), &options(method, 1e-12, true, vec![7.5]));
+        assert_eq!(stats.events, 3, "{method:?}: {stats:?}");
+        let te = stats.last_event.unwrap();
+        assert!((te - 7.0).abs() < 1e-8, "{method:?}: last event at {te}");
+        let (th, thd) = out[0];
+        assert!(
+            (th - 0.75).abs() < 1e-8 && thd.abs() < 1e-8,
+            "{method:?}: θ {th}, θ̇ {thd}"
+        );
+    }
+}

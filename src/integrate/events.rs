@@ -17,11 +17,13 @@
 //! switched and the integrator restarted from `(t_e, y(t_e))`: no multistep
 //! history and no Runge–Kutta stage crosses the discontinuity.
 //!
-//! A sign change is accepted as a segment change only if θ really leaves
-//! the segment there (|θ − b| small and θ̇ pointing out of the segment):
-//! this discards the sign change of the breakpoint just crossed during the
-//! first step after a restart (θ starts within round-off of `b`) and the
-//! jump of θ by 2π where the relative angle wraps at ±π.
+//! A leg starts with θ on the breakpoint just crossed (within round-off,
+//! on either side): that root function is offset by the round-off plus
+//! `1e-14 (1 + |b|)` rad so that it starts strictly inside-signed, and an
+//! immediate re-crossing still changes its sign. A sign change is
+//! accepted as a segment change only if θ really leaves the segment there
+//! (|θ − b| ≤ `1e-8 (1 + |b|)` and θ̇ pointing out of the segment): this
+//! discards the jump of θ by 2π where the relative angle wraps at ±π.
 //!
 //! Limitation: a relative angle wrapping at ±π (a law whose θ range
 //! leaves (−π, π]) is not an event; the frozen segment then continues
@@ -110,6 +112,13 @@ pub(crate) struct Events {
     switches: Vec<Switch>,
     /// Current interval of each switch.
     mode: Vec<usize>,
+    /// Per switch, `[s_lo, s_hi] ≥ 0`: the root functions are
+    /// `θ − b_lo + s_lo` and `θ − b_hi − s_hi`, so that they are strictly
+    /// inside-signed at the start of a leg even when θ sits on (or, by
+    /// round-off, just past) the breakpoint it has just crossed; otherwise
+    /// a re-crossing during the first step would show no sign change.
+    /// Non-zero only within `1e-8 (1 + |b|)` of a breakpoint.
+    shift: Vec<[f64; 2]>,
     nforces: usize,
     /// Whether segment changes are events (otherwise the laws are
     /// evaluated by value and no root function is active).
@@ -141,9 +150,11 @@ impl Events {
             }
         }
         let mode = vec![0; switches.len()];
+        let shift = vec![[0.0; 2]; switches.len()];
         Events {
             switches,
             mode,
+            shift,
             nforces: sys.model.forces.len(),
             enabled,
         }
@@ -172,6 +183,31 @@ impl Events {
             let (th, _) = sys.joint_angle(&kin, sw.joint);
             self.mode[k] = sw.interval(th);
         }
+        for k in 0..self.switches.len() {
+            self.set_shift(sys, k, &kin);
+        }
+    }
+
+    /// Recompute `shift[k]` from θ at the kinematics `kin` (module doc of
+    /// the field).
+    fn set_shift(&mut self, sys: &System, k: usize, kin: &[BodyKin<f64>]) {
+        let sw = &self.switches[k];
+        let i = self.mode[k];
+        let (th, _) = sys.joint_angle(kin, sw.joint);
+        let near = |b: f64| (th - b).abs() <= 1e-8 * (1.0 + b.abs());
+        let margin = |b: f64| 1e-14 * (1.0 + b.abs());
+        let mut sh = [0.0; 2];
+        if let Some(&b) = i.checked_sub(1).and_then(|j| sw.breaks.get(j)) {
+            if near(b) {
+                sh[0] = (b - th).max(0.0) + margin(b);
+            }
+        }
+        if let Some(&b) = sw.breaks.get(i) {
+            if near(b) {
+                sh[1] = (th - b).max(0.0) + margin(b);
+            }
+        }
+        self.shift[k] = sh;
     }
 
     /// Frozen segment per force for [`Workspace::segments`] (empty when
@@ -198,9 +234,14 @@ impl Events {
         sys.body_kin(y, &[], kin);
         for (k, (sw, &i)) in self.switches.iter().zip(&self.mode).enumerate() {
             let (th, _) = sys.joint_angle(kin, sw.joint);
-            g[2 * k] = if i > 0 { th - sw.breaks[i - 1] } else { 1.0 };
+            let [s_lo, s_hi] = self.shift[k];
+            g[2 * k] = if i > 0 {
+                th - sw.breaks[i - 1] + s_lo
+            } else {
+                1.0
+            };
             g[2 * k + 1] = match sw.breaks.get(i) {
-                Some(b) => th - b,
+                Some(b) => th - b - s_hi,
                 None => -1.0,
             };
         }
@@ -278,8 +319,11 @@ impl Events {
         let (t, y) = at;
         let n = y.len();
         let ns = s.len() / n.max(1);
+        let mut kin = Vec::new();
+        sys.body_kin(y, &[], &mut kin);
         if ns == 0 {
             self.mode[c.switch] = c.to;
+            self.set_shift(sys, c.switch, &kin);
             return Ok(Vec::new());
         }
         let mut fm = vec![0.0; n];
@@ -287,6 +331,7 @@ impl Events {
         ws.segments = self.segments();
         sys.rhs(t, y, &mut fm, ws);
         self.mode[c.switch] = c.to;
+        self.set_shift(sys, c.switch, &kin);
         ws.segments = self.segments();
         sys.rhs(t, y, &mut fp, ws);
         let sw = &self.switches[c.switch];
