@@ -71,13 +71,15 @@ pub struct Options {
     /// `results/events/events.csv`, rtol 1e-4/1e-6/1e-8 against a rtol
     /// 1e-12 reference): the sensitivities dθ/dp are right only with
     /// events (relative error 3e-4 / 5e-6 / 5e-7 with BDF, 4e-6 / 8e-9 /
-    /// 2e-10 with tsit45; 2e-2 to 2e-1 by value at every rtol, because
-    /// direct differentiation of the by-value law misses the jump of `s`
-    /// at the event); θ(10 s) is 2–5× (BDF, rtol ≤ 1e-6) and 200–4000×
-    /// (tsit45) more accurate, with fewer error-test failures. Cost:
-    /// tsit45 about the same wall time; BDF restarts at order 1 after each
-    /// event, which costs extra Jacobians (+10 % wall at rtol 1e-6, about
-    /// 2× at 1e-4, −6 % at 1e-8).
+    /// 2e-10 with tsit45; 7e-4 to 2e-1 by value, not converging with
+    /// rtol, because direct differentiation of the by-value law misses the
+    /// jump of `s` at the event); θ(10 s) is 2–5× (BDF, rtol ≤ 1e-6; at
+    /// 1e-4 both are 1.2–1.4e-4) and 200–4000× (tsit45) more accurate,
+    /// with fewer error-test failures. Cost (three runs on a shared 2-core
+    /// VM): tsit45 the same wall time within noise; BDF restarts at order 1
+    /// after each event, which costs extra steps and Jacobians (about 2×
+    /// wall at rtol 1e-4, +10–25 % at 1e-6, −6 to +14 % at 1e-8). Scenes
+    /// that cross no breakpoint (SAR 0–3 s) are bit-identical either way.
     pub events: bool,
 }
 
