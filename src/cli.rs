@@ -260,7 +260,13 @@ fn handlers() -> Vec<(&'static str, Handler)> {
         ("scaling", run_scaling_handler),
         ("map", run_map_handler),
         ("kernel_bench", run_kernel_bench_handler),
+        ("events_bench", run_events_bench_handler),
     ]
+}
+
+/// The `[events_bench]` section: Eq. 32 segment changes as events or not.
+fn run_events_bench_handler(cfg: &RunConfig) -> Result<()> {
+    crate::mbs::events_bench::run_events_bench(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
 }
 
 /// The `[kernel_bench]` section: multibody kernel cost and accuracy table.

@@ -29,6 +29,7 @@ fn run(method: Method, rtol: f64) -> (f64, f64, f64) {
         atol: rtol * 1e-2,
         t0: 0.0,
         times: (1..=400).map(|k| k as f64 * 0.025).collect(),
+        events: true,
     };
     integrate(&sys, &y0, &opts, |_t, y| {
         let mut ws = Workspace::empty();

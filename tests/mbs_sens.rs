@@ -60,6 +60,7 @@ fn options(method: Method) -> Options {
         atol: 1e-13,
         t0: 0.0,
         times: vec![1.0],
+        events: true,
     }
 }
 
@@ -161,6 +162,7 @@ fn sar_sensitivities_of_deployment_angle() {
         atol: 1e-12,
         t0: 0.0,
         times: vec![3.0],
+        events: true,
     };
     let sys = System::new(m.clone());
     let y0 = sys.initial_state();

@@ -408,6 +408,7 @@ impl<T: Scalar> Workspace<T> {
             q: Vec::new(),
             rank: 0,
             params: Vec::new(),
+            segments: Vec::new(),
         }
     }
 }

@@ -113,6 +113,12 @@ pub struct Workspace<T: Scalar> {
     /// Parameter values overriding the model's (sensitivity analysis);
     /// empty for plain evaluations.
     pub params: Vec<(Param, T)>,
+    /// Frozen segment of each actuator's Eq. 32 law, by force index, while
+    /// the integrator treats segment changes as events (`integrate::events`):
+    /// the segment's line then extends past its breakpoints, so the
+    /// right-hand side is smooth. Empty (or an out-of-range entry): the
+    /// segment is picked by the value of θ.
+    pub segments: Vec<usize>,
 }
 
 /// Kinematics of one body at the current state.
@@ -759,7 +765,10 @@ impl System {
                     let (th, thd) = angle_of(&mi, &mj);
                     let mut m = pval(&ws.params, Param::Damping(fi), *damping) * thd;
                     if let Some(law) = law {
-                        let k = law.segment_index(th.to_subset().unwrap_or(f64::NAN));
+                        let k = match ws.segments.get(fi) {
+                            Some(&k) if k < law.segments.len() => k,
+                            _ => law.segment_index(th.to_subset().unwrap_or(f64::NAN)),
+                        };
                         let seg = &law.segments[k];
                         let anchor = pval(&ws.params, Param::Anchor(fi, k), seg.anchor);
                         m += cst::<T>(seg.value) + cst::<T>(seg.slope) * (anchor - th);

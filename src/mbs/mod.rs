@@ -51,6 +51,7 @@ pub mod analysis;
 pub mod beam;
 pub mod bench;
 pub mod dynamics;
+pub mod events_bench;
 pub mod flex;
 pub mod flexdyn;
 pub mod linalg;

@@ -28,7 +28,7 @@
 //! segments = [{ lower, upper, value, slope, anchor }, ..]  # Eq. 32
 //! type = "spring"; marker_i, marker_j, stiffness, damping, length
 //! type = "load"; body, force, torque       # or table = [[t, fx, fy, fz, tx, ty, tz], ..]
-//! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out
+//! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out, events = true
 //! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation",
 //!                                "B3.strain_energy", "B3.modal", "<marker>.deflection"]
 //!                  plot = "R3.angle"; plot_file = "theta"   # theta.svg
@@ -283,6 +283,13 @@ pub struct IntegratorSpec {
     pub atol: f64,
     pub t_end: f64,
     pub dt_out: f64,
+    /// Segment changes of actuator laws as integration events
+    /// ([`Options::events`], default `true`).
+    #[serde(default = "default_events")]
+    pub events: bool,
+}
+fn default_events() -> bool {
+    true
 }
 fn default_method() -> Method {
     Method::Bdf
@@ -752,6 +759,7 @@ impl SceneSpec {
             atol: it.atol,
             t0: 0.0,
             times,
+            events: it.events,
         };
         options.validate()?;
         let flex_names: Vec<&str> = self

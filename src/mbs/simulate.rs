@@ -327,6 +327,9 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
         ("error_test_failures", s.error_test_failures.to_string()),
         ("nonlinear_iterations", s.nonlinear_iterations.to_string()),
         ("nonlinear_failures", s.nonlinear_failures.to_string()),
+        ("events", scene.options.events.to_string()),
+        ("segment_events", s.events.to_string()),
+        ("restarts", s.restarts.to_string()),
         ("wall_time_s", format!("{:.6e}", s.wall)),
         ("output_wall_time_s", format!("{:.6e}", s.observer_wall)),
         ("equations", sim.equations.to_string()),
@@ -444,7 +447,7 @@ pub fn summary(sim: &Simulation) -> String {
     let mut text = format!(
         "constraints: {} equations, {} redundant; initial |Φ| {:.2e} (position correction {:.2e}, velocity {:.2e})\n\
          max constraint violation {:.2e}; energy error {}\n\
-         integrator: {} steps, {} rhs calls, {} Jacobian-vector products, {} Jacobians, {} error-test failures; wall {:.3} ms (+ {:.3} ms outputs)",
+         integrator: {} steps, {} rhs calls, {} Jacobian-vector products, {} Jacobians, {} error-test failures, {} segment events ({} restarts); wall {:.3} ms (+ {:.3} ms outputs)",
         sim.equations,
         sim.redundant,
         sim.projection.phi_before,
@@ -457,6 +460,8 @@ pub fn summary(sim: &Simulation) -> String {
         s.jvp_calls,
         s.jacobians,
         s.error_test_failures,
+        s.events,
+        s.restarts,
         s.wall * 1e3,
         s.observer_wall * 1e3
     );
