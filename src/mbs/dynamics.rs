@@ -37,10 +37,11 @@
 
 use super::flexdyn::{flex_terms, FlexEffects, FlexState, InvT};
 use super::linalg::{
-    cholesky_solve, cst, dense_cholesky, dense_cholesky_solve, euler_rate, min_degree_order,
-    ordered_cholesky, rotation, rotation_tangent, rotation_vector, Scalar,
+    cst, dense_cholesky, euler_rate, rotation, rotation_tangent, rotation_vector, Scalar,
 };
 use super::model::{Force, JointKind, Model, Param};
+pub use super::rows::angle_of;
+use super::rows::{angle_row, dot_row, point_row};
 use nalgebra::{Matrix3, Vector3};
 use std::cell::Cell;
 
@@ -202,7 +203,7 @@ pub struct System {
     nvel: usize,
     /// Constraint rows left out of the solve (their multipliers are zero):
     /// equations found redundant at the projected initial state.
-    drop: Vec<bool>,
+    pub(crate) drop: Vec<bool>,
     pub counters: Counters,
 }
 
@@ -882,255 +883,14 @@ impl System {
             dy[io + i] = v * cst::<T>(integral.scale);
         }
     }
-
-    /// `M⁻¹ x` for slot `s` (in place).
-    fn apply_minv<T: Scalar>(
-        &self,
-        ws_mfac: &[Vec<T>],
-        params: &[(Param, T)],
-        s: usize,
-        x: &mut [T],
-    ) {
-        if self.modes[s] > 0 {
-            dense_cholesky_solve(&ws_mfac[s], self.dof(s), x);
-            return;
-        }
-        let b = self.moving[s];
-        let body = &self.model.bodies[b];
-        let im = T::one() / pval(params, Param::Mass(b), body.mass);
-        let w = body.inv_inertia.map(cst::<T>) * Vector3::new(x[3], x[4], x[5]);
-        for c in 0..3 {
-            x[c] *= im;
-            x[3 + c] = w[c];
-        }
-    }
-
-    /// Solve for the multipliers and accelerations with the rows, applied
-    /// forces and mass factors in `ws`. Returns `v̇` (velocity layout);
-    /// `ws.rhs` = λ.
-    pub(crate) fn solve<T: Scalar>(&self, ws: &mut Workspace<T>) -> Vec<T> {
-        let m = ws.rows.len();
-        let nb = self.nb();
-        let mut mq = ws.q.clone();
-        for s in 0..nb {
-            let o = self.vel_local(s);
-            self.apply_minv(&ws.mfac, &ws.params, s, &mut mq[o..o + self.dof(s)]);
-        }
-        // Rows touching each body, with d and M⁻¹d in the arena.
-        let mut by_body = std::mem::take(&mut ws.by_body);
-        by_body.resize_with(nb, Vec::new);
-        for list in by_body.iter_mut() {
-            list.clear();
-        }
-        let mut arena = std::mem::take(&mut ws.arena);
-        arena.clear();
-        ws.rhs.clear();
-        for (r, row) in ws.rows.iter().enumerate() {
-            let mut b = row.gamma;
-            for (side, (slot, blk)) in row.blocks.iter().enumerate() {
-                let Some(s) = *slot else { continue };
-                let d = self.dof(s);
-                let off = arena.len();
-                arena.extend_from_slice(blk);
-                if d > 6 {
-                    let mo = row.modal[side];
-                    if mo == RIGID {
-                        arena.extend(std::iter::repeat_n(T::zero(), d - 6));
-                    } else {
-                        arena.extend_from_slice(&ws.mjac[mo..mo + d - 6]);
-                    }
-                }
-                arena.extend_from_within(off..off + d);
-                self.apply_minv(&ws.mfac, &ws.params, s, &mut arena[off + d..off + 2 * d]);
-                let o = self.vel_local(s);
-                b -= dot(&arena[off..off + d], &mq[o..o + d]);
-                by_body[s].push((r, off));
-            }
-            ws.rhs.push(b);
-        }
-        // Fill-reducing order, computed once per workspace (the row
-        // structure of a system never changes).
-        if ws.inv_order.len() != m {
-            let mut edges = Vec::new();
-            for list in &by_body {
-                for (x, (r, _)) in list.iter().enumerate() {
-                    for (c, _) in list.iter().take(x) {
-                        edges.push((*r, *c));
-                    }
-                }
-            }
-            let order = min_degree_order(m, &edges);
-            ws.inv_order = vec![0; m];
-            for (k, &r) in order.iter().enumerate() {
-                ws.inv_order[r] = k;
-            }
-        }
-        let inv = &ws.inv_order;
-        ws.a.clear();
-        ws.a.resize(m * m, T::zero());
-        for (s, list) in by_body.iter().enumerate() {
-            let d = self.dof(s);
-            for (x, (r, od)) in list.iter().enumerate() {
-                for (c, ow) in list.iter().take(x + 1) {
-                    let (pr, pc) = (inv[*r], inv[*c]);
-                    let (hi, lo) = if pr >= pc { (pr, pc) } else { (pc, pr) };
-                    ws.a[hi * m + lo] += dot(&arena[*od..*od + d], &arena[ow + d..ow + 2 * d]);
-                }
-            }
-        }
-        let mut ndrop = 0;
-        for (r, _) in self.drop.iter().enumerate().take(m).filter(|(_, d)| **d) {
-            ndrop += 1;
-            let p = inv[r];
-            for c in 0..p {
-                ws.a[p * m + c] = T::zero();
-            }
-            for q in p + 1..m {
-                ws.a[q * m + p] = T::zero();
-            }
-            ws.a[p * m + p] = T::one();
-            ws.rhs[r] = T::zero();
-        }
-        let f = ordered_cholesky(
-            &mut ws.a,
-            m,
-            &mut ws.scale,
-            (RANK_TOL, RANK_REG),
-            &mut ws.col,
-            &mut ws.nz,
-        );
-        ws.rank = f.rank - ndrop;
-        let mut lam = std::mem::take(&mut ws.rhs);
-        ws.tmp.clear();
-        ws.tmp.resize(m, T::zero());
-        for r in 0..m {
-            ws.tmp[inv[r]] = lam[r];
-        }
-        std::mem::swap(&mut lam, &mut ws.tmp);
-        cholesky_solve(&ws.a, m, &ws.scale, f.accepted, &mut lam, &mut ws.tmp);
-        ws.tmp.clear();
-        ws.tmp.extend((0..m).map(|r| lam[inv[r]]));
-        std::mem::swap(&mut lam, &mut ws.tmp);
-        let mut acc = mq;
-        for (s, list) in by_body.iter().enumerate() {
-            let d = self.dof(s);
-            let o = self.vel_local(s);
-            for (r, off) in list {
-                let w = &arena[off + d..off + 2 * d];
-                for c in 0..d {
-                    acc[o + c] += w[c] * lam[*r];
-                }
-            }
-        }
-        ws.rhs = lam;
-        ws.by_body = by_body;
-        ws.arena = arena;
-        acc
-    }
 }
 
 /// The value of parameter `which`: the override in `params` if present,
 /// else the model's `default`.
 #[inline]
-fn pval<T: Scalar>(params: &[(Param, T)], which: Param, default: f64) -> T {
+pub(crate) fn pval<T: Scalar>(params: &[(Param, T)], which: Param, default: f64) -> T {
     params
         .iter()
         .find(|(p, _)| *p == which)
         .map_or_else(|| cst::<T>(default), |(_, v)| *v)
-}
-
-fn dot<T: Scalar>(a: &[T], b: &[T]) -> T {
-    a.iter().zip(b).fold(T::zero(), |acc, (x, y)| acc + *x * *y)
-}
-
-/// `θ = atan2(z_i·(x_i × x_j), x_i·x_j)` and `θ̇ = z_i·(ω_j − ω_i)`.
-pub fn angle_of<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>) -> (T, T) {
-    let xi: Vector3<T> = mi.frame.column(0).into();
-    let zi: Vector3<T> = mi.frame.column(2).into();
-    let xj: Vector3<T> = mj.frame.column(0).into();
-    let th = zi.dot(&xi.cross(&xj)).atan2(xi.dot(&xj));
-    (th, zi.dot(&(mj.w - mi.w)))
-}
-
-/// Block of a row for a marker: `(slot, [∂/∂ṙ, ∂/∂ω_global])`.
-fn block<T: Scalar>(mk: &MarkerKin<T>, dr: Vector3<T>, dw: Vector3<T>) -> (Option<usize>, [T; 6]) {
-    (mk.slot, [dr[0], dr[1], dr[2], dw[0], dw[1], dw[2]])
-}
-
-/// Component `k` of `x_i − x_j = 0`. Velocity: `ṙ + ω × s`, so the ω
-/// block is `e_kᵀ(−s̃) = (s × e_k)ᵀ`; `γ = −e_k·(a_i − a_j)` with the
-/// velocity-dependent accelerations [`MarkerKin::acc`]
-/// (`ω×(ω×s)` on rigid bodies).
-fn point_row<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, k: usize) -> Row<T> {
-    let mut e = Vector3::zeros();
-    e[k] = T::one();
-    Row {
-        phi: mi.x[k] - mj.x[k],
-        phidot: T::zero(),
-        gamma: -(mi.acc[k] - mj.acc[k]),
-        blocks: [block(mi, e, mi.s.cross(&e)), block(mj, -e, -mj.s.cross(&e))],
-        markers: [0, 0],
-        modal: [RIGID, RIGID],
-    }
-}
-
-/// `a·b = 0` with `a` fixed in body i and `b` in body j:
-/// `d/dt(a·b) = ω_i·(a×b) + ω_j·(b×a)`,
-/// `γ = −[b·(ω_i×(ω_i×a)) + 2(ω_i×a)·(ω_j×b) + a·(ω_j×(ω_j×b))
-///       + (α_i − α_j)·(a×b)]` (`α` = [`MarkerKin::alpha`]).
-fn dot_row<T: Scalar>(
-    mi: &MarkerKin<T>,
-    mj: &MarkerKin<T>,
-    a: &Vector3<T>,
-    b: &Vector3<T>,
-) -> Row<T> {
-    let axb = a.cross(b);
-    let wa = mi.w.cross(a);
-    let wb = mj.w.cross(b);
-    let quad = b.dot(&mi.w.cross(&wa))
-        + cst::<T>(2.0) * wa.dot(&wb)
-        + a.dot(&mj.w.cross(&wb))
-        + (mi.alpha - mj.alpha).dot(&axb);
-    Row {
-        phi: a.dot(b),
-        phidot: T::zero(),
-        gamma: -quad,
-        blocks: [
-            block(mi, Vector3::zeros(), axb),
-            block(mj, Vector3::zeros(), -axb),
-        ],
-        markers: [0, 0],
-        modal: [RIGID, RIGID],
-    }
-}
-
-/// Prescribed angle `θ − f(t) = 0` (wrapped to (−π, π]):
-/// `θ̇ = z_i·(ω_j − ω_i)`, `γ = f̈ − (ω_i×z_i)·(ω_j − ω_i) − z_i·(α_j − α_i)`,
-/// `ν = ḟ`.
-fn angle_row<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, drive: (f64, f64, f64)) -> Row<T> {
-    let (th, _) = angle_of(mi, mj);
-    let zi: Vector3<T> = mi.frame.column(2).into();
-    let mut d = th - cst::<T>(drive.0);
-    let pi = T::pi();
-    let two_pi = T::two_pi();
-    while d > pi {
-        d -= two_pi;
-    }
-    while d <= -pi {
-        d += two_pi;
-    }
-    Row {
-        phi: d,
-        // ν enters with a minus sign: phidot holds −ν until assembled.
-        phidot: cst::<T>(drive.1),
-        gamma: cst::<T>(drive.2)
-            - mi.w.cross(&zi).dot(&(mj.w - mi.w))
-            - zi.dot(&(mj.alpha - mi.alpha)),
-        blocks: [
-            block(mi, Vector3::zeros(), -zi),
-            block(mj, Vector3::zeros(), zi),
-        ],
-        markers: [0, 0],
-        modal: [RIGID, RIGID],
-    }
 }

@@ -57,8 +57,11 @@ pub mod flexdyn;
 pub mod linalg;
 pub mod model;
 pub mod responses;
+pub mod rows;
 pub mod scene;
+pub mod scene_parts;
 pub mod simulate;
+pub mod solve;
 
 pub use analysis::{Projection, Reaction};
 pub use dynamics::{System, Workspace};

@@ -1,0 +1,331 @@
+//! Pieces of the scene builder ([`super::scene`]): names to parameters
+//! and outputs, markers (snapped to flexible nodes), load tables and
+//! flexible bodies.
+
+use super::beam::Beam;
+use super::linalg::euler_from_rotation;
+use super::model::{Body, Flex, Force, Marker, Model, Param};
+use super::scene::{finite3, FlexSpec, ForceSpec, PanelBases, Quantity};
+use crate::error::{Error, Result};
+use nalgebra::{Matrix3, Vector3};
+
+/// A sensitivity parameter name → [`Param`], if it names an existing,
+/// built model value.
+/// Segment indices are those of the scene file; the model's law is sorted
+/// by `lower`, so they are translated through the segment bounds.
+pub(super) fn parse_param(
+    model: &Model,
+    forces: &[ForceSpec],
+    force_index: &[Option<usize>],
+    name: &str,
+) -> Option<Param> {
+    if let Some(body) = name.strip_suffix(".mass") {
+        let b = model.body(body)?;
+        return model.bodies[b].flex.is_none().then_some(Param::Mass(b));
+    }
+    if let Some((body, var)) = name.split_once(".design.") {
+        let b = model.body(body)?;
+        let flex = model.bodies[b].flex.as_ref()?;
+        let k = flex.basis.derivatives.iter().position(|d| d.name == var)?;
+        return Some(Param::Design(b, k));
+    }
+    let rest = name.strip_prefix("forces[")?;
+    let (idx, rest) = rest.split_once(']')?;
+    let k_spec = idx.parse::<usize>().ok()?;
+    let fi = (*force_index.get(k_spec)?)?;
+    let p = match rest {
+        ".stiffness" => Param::Stiffness(fi),
+        ".damping" => Param::Damping(fi),
+        _ => {
+            let seg: usize = rest
+                .strip_prefix(".segments[")?
+                .strip_suffix("].anchor")?
+                .parse()
+                .ok()?;
+            let ForceSpec::Actuator { segments, .. } = forces.get(k_spec)? else {
+                return None;
+            };
+            let spec = segments.get(seg)?;
+            let Force::Rotational { law: Some(law), .. } = &model.forces[fi] else {
+                return None;
+            };
+            let sorted = law
+                .segments
+                .iter()
+                .position(|s| s.lower == spec.lower && s.upper == spec.upper)?;
+            Param::Anchor(fi, sorted)
+        }
+    };
+    p.value(model).map(|_| p)
+}
+
+/// An output name → [`Quantity`]. Bodies named in `flex_names` have a
+/// `flexible` table: their modal outputs stay valid when the scene runs
+/// them rigid (no columns for `modal`, zero strain energy and deflection).
+pub(super) fn parse_quantity(
+    model: &Model,
+    flex_names: &[&str],
+    key: &str,
+    q: &str,
+) -> Result<Quantity> {
+    match q {
+        "energy" => return Ok(Quantity::Energy),
+        "violation" => return Ok(Quantity::Violation),
+        _ => {}
+    }
+    let bad = || {
+        Error::input(
+            key,
+            q,
+            "energy, violation, <joint>.angle|rate|reaction, <body>.position, \
+             <flexible body>.modal|strain_energy or <marker on a flexible node>.deflection",
+        )
+    };
+    let (name, what) = q.rsplit_once('.').ok_or_else(bad)?;
+    match what {
+        "angle" | "rate" | "reaction" => {
+            let j = model.joint(name).ok_or_else(bad)?;
+            if what != "reaction" && !model.joints[j].kind.has_angle() {
+                return Err(Error::input(
+                    key,
+                    q,
+                    "an angle or rate of a revolute, locked or driven joint",
+                ));
+            }
+            Ok(match what {
+                "angle" => Quantity::Angle(j),
+                "rate" => Quantity::Rate(j),
+                _ => Quantity::Reaction(j),
+            })
+        }
+        "position" => {
+            let b = model.body(name).ok_or_else(bad)?;
+            Ok(Quantity::Position(b))
+        }
+        "modal" | "strain_energy" => {
+            let b = model.body(name).ok_or_else(bad)?;
+            let n = match &model.bodies[b].flex {
+                Some(f) => f.n(),
+                None if flex_names.contains(&name) => 0,
+                None => return Err(bad()),
+            };
+            Ok(match what {
+                "modal" => Quantity::Modal(b, n),
+                _ => Quantity::Strain(b),
+            })
+        }
+        "deflection" => {
+            let m = model.marker(name).ok_or_else(bad)?;
+            let on_flex = model.markers[m]
+                .body
+                .is_some_and(|b| flex_names.contains(&model.bodies[b].name.as_str()));
+            if model.markers[m].node.is_none() && !on_flex {
+                return Err(bad());
+            }
+            Ok(Quantity::Deflection(m))
+        }
+        _ => Err(bad()),
+    }
+}
+
+/// A marker `(name, body)` at the global point `p` with global frame
+/// `frame`, expressed in the body's initial frame. On a flexible body the
+/// point must be a node of its basis (within 1e-6 of the body's size);
+/// `key` names the point in errors.
+pub(super) fn make_marker(
+    model: &Model,
+    key: &str,
+    named: (&str, Option<usize>),
+    p: Vector3<f64>,
+    frame: Matrix3<f64>,
+) -> Result<Marker> {
+    let (name, body) = named;
+    let Some(b) = body else {
+        return Ok(Marker {
+            name: name.to_string(),
+            body,
+            pos: p,
+            frame,
+            node: None,
+        });
+    };
+    let bd = &model.bodies[b];
+    let a0 = bd.orientation();
+    let local = a0.transpose() * (p - bd.r0);
+    let mut marker = Marker {
+        name: name.to_string(),
+        body,
+        pos: local,
+        frame: a0.transpose() * frame,
+        node: None,
+    };
+    if let Some(flex) = &bd.flex {
+        let (k, dist) = flex.basis.nearest_node(&local);
+        let size = flex
+            .basis
+            .nodes
+            .iter()
+            .fold(0.0f64, |m, s| m.max(s.norm()))
+            .max(1e-3);
+        if dist > 1e-6 * size {
+            return Err(Error::input(
+                key,
+                format!("{:?}", p.as_slice()),
+                format!(
+                    "a node of flexible body '{}' (nearest node {k} is {dist:.3e} m away)",
+                    bd.name
+                ),
+            ));
+        }
+        marker.pos = flex.basis.nodes[k];
+        marker.node = Some(k);
+    }
+    Ok(marker)
+}
+
+/// Validate a load table: rows `[t, fx, fy, fz, tx, ty, tz]`, finite,
+/// strictly increasing times.
+pub(super) fn load_table(key: &str, rows: &[[f64; 7]]) -> Result<Vec<(f64, [f64; 6])>> {
+    if rows.is_empty() {
+        return Err(Error::input(
+            key,
+            "[]",
+            "at least one row [t, fx, fy, fz, tx, ty, tz]",
+        ));
+    }
+    let mut out: Vec<(f64, [f64; 6])> = Vec::with_capacity(rows.len());
+    for (k, r) in rows.iter().enumerate() {
+        let increasing = out.last().is_none_or(|(t, _)| r[0] > *t);
+        if r.iter().any(|v| !v.is_finite()) || !increasing {
+            return Err(Error::input(
+                format!("{key}[{k}]"),
+                format!("{r:?}"),
+                "finite rows [t (s), fx, fy, fz (N), tx, ty, tz (N·m)] with increasing t",
+            ));
+        }
+        let mut v = [0.0; 6];
+        v.copy_from_slice(&r[1..]);
+        out.push((r[0], v));
+    }
+    Ok(out)
+}
+
+/// A flexible body from its `flexible` table: basis, invariants, frame
+/// placement.
+pub(super) fn flexible_body(
+    key: &str,
+    name: &str,
+    f: &FlexSpec,
+    damping: bool,
+    panels: PanelBases,
+) -> Result<Body> {
+    let fk = format!("{key}.flexible");
+    if f.modes == 0 {
+        return Err(Error::input(format!("{fk}.modes"), 0, "at least one mode"));
+    }
+    if !(f.damping.is_finite() && (0.0..1.0).contains(&f.damping)) {
+        return Err(Error::input(
+            format!("{fk}.damping"),
+            f.damping,
+            "a modal damping ratio in [0, 1)",
+        ));
+    }
+    let basis = match f.kind.as_str() {
+        "beam" => {
+            let get = |what: &str, v: Option<f64>| {
+                v.ok_or_else(|| {
+                    Error::input(format!("{fk}.{what}"), "(missing)", "a beam property")
+                })
+            };
+            let beam = Beam {
+                length: get("length", f.length)?,
+                ei_y: get("ei_y", f.ei_y)?,
+                ei_z: get("ei_z", f.ei_z)?,
+                rho_a: get("rho_a", f.rho_a)?,
+            };
+            beam.validate(&fk)?;
+            let rho_ip = f.rho_ip.unwrap_or(0.0);
+            if !(rho_ip.is_finite() && rho_ip > 0.0) {
+                return Err(Error::input(
+                    format!("{fk}.rho_ip"),
+                    rho_ip,
+                    "a polar mass moment per length > 0 (kg·m): the frame needs a rotary inertia about the beam axis",
+                ));
+            }
+            let mut b = beam
+                .basis(f.modes, Beam::segments_for(f.modes))?
+                .truncated(f.modes);
+            // Rotary inertia about the beam axis, lumped like the mass.
+            for (k, m) in b.node_mass.iter().enumerate() {
+                b.node_inertia[k].x = rho_ip * m / beam.rho_a;
+            }
+            b
+        }
+        "panel" => {
+            let panel = f.panel.as_deref().ok_or_else(|| {
+                Error::input(
+                    format!("{fk}.panel"),
+                    "(missing)",
+                    "the name of a [[panels]] entry",
+                )
+            })?;
+            if let Some(d) = f.derivatives.as_deref() {
+                if d != "fixed" && d != "updated" {
+                    return Err(Error::input(
+                        format!("{fk}.derivatives"),
+                        d,
+                        "fixed (Eq. 19) or updated (Eq. 18)",
+                    ));
+                }
+            }
+            panels(panel, f.modes, f.derivatives.as_deref())?
+        }
+        other => {
+            return Err(Error::input(format!("{fk}.kind"), other, "beam or panel"));
+        }
+    };
+    basis.validate(&fk)?;
+    let origin = finite3(format!("{fk}.origin"), f.origin)?;
+    let x = finite3(format!("{fk}.x_axis"), f.x_axis)?;
+    let y = finite3(format!("{fk}.y_axis"), f.y_axis)?;
+    if x.norm() < 1e-12
+        || (y - x * (x.dot(&y) / x.norm_squared())).norm() < 1e-9 * y.norm().max(1e-300)
+    {
+        return Err(Error::input(
+            format!("{fk}.y_axis"),
+            format!("{:?} with x_axis {:?}", f.y_axis, f.x_axis),
+            "non-zero, non-parallel x and y axis directions",
+        ));
+    }
+    let ex = x.normalize();
+    let ey = (y - ex * ex.dot(&y)).normalize();
+    let a0 = Matrix3::from_columns(&[ex, ey, ex.cross(&ey)]);
+    let design = vec![0.0; basis.derivatives.len()];
+    let flex = Flex::new(basis, if damping { f.damping } else { 0.0 }, design);
+    let inv = &flex.inv;
+    let c = inv.s0 / inv.mass;
+    // Inertia about the centre of mass (frame axes), for reports.
+    let j_o = Matrix3::identity() * inv.e0.trace() - inv.e0 + inv.j_rot;
+    let j_c = j_o - (Matrix3::identity() * c.norm_squared() - c * c.transpose()) * inv.mass;
+    let inv_inertia = j_c.try_inverse().unwrap_or_else(Matrix3::zeros);
+    Ok(Body {
+        name: name.to_string(),
+        mass: inv.mass,
+        inertia: j_c,
+        inv_inertia,
+        r0: origin,
+        p0: euler_from_rotation(&a0),
+        v0: Vector3::zeros(),
+        w0: Vector3::zeros(),
+        fixed: false,
+        flex: Some(flex),
+    })
+}
+
+pub(super) fn initial_distance(model: &Model, i: usize, j: usize) -> f64 {
+    let g = |m: &Marker| match m.body {
+        Some(b) => model.bodies[b].r0 + model.bodies[b].orientation() * m.pos,
+        None => m.pos,
+    };
+    (g(&model.markers[j]) - g(&model.markers[i])).norm()
+}
