@@ -22,8 +22,11 @@
 //! shift level and are counted ([`RANK_TOL`]); their multipliers take the
 //! minimum-norm split, and the accelerations, which do not depend on that
 //! split, stay unique. One factorization per evaluation (plus one small
-//! Cholesky per flexible body); the dual-number evaluation differentiates
-//! the same factorizations (no finite differences).
+//! Cholesky per flexible body). A dual-number evaluation factors only the
+//! real parts and differentiates each solve analytically with that same
+//! factor, `x' = A⁻¹(b' − A'x)` ([`Scalar::spd_solve`],
+//! [`Scalar::dense_solve`]): no dual arithmetic inside the factorizations,
+//! no finite differences.
 //!
 //! Markers on nodes of flexible bodies move with the modes
 //! (`x = r + A(s_k + Φ_k w)`) and rotate with them (frame
@@ -37,7 +40,7 @@
 
 use super::flexdyn::{flex_terms, FlexEffects, FlexState, InvT};
 use super::linalg::{
-    cst, dense_cholesky, euler_rate, rotation, rotation_tangent, rotation_vector, Scalar,
+    cst, euler_rate, rotation, rotation_tangent, rotation_vector, Scalar, SpdScratch,
 };
 use super::model::{Force, JointKind, Model, Param};
 pub use super::rows::angle_of;
@@ -96,8 +99,7 @@ pub struct Workspace<T: Scalar> {
     pub mjac: Vec<T>,
     /// Position of each row in the fill-reducing order.
     pub(crate) inv_order: Vec<usize>,
-    pub(crate) col: Vec<T>,
-    pub(crate) nz: Vec<usize>,
+    pub(crate) spd: SpdScratch,
     /// Applied generalized forces, all bodies (velocity layout).
     pub q: Vec<T>,
     /// Per moving body: the Cholesky factor of a flexible body's mass
@@ -639,7 +641,7 @@ impl System {
             }
             // A non-positive pivot leaves a NaN in the factor, which the
             // integrator reports with the time.
-            if !dense_cholesky(&mut mass, d) {
+            if !T::dense_factor(&mut mass, d) {
                 mass[0] = cst::<T>(f64::NAN);
             }
             ws.mfac[s] = mass;

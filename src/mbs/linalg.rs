@@ -14,8 +14,56 @@ use nalgebra::{Matrix3, RealField, Vector3};
 /// `is_exact_zero` is true only when every component is exactly zero: the
 /// factorization skips structural zeros of sparse matrices by value without
 /// ever dropping a derivative.
+///
+/// The two symmetric positive definite solves of a right-hand side (the
+/// constraint-space matrix and the dense mass of a flexible body) go
+/// through this trait so that a dual-number evaluation differentiates them
+/// analytically, reusing one real factorization, instead of running the
+/// factorization in dual arithmetic (NUMERICS.md): for `A x = b`,
+/// `x' = A⁻¹(b' − A' x)` with the factor of the real part of `A`.
 pub trait Scalar: RealField + Copy {
     fn is_exact_zero(&self) -> bool;
+
+    /// Factor the constraint-space matrix `a` (lower triangle, row-major
+    /// `m × m`) in place as [`ordered_cholesky`] does; for dual numbers
+    /// the real parts receive the factor of the real matrix and the dual
+    /// parts keep `A' + reg·diag(A')` for [`Scalar::spd_solve`].
+    fn spd_factor(
+        a: &mut [Self],
+        m: usize,
+        scale: &mut Vec<Self>,
+        tols: (f64, f64),
+        scratch: &mut SpdScratch,
+    ) -> Factored;
+
+    /// Solve with the factor of [`Scalar::spd_factor`] (`b` overwritten).
+    fn spd_solve(
+        a: &[Self],
+        m: usize,
+        scale: &[Self],
+        f: Factored,
+        b: &mut [Self],
+        scratch: &mut SpdScratch,
+    );
+
+    /// Factor a dense SPD matrix (row-major `n × n`, both triangles) in
+    /// place for [`Scalar::dense_solve`]; `false` at a non-positive pivot.
+    fn dense_factor(a: &mut [Self], n: usize) -> bool;
+
+    /// Solve with the factor of [`Scalar::dense_factor`] (`x` overwritten).
+    fn dense_solve(a: &[Self], n: usize, x: &mut [Self]);
+}
+
+/// Real scratch storage of [`Scalar::spd_factor`] / [`Scalar::spd_solve`].
+#[derive(Debug, Clone, Default)]
+pub struct SpdScratch {
+    col: Vec<f64>,
+    nz: Vec<usize>,
+    scale: Vec<f64>,
+    re: Vec<f64>,
+    x: Vec<f64>,
+    r: Vec<f64>,
+    tmp: Vec<f64>,
 }
 
 impl Scalar for f64 {
@@ -23,12 +71,145 @@ impl Scalar for f64 {
     fn is_exact_zero(&self) -> bool {
         *self == 0.0
     }
+    fn spd_factor(
+        a: &mut [f64],
+        m: usize,
+        scale: &mut Vec<f64>,
+        tols: (f64, f64),
+        sc: &mut SpdScratch,
+    ) -> Factored {
+        ordered_cholesky(a, m, scale, tols, &mut sc.col, &mut sc.nz)
+    }
+    fn spd_solve(
+        a: &[f64],
+        m: usize,
+        scale: &[f64],
+        f: Factored,
+        b: &mut [f64],
+        sc: &mut SpdScratch,
+    ) {
+        cholesky_solve(a, m, scale, f.accepted, b, &mut sc.tmp);
+    }
+    fn dense_factor(a: &mut [f64], n: usize) -> bool {
+        dense_cholesky(a, n)
+    }
+    fn dense_solve(a: &[f64], n: usize, x: &mut [f64]) {
+        dense_cholesky_solve(a, n, x);
+    }
 }
 
 impl Scalar for num_dual::Dual64 {
     #[inline]
     fn is_exact_zero(&self) -> bool {
         self.re == 0.0 && self.eps == 0.0
+    }
+    fn spd_factor(
+        a: &mut [Self],
+        m: usize,
+        scale: &mut Vec<Self>,
+        tols: (f64, f64),
+        sc: &mut SpdScratch,
+    ) -> Factored {
+        sc.re.clear();
+        sc.re.extend(a.iter().map(|v| v.re));
+        let f = ordered_cholesky(&mut sc.re, m, &mut sc.scale, tols, &mut sc.col, &mut sc.nz);
+        for k in 0..m {
+            // The regularised system is (A + reg·diag(A)) x = b.
+            a[k * m + k].eps *= 1.0 + tols.1;
+        }
+        for (v, r) in a.iter_mut().zip(&sc.re) {
+            v.re = *r;
+        }
+        scale.clear();
+        scale.extend(sc.scale.iter().map(|&v| Self::from(v)));
+        f
+    }
+    fn spd_solve(
+        a: &[Self],
+        m: usize,
+        _scale: &[Self],
+        f: Factored,
+        b: &mut [Self],
+        sc: &mut SpdScratch,
+    ) {
+        // `sc.re` and `sc.scale` hold the real factor of the preceding
+        // `spd_factor` of `a`.
+        debug_assert_eq!(sc.re.len(), a.len());
+        sc.x.clear();
+        sc.x.extend(b.iter().map(|v| v.re));
+        cholesky_solve(&sc.re, m, &sc.scale, f.accepted, &mut sc.x, &mut sc.tmp);
+        // r = b' − A' x (A' symmetric, lower triangle stored).
+        sc.r.clear();
+        sc.r.extend(b.iter().map(|v| v.eps));
+        for i in 0..m {
+            for j in 0..=i {
+                let e = a[i * m + j].eps;
+                if e != 0.0 {
+                    sc.r[i] -= e * sc.x[j];
+                    if i != j {
+                        sc.r[j] -= e * sc.x[i];
+                    }
+                }
+            }
+        }
+        cholesky_solve(&sc.re, m, &sc.scale, f.accepted, &mut sc.r, &mut sc.tmp);
+        for (v, (x, r)) in b.iter_mut().zip(sc.x.iter().zip(&sc.r)) {
+            *v = Self::new(*x, *r);
+        }
+    }
+    fn dense_factor(a: &mut [Self], n: usize) -> bool {
+        let mut re: Vec<f64> = a.iter().map(|v| v.re).collect();
+        let ok = dense_cholesky(&mut re, n);
+        for (v, r) in a.iter_mut().zip(&re) {
+            v.re = *r;
+        }
+        ok
+    }
+    fn dense_solve(a: &[Self], n: usize, x: &mut [Self]) {
+        // L Lᵀ x = b on the real parts of `a` (no copies; stack buffers
+        // for the flexible bodies' 6 + modes ≤ 64 unknowns).
+        let solve = |b: &mut [f64]| {
+            for k in 0..n {
+                let mut s = b[k];
+                for j in 0..k {
+                    s -= a[k * n + j].re * b[j];
+                }
+                b[k] = s / a[k * n + k].re;
+            }
+            for k in (0..n).rev() {
+                let mut s = b[k];
+                for r in k + 1..n {
+                    s -= a[r * n + k].re * b[r];
+                }
+                b[k] = s / a[k * n + k].re;
+            }
+        };
+        let (mut xs, mut rs) = ([0.0f64; 64], [0.0f64; 64]);
+        let (mut xv, mut rv) = (Vec::new(), Vec::new());
+        let (xr, r): (&mut [f64], &mut [f64]) = if n <= 64 {
+            (&mut xs[..n], &mut rs[..n])
+        } else {
+            xv.resize(n, 0.0);
+            rv.resize(n, 0.0);
+            (&mut xv[..], &mut rv[..])
+        };
+        for k in 0..n {
+            xr[k] = x[k].re;
+        }
+        solve(xr);
+        for i in 0..n {
+            let row = &a[i * n..(i + 1) * n];
+            r[i] = x[i].eps
+                - row
+                    .iter()
+                    .zip(xr.iter())
+                    .map(|(e, v)| e.eps * v)
+                    .sum::<f64>();
+        }
+        solve(r);
+        for k in 0..n {
+            x[k] = Self::new(xr[k], r[k]);
+        }
     }
 }
 

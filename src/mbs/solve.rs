@@ -3,9 +3,7 @@
 //! the method in [`super::dynamics`]).
 
 use super::dynamics::{pval, System, Workspace, RANK_REG, RANK_TOL, RIGID};
-use super::linalg::{
-    cholesky_solve, cst, dense_cholesky_solve, min_degree_order, ordered_cholesky, Scalar,
-};
+use super::linalg::{cst, min_degree_order, Scalar};
 use super::model::Param;
 use nalgebra::Vector3;
 
@@ -19,7 +17,7 @@ impl System {
         x: &mut [T],
     ) {
         if self.modes[s] > 0 {
-            dense_cholesky_solve(&ws_mfac[s], self.dof(s), x);
+            T::dense_solve(&ws_mfac[s], self.dof(s), x);
             return;
         }
         let b = self.moving[s];
@@ -118,13 +116,12 @@ impl System {
             ws.a[p * m + p] = T::one();
             ws.rhs[r] = T::zero();
         }
-        let f = ordered_cholesky(
+        let f = T::spd_factor(
             &mut ws.a,
             m,
             &mut ws.scale,
             (RANK_TOL, RANK_REG),
-            &mut ws.col,
-            &mut ws.nz,
+            &mut ws.spd,
         );
         ws.rank = f.rank - ndrop;
         let mut lam = std::mem::take(&mut ws.rhs);
@@ -134,7 +131,7 @@ impl System {
             ws.tmp[inv[r]] = lam[r];
         }
         std::mem::swap(&mut lam, &mut ws.tmp);
-        cholesky_solve(&ws.a, m, &ws.scale, f.accepted, &mut lam, &mut ws.tmp);
+        T::spd_solve(&ws.a, m, &ws.scale, f, &mut lam, &mut ws.spd);
         ws.tmp.clear();
         ws.tmp.extend((0..m).map(|r| lam[inv[r]]));
         std::mem::swap(&mut lam, &mut ws.tmp);
