@@ -439,27 +439,8 @@ impl SceneProblem {
     /// Simulate at `x` and return the named responses (gradients per
     /// degree of each variable when asked).
     fn raw(&self, x: &[f64], names: &[String], gradients: bool) -> Result<Raw> {
-        let design = || {
-            let parts: Vec<String> = self
-                .vars
-                .iter()
-                .zip(x)
-                .map(|(v, x)| format!("{} = {x}", v.name))
-                .collect();
-            parts.join(", ")
-        };
-        let at = |e: Error| match e {
-            Error::Numerical {
-                place,
-                time,
-                detail,
-            } => Error::Numerical {
-                place: format!("scene problem at [{}]: {place}", design()),
-                time,
-                detail,
-            },
-            e => e,
-        };
+        let design = || design_label(&self.vars, x);
+        let at = |e: Error| at_design(e, &self.vars, x);
         let study = self.study_at(x, gradients)?;
         let scene = load_scene(&study).map_err(at)?;
         let sim = simulate(&scene).map_err(at)?.1;
@@ -500,6 +481,33 @@ impl SceneProblem {
             values,
             gradients: gradients.then_some(grads),
         })
+    }
+}
+
+/// `theta1_deg = 55, theta2_deg = -55`.
+fn design_label(vars: &[Variable], x: &[f64]) -> String {
+    let parts: Vec<String> = vars
+        .iter()
+        .zip(x)
+        .map(|(v, x)| format!("{} = {x}", v.name))
+        .collect();
+    parts.join(", ")
+}
+
+/// A numerical failure of the scene, with the design in its place; other
+/// errors unchanged.
+fn at_design(e: Error, vars: &[Variable], x: &[f64]) -> Error {
+    match e {
+        Error::Numerical {
+            place,
+            time,
+            detail,
+        } => Error::Numerical {
+            place: format!("scene problem at [{}]: {place}", design_label(vars, x)),
+            time,
+            detail,
+        },
+        e => e,
     }
 }
 
@@ -564,5 +572,32 @@ impl Problem for SceneProblem {
     }
     fn name(&self) -> &str {
         "scene"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numerical_failures_carry_the_design() {
+        let vars = vec![
+            Variable::periodic("theta1_deg", -90.0, 180.0).unwrap(),
+            Variable::periodic("theta2_deg", -90.0, 180.0).unwrap(),
+        ];
+        let e = at_design(
+            Error::numerical_at("integrate: bdf", 0.026, "step size underflow"),
+            &vars,
+            &[55.0, -55.0],
+        );
+        let s = e.to_string();
+        assert!(matches!(e, Error::Numerical { time: Some(t), .. } if t == 0.026));
+        assert!(
+            s.contains("scene problem at [theta1_deg = 55, theta2_deg = -55]: integrate: bdf")
+                && s.contains("step size underflow"),
+            "{s}"
+        );
+        let e = at_design(Error::input("k", 1, "2"), &vars, &[0.0, 0.0]);
+        assert!(matches!(e, Error::Input { .. }));
     }
 }
