@@ -243,7 +243,7 @@ fn run_map_handler(cfg: &RunConfig) -> Result<()> {
 }
 
 /// Sections that hold data other sections use; they do no work themselves.
-const DATA_SECTIONS: &[&str] = &["problem", "panels", "convergence"];
+const DATA_SECTIONS: &[&str] = &["problem", "panels", "convergence", "scene_problem"];
 
 /// A kind of work a study can ask for: the top-level section that asks for
 /// it, and the function that does it.

@@ -16,7 +16,8 @@
 //! continues a stopped multistart and `--shard i/n` splits one over
 //! machines, with `plyscape merge` putting the pieces back together.
 //!
-//! Study sections read here: `[problem]` ([`problems::ProblemSpec`]),
+//! Study sections read here: `[problem]` ([`problems::ProblemSpec`]; with
+//! `name = "scene"` also `[scene_problem]`, [`scene_problem`]),
 //! `[multistart]` ([`MultistartSection`]), `[evolve]` ([`EvolveSection`]),
 //! `[compare]` (no keys), `[map]` ([`MapSection`]) and `[scaling]`
 //! ([`scaling::ScalingSection`]).
@@ -28,6 +29,7 @@ pub mod multistart;
 pub mod problems;
 pub mod sampling;
 pub mod scaling;
+pub mod scene_problem;
 pub mod solvers;
 pub mod tables;
 
@@ -206,6 +208,17 @@ impl Context<'_> {
 pub fn problem(study: &Study) -> Result<Box<dyn Problem>> {
     let spec: problems::ProblemSpec =
         study.require_section("problem", "the problem to explore (name = ...)")?;
+    if spec.name == "scene" {
+        // The study's own scene (`[scene_problem]`, scene_problem.rs).
+        if spec.dimension.is_some() || spec.bounds.is_some() || spec.cost_ms != 0.0 {
+            return Err(study.error(
+                "problem",
+                "(table)",
+                "only `name = \"scene\"`: variables and bounds are in [scene_problem]",
+            ));
+        }
+        return Ok(Box::new(scene_problem::SceneProblem::from_study(study)?));
+    }
     spec.build().map_err(study.locate("problem"))
 }
 

@@ -50,7 +50,7 @@ fn default_cost_mode() -> String {
 
 /// Names accepted by [`ProblemSpec::build`].
 pub const PROBLEM_NAMES: &str =
-    "himmelblau, rosenbrock, rastrigin, hs21, hs22, hs35, hs43, hs76, hs100, disc, seam, periodic2";
+    "himmelblau, rosenbrock, rastrigin, hs21, hs22, hs35, hs43, hs76, hs100, disc, seam, periodic2, scene (with [scene_problem])";
 
 impl ProblemSpec {
     /// Build the named problem (wrapped in [`Costly`] when `cost_ms > 0`).
@@ -99,6 +99,13 @@ impl ProblemSpec {
             "seam" => Box::new(tp::seam()),
             "hs22" => Box::new(Hs22::new()),
             "periodic2" => Box::new(Periodic2::new()),
+            "scene" => {
+                return Err(Error::input(
+                    "name",
+                    "\"scene\"",
+                    "a study: build scene problems with explore::problem(study)",
+                ))
+            }
             other => {
                 return Err(Error::input(
                     "name",

@@ -1,0 +1,603 @@
+//! A study's multibody scene as an optimization [`Problem`]: the paper's
+//! ply-angle optimization of the SAR antenna (Neto, Ambrósio, Leal §4–§6,
+//! Eqs. 29–34, Table 4).
+//!
+//! A study selects it with `[problem] name = "scene"` and describes it in
+//! the sibling section `[scene_problem]` (a sibling rather than
+//! `[problem.scene]`, so that the analytic `[problem]` keys stay one flat,
+//! strictly checked table):
+//!
+//! ```toml
+//! [problem]
+//! name = "scene"
+//!
+//! [scene_problem]
+//! start = [55.0, -55.0]                  # degrees, one per variable (Table 4)
+//!
+//! [[scene_problem.variables]]
+//! name = "theta1_deg"
+//! bounds = [-90.0, 90.0]                 # degrees
+//! periodic = true                        # then upper - lower = 180°
+//! sets = ["panel2:theta_1_4", "panel3:theta_1_4"]   # [[panels]] name : design variable
+//!
+//! [scene_problem.objective]
+//! response = "psi0"                      # a [[scene.responses]] name
+//! normalize_at = [55.0, -55.0]           # optional: f = value / value at this design
+//!
+//! [[scene_problem.constraints]]
+//! response = "u3_peak"
+//! upper_relative = 1.0                   # c = 1.0 × value at `start` (or `upper = c`, absolute)
+//! ```
+//!
+//! Each problem variable is a ply angle in degrees written into every
+//! listed `[[panels]]` design variable (all plies of its group, e.g. plies
+//! 1 and 4 of `theta_1_4`); tying one variable to both panels is the
+//! paper's shared θ1/θ2. The objective is `f = R₀(x) / R₀(x_ref)` (or
+//! `R₀(x)` without `normalize_at`), each constraint
+//! `g_j = R_j(x) / c_j − 1 <= 0` (Eq. 34 with `c_j` the bound).
+//!
+//! Evaluation: the study's TOML is copied, the ply angles rewritten, the
+//! scene loaded (panel modal bases rebuilt for the new lay-up) and
+//! simulated. Gradients come from the scene's forward sensitivities
+//! (exact, `crate::mbs::responses`): with gradients asked, the scene runs
+//! with exactly the lanes `<body>.design.<variable>` of the bodies built
+//! from the tied panels (each must appear in `[scene] sensitivities`, so
+//! that the study file shows what is differentiated); without, with none.
+//! A variable's derivative is the sum over its lanes, times π/180 (the
+//! scene's lanes are per radian, the variables in degrees). The output
+//! columns of `[scene.outputs]` are dropped (responses need none). Nothing
+//! is shared between evaluations, so drivers may evaluate in parallel.
+//!
+//! Ply angles repeat every 180° (NUMERICS.md): a periodic variable is
+//! written as given, and `x` and `x + 180°` give the same laminate up to
+//! the rounding of the rotation's sines and cosines.
+
+use crate::error::{Error, Result};
+use crate::mbs::responses::ResponseValue;
+use crate::mbs::scene::SceneSpec;
+use crate::mbs::simulate::{load_scene, simulate};
+use crate::optimize::{Evaluation, Problem, Variable};
+use crate::study::Study;
+use serde::Deserialize;
+
+/// The `[scene_problem]` section.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneProblemSpec {
+    /// The design variables.
+    pub variables: Vec<VariableSpec>,
+    /// Start design \[deg\], one value per variable (reference of the
+    /// relative constraint bounds).
+    pub start: Vec<f64>,
+    /// The objective.
+    pub objective: ObjectiveSpec,
+    /// Upper-bound constraints on responses.
+    #[serde(default)]
+    pub constraints: Vec<ConstraintSpec>,
+}
+
+/// One `[[scene_problem.variables]]` entry.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VariableSpec {
+    /// Name in reports (e.g. `theta1_deg`).
+    pub name: String,
+    /// `[lower, upper]` \[deg\].
+    pub bounds: [f64; 2],
+    /// Periodic ply angle (`upper − lower` must be 180°).
+    #[serde(default)]
+    pub periodic: bool,
+    /// `"<panel>:<design variable>"` entries this variable sets, e.g.
+    /// `"panel3:theta_1_4"`.
+    pub sets: Vec<String>,
+}
+
+/// `[scene_problem.objective]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectiveSpec {
+    /// A `[[scene.responses]]` name.
+    pub response: String,
+    /// Divide by the response's value at this design \[deg\].
+    pub normalize_at: Option<Vec<f64>>,
+}
+
+/// One `[[scene_problem.constraints]]` entry: `R / c − 1 <= 0` with
+/// either `c = upper` or `c = upper_relative · R(start)`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstraintSpec {
+    /// A `[[scene.responses]]` name.
+    pub response: String,
+    /// Absolute bound `c > 0` (response units).
+    pub upper: Option<f64>,
+    /// Bound as a factor of the response at the start design.
+    pub upper_relative: Option<f64>,
+}
+
+/// Where one problem variable writes: a `[[panels]]` entry and the
+/// 0-based plies of one of its design variables.
+#[derive(Debug, Clone)]
+struct PlyTarget {
+    panel: usize,
+    plies: Vec<usize>,
+}
+
+/// A scene response as an optimization problem (see the module doc).
+pub struct SceneProblem {
+    vars: Vec<Variable>,
+    /// Study with `[scene.outputs]` removed; ply angles rewritten per call.
+    base: Study,
+    /// Per variable: the plies it sets.
+    targets: Vec<Vec<PlyTarget>>,
+    /// All sensitivity lanes, in the order they are passed to the scene.
+    lanes: Vec<String>,
+    /// Per variable: indices into `lanes`.
+    lanes_of: Vec<Vec<usize>>,
+    /// Objective response and divisor.
+    objective: (String, f64),
+    /// Constraint responses and bounds `c`.
+    constraints: Vec<(String, f64)>,
+    start: Vec<f64>,
+}
+
+/// Raw response values (and their gradients per degree of each variable).
+struct Raw {
+    values: Vec<f64>,
+    gradients: Option<Vec<Vec<f64>>>,
+}
+
+impl SceneProblem {
+    /// Build from a study with `[scene]`, `[[panels]]` and
+    /// `[scene_problem]`; evaluates the start design (and the
+    /// normalization design) once. Errors name the file and key.
+    pub fn from_study(study: &Study) -> Result<SceneProblem> {
+        let spec: SceneProblemSpec = study.require_section(
+            "scene_problem",
+            "the scene problem (variables, start, objective)",
+        )?;
+        let scene: SceneSpec = study.require_section("scene", "the multibody scene")?;
+        let panels = crate::fe::panels_from_study(study)?;
+        let err = |key: String, value: &dyn std::fmt::Display, exp: String| {
+            study.error(format!("scene_problem.{key}"), value, exp)
+        };
+        if spec.variables.is_empty() {
+            return Err(err(
+                "variables".into(),
+                &"[]",
+                "at least one variable".into(),
+            ));
+        }
+        let mut vars = Vec::new();
+        let mut targets = Vec::new();
+        let mut lanes: Vec<String> = Vec::new();
+        let mut lanes_of = Vec::new();
+        let mut used: Vec<(usize, usize)> = Vec::new();
+        for (i, v) in spec.variables.iter().enumerate() {
+            let key = format!("variables[{i}]");
+            let [lo, hi] = v.bounds;
+            let var = if v.periodic {
+                if !(lo.is_finite() && hi - lo == 180.0) {
+                    return Err(err(
+                        format!("{key}.bounds"),
+                        &format!("[{lo}, {hi}]"),
+                        "finite bounds 180° apart (ply angles repeat every 180°)".into(),
+                    ));
+                }
+                Variable::periodic(v.name.clone(), lo, 180.0)
+            } else {
+                Variable::bounded(v.name.clone(), lo, hi)
+            }
+            .map_err(|e| e.in_file(&study.path, &format!("scene_problem.{key}")))?;
+            vars.push(var);
+            if v.sets.is_empty() {
+                return Err(err(
+                    format!("{key}.sets"),
+                    &"[]",
+                    "at least one \"<panel>:<design variable>\"".into(),
+                ));
+            }
+            let (mut t, mut l) = (Vec::new(), Vec::new());
+            for (k, entry) in v.sets.iter().enumerate() {
+                let key = format!("{key}.sets[{k}]");
+                let (pname, dname) = entry.split_once(':').ok_or_else(|| {
+                    err(
+                        key.clone(),
+                        &format!("\"{entry}\""),
+                        "\"<panel>:<design variable>\", e.g. \"panel3:theta_1_4\"".into(),
+                    )
+                })?;
+                let Some(p) = panels.iter().position(|p| p.name == pname) else {
+                    let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
+                    return Err(err(
+                        key,
+                        &format!("\"{entry}\""),
+                        format!("a [[panels]] name before ':' ({})", names.join(", ")),
+                    ));
+                };
+                let names = design_names(&panels[p].design);
+                let Some(d) = names.iter().position(|n| n == dname) else {
+                    return Err(err(
+                        key,
+                        &format!("\"{entry}\""),
+                        format!(
+                            "a design variable of panel {pname} after ':' ({})",
+                            names.join(", ")
+                        ),
+                    ));
+                };
+                if used.contains(&(p, d)) {
+                    return Err(err(
+                        key,
+                        &format!("\"{entry}\""),
+                        "each panel design variable set by one problem variable".into(),
+                    ));
+                }
+                used.push((p, d));
+                t.push(PlyTarget {
+                    panel: p,
+                    plies: panels[p].design.groups()[d].clone(),
+                });
+                let bodies: Vec<&str> = scene
+                    .bodies
+                    .iter()
+                    .filter(|b| {
+                        b.flexible
+                            .as_ref()
+                            .is_some_and(|f| f.kind == "panel" && f.panel.as_deref() == Some(pname))
+                    })
+                    .map(|b| b.name.as_str())
+                    .collect();
+                if bodies.is_empty() {
+                    return Err(err(
+                        key,
+                        &format!("\"{entry}\""),
+                        format!("a panel of a flexible scene body (no [[scene.bodies]] uses panel {pname})"),
+                    ));
+                }
+                for b in bodies {
+                    let lane = format!("{b}.design.{dname}");
+                    if !scene.sensitivities.contains(&lane) {
+                        return Err(study.error(
+                            "scene.sensitivities",
+                            format!("{:?}", scene.sensitivities),
+                            format!(
+                                "a list containing \"{lane}\" (the gradient of scene_problem.{key})"
+                            ),
+                        ));
+                    }
+                    l.push(lanes.len());
+                    lanes.push(lane);
+                }
+            }
+            targets.push(t);
+            lanes_of.push(l);
+        }
+        let names: Vec<&str> = scene.responses.iter().map(|r| r.name.as_str()).collect();
+        let check_response = |key: String, r: &str| {
+            if names.contains(&r) {
+                Ok(())
+            } else {
+                Err(err(
+                    key,
+                    &format!("\"{r}\""),
+                    format!("a [[scene.responses]] name ({})", names.join(", ")),
+                ))
+            }
+        };
+        check_response("objective.response".into(), &spec.objective.response)?;
+        let check_design = |key: &str, x: &[f64]| -> Result<()> {
+            if x.len() != vars.len()
+                || x.iter()
+                    .zip(&vars)
+                    .any(|(&x, v)| !x.is_finite() || (v.period.is_none() && v.wrap(x) != x))
+            {
+                return Err(err(
+                    key.into(),
+                    &format!("{x:?}"),
+                    format!("{} finite angles [deg] within the bounds", vars.len()),
+                ));
+            }
+            Ok(())
+        };
+        check_design("start", &spec.start)?;
+        if let Some(r) = &spec.objective.normalize_at {
+            check_design("objective.normalize_at", r)?;
+        }
+        for (j, c) in spec.constraints.iter().enumerate() {
+            let key = format!("constraints[{j}]");
+            check_response(format!("{key}.response"), &c.response)?;
+            let (v, k) = match (c.upper, c.upper_relative) {
+                (Some(u), None) => (u, "upper"),
+                (None, Some(u)) => (u, "upper_relative"),
+                _ => {
+                    return Err(err(
+                        key,
+                        &"(table)",
+                        "exactly one of `upper` (absolute) and `upper_relative` (factor of the start value)".into(),
+                    ))
+                }
+            };
+            if !(v.is_finite() && v > 0.0) {
+                return Err(err(format!("{key}.{k}"), &v, "a finite bound > 0".into()));
+            }
+        }
+        let mut base = study.clone();
+        if let Some(toml::Value::Table(s)) = base.table.get_mut("scene") {
+            s.remove("outputs");
+        }
+        let mut problem = SceneProblem {
+            vars,
+            base,
+            targets,
+            lanes,
+            lanes_of,
+            objective: (spec.objective.response.clone(), 1.0),
+            constraints: Vec::new(),
+            start: spec.start.clone(),
+        };
+        // Reference values: the start design (and the normalization one).
+        let mut wanted = vec![spec.objective.response.clone()];
+        wanted.extend(spec.constraints.iter().map(|c| c.response.clone()));
+        let at_start = problem.raw(&spec.start, &wanted, false)?;
+        for (j, c) in spec.constraints.iter().enumerate() {
+            let bound = match c.upper {
+                Some(u) => u,
+                None => c.upper_relative.unwrap_or(1.0) * at_start.values[j + 1],
+            };
+            if !(bound.is_finite() && bound > 0.0) {
+                return Err(err(
+                    format!("constraints[{j}].upper_relative"),
+                    &c.upper_relative.unwrap_or(1.0),
+                    format!(
+                        "a bound > 0: {} at the start design is {bound:e}, so the constraint is degenerate",
+                        c.response
+                    ),
+                ));
+            }
+            problem.constraints.push((c.response.clone(), bound));
+        }
+        if let Some(r) = &spec.objective.normalize_at {
+            let v = if *r == spec.start {
+                at_start.values[0]
+            } else {
+                problem.raw(r, &wanted[..1], false)?.values[0]
+            };
+            if !(v.is_finite() && v != 0.0) {
+                return Err(err(
+                    "objective.normalize_at".into(),
+                    &format!("{r:?}"),
+                    format!(
+                        "a design where {} is not zero (it is {v:e})",
+                        spec.objective.response
+                    ),
+                ));
+            }
+            problem.objective.1 = v;
+        }
+        Ok(problem)
+    }
+
+    /// The start design \[deg\].
+    pub fn start(&self) -> &[f64] {
+        &self.start
+    }
+
+    /// The divisor of the objective (1 without `normalize_at`).
+    pub fn objective_scale(&self) -> f64 {
+        self.objective.1
+    }
+
+    /// The constraint bounds `c_j` (response units).
+    pub fn bounds(&self) -> Vec<f64> {
+        self.constraints.iter().map(|c| c.1).collect()
+    }
+
+    /// The study at design `x` \[deg\]: ply angles rewritten, sensitivities
+    /// set to the problem's lanes (with `gradients`) or none.
+    pub fn study_at(&self, x: &[f64], gradients: bool) -> Result<Study> {
+        let mut study = self.base.clone();
+        let panels = study
+            .table
+            .get_mut("panels")
+            .and_then(|p| p.as_array_mut())
+            .ok_or_else(|| Error::input("panels", "(missing)", "[[panels]] entries"))?;
+        for (xi, targets) in x.iter().zip(&self.targets) {
+            for t in targets {
+                let plies = panels[t.panel]
+                    .get_mut("plies")
+                    .and_then(|p| p.as_array_mut())
+                    .ok_or_else(|| {
+                        Error::input(format!("panels[{}].plies", t.panel), "(missing)", "plies")
+                    })?;
+                for &k in &t.plies {
+                    let ply = plies[k].as_table_mut().ok_or_else(|| {
+                        Error::input(
+                            format!("panels[{}].plies[{k}]", t.panel),
+                            "(not a table)",
+                            "{ angle = .., thickness = .. }",
+                        )
+                    })?;
+                    ply.insert("angle".into(), toml::Value::Float(*xi));
+                }
+            }
+        }
+        if let Some(toml::Value::Table(s)) = study.table.get_mut("scene") {
+            let lanes = if gradients {
+                self.lanes.clone()
+            } else {
+                vec![]
+            };
+            s.insert(
+                "sensitivities".into(),
+                toml::Value::Array(lanes.into_iter().map(toml::Value::String).collect()),
+            );
+        }
+        Ok(study)
+    }
+
+    /// Simulate at `x` and return the named responses (gradients per
+    /// degree of each variable when asked).
+    fn raw(&self, x: &[f64], names: &[String], gradients: bool) -> Result<Raw> {
+        let design = || design_label(&self.vars, x);
+        let at = |e: Error| at_design(e, &self.vars, x);
+        let study = self.study_at(x, gradients)?;
+        let scene = load_scene(&study).map_err(at)?;
+        let sim = simulate(&scene).map_err(at)?.1;
+        let find = |name: &str| -> Result<&ResponseValue> {
+            sim.responses
+                .iter()
+                .find(|r| r.name == name)
+                .ok_or_else(|| Error::input("scene.responses", name, "a response of the scene"))
+        };
+        let deg = std::f64::consts::PI / 180.0;
+        let mut values = Vec::new();
+        let mut grads = Vec::new();
+        for name in names {
+            let r = find(name)?;
+            if !r.value.is_finite() {
+                return Err(Error::numerical(
+                    format!("scene problem at [{}]", design()),
+                    format!("response {name} = {}", r.value),
+                ));
+            }
+            values.push(r.value);
+            if gradients {
+                let g: Vec<f64> = self
+                    .lanes_of
+                    .iter()
+                    .map(|l| l.iter().map(|&k| r.gradient[k]).sum::<f64>() * deg)
+                    .collect();
+                if g.iter().any(|v| !v.is_finite()) {
+                    return Err(Error::numerical(
+                        format!("scene problem at [{}]", design()),
+                        format!("gradient of {name} = {g:?}"),
+                    ));
+                }
+                grads.push(g);
+            }
+        }
+        Ok(Raw {
+            values,
+            gradients: gradients.then_some(grads),
+        })
+    }
+}
+
+/// `theta1_deg = 55, theta2_deg = -55`.
+fn design_label(vars: &[Variable], x: &[f64]) -> String {
+    let parts: Vec<String> = vars
+        .iter()
+        .zip(x)
+        .map(|(v, x)| format!("{} = {x}", v.name))
+        .collect();
+    parts.join(", ")
+}
+
+/// A numerical failure of the scene, with the design in its place; other
+/// errors unchanged.
+fn at_design(e: Error, vars: &[Variable], x: &[f64]) -> Error {
+    match e {
+        Error::Numerical {
+            place,
+            time,
+            detail,
+        } => Error::Numerical {
+            place: format!("scene problem at [{}]: {place}", design_label(vars, x)),
+            time,
+            detail,
+        },
+        e => e,
+    }
+}
+
+/// Names of a panel's design variables (`theta_1_4` for plies 1 and 4),
+/// as the modal basis names them.
+fn design_names(map: &crate::laminate::DesignMap) -> Vec<String> {
+    map.groups()
+        .iter()
+        .map(|g| {
+            let plies: Vec<String> = g.iter().map(|k| (k + 1).to_string()).collect();
+            format!("theta_{}", plies.join("_"))
+        })
+        .collect()
+}
+
+impl Problem for SceneProblem {
+    fn variables(&self) -> &[Variable] {
+        &self.vars
+    }
+    fn n_constraints(&self) -> usize {
+        self.constraints.len()
+    }
+    /// `f = R₀/s`, `g_j = R_j/c_j − 1`, gradients per degree.
+    fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
+        if x.len() != self.vars.len() || x.iter().any(|v| !v.is_finite()) {
+            return Err(Error::input(
+                "scene_problem.x",
+                format!("{x:?}"),
+                format!("{} finite angles [deg]", self.vars.len()),
+            ));
+        }
+        let mut names = vec![self.objective.0.clone()];
+        names.extend(self.constraints.iter().map(|c| c.0.clone()));
+        let raw = self.raw(x, &names, gradients)?;
+        let s = self.objective.1;
+        let f = raw.values[0] / s;
+        let g = self
+            .constraints
+            .iter()
+            .zip(&raw.values[1..])
+            .map(|(c, v)| v / c.1 - 1.0)
+            .collect();
+        let (grad_f, grad_g) = match raw.gradients {
+            None => (None, None),
+            Some(gr) => {
+                let gf = gr[0].iter().map(|v| v / s).collect();
+                let gg = self
+                    .constraints
+                    .iter()
+                    .zip(&gr[1..])
+                    .map(|(c, row)| row.iter().map(|v| v / c.1).collect())
+                    .collect();
+                (Some(gf), Some(gg))
+            }
+        };
+        Ok(Evaluation {
+            f,
+            g,
+            grad_f,
+            grad_g,
+        })
+    }
+    fn name(&self) -> &str {
+        "scene"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numerical_failures_carry_the_design() {
+        let vars = vec![
+            Variable::periodic("theta1_deg", -90.0, 180.0).unwrap(),
+            Variable::periodic("theta2_deg", -90.0, 180.0).unwrap(),
+        ];
+        let e = at_design(
+            Error::numerical_at("integrate: bdf", 0.026, "step size underflow"),
+            &vars,
+            &[55.0, -55.0],
+        );
+        let s = e.to_string();
+        assert!(matches!(e, Error::Numerical { time: Some(t), .. } if t == 0.026));
+        assert!(
+            s.contains("scene problem at [theta1_deg = 55, theta2_deg = -55]: integrate: bdf")
+                && s.contains("step size underflow"),
+            "{s}"
+        );
+        let e = at_design(Error::input("k", 1, "2"), &vars, &[0.0, 0.0]);
+        assert!(matches!(e, Error::Input { .. }));
+    }
+}

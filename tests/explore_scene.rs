@@ -1,0 +1,208 @@
+//! The scene problem (`[problem] name = "scene"`, explore::scene_problem)
+//! on a coarse version of studies/sar_optimize.toml made by text
+//! replacement (8 mesh divisions, 4 modes, 0–0.5 s, tight integrator
+//! tolerances) so that one evaluation takes a fraction of a second: its
+//! gradients against central finite differences of its own `evaluate`,
+//! its 180° periodicity, and input errors that name the key.
+
+use plyscape::explore;
+use plyscape::optimize::Problem;
+use plyscape::study::Study;
+use std::time::Instant;
+
+const STUDY: &str = include_str!("../studies/sar_optimize.toml");
+
+/// Replace every occurrence of `from`, requiring `count` of them (a change
+/// of the study file cannot silently void a test).
+fn replace(text: &str, from: &str, to: &str, count: usize) -> String {
+    assert_eq!(
+        text.matches(from).count(),
+        count,
+        "expected {count} × {from:?} in the study"
+    );
+    text.replace(from, to)
+}
+
+/// The coarse study text.
+fn coarse() -> String {
+    let mut t = STUDY.to_string();
+    t = replace(&t, "divisions = 32", "divisions = 8", 2);
+    t = replace(&t, "modes = 14", "modes = 4", 2);
+    t = replace(&t, "t_end = 3.0", "t_end = 0.5", 1);
+    t = replace(&t, "dt_out = 0.01", "dt_out = 0.005", 1);
+    t = replace(&t, "rtol = 1e-6", "rtol = 1e-10", 1);
+    replace(&t, "atol = 1e-8", "atol = 1e-12", 1)
+}
+
+fn build(text: &str) -> plyscape::Result<Box<dyn Problem>> {
+    explore::problem(&Study::parse("sar_optimize.toml", text)?)
+}
+
+#[test]
+fn gradients_match_central_differences_of_evaluate() {
+    // Objective Ψ₀/Ψ₀(start) and constraint peak U3/peak U3(start) − 1,
+    // both variables tied to panels 2 and 3: exact forward sensitivities
+    // (summed over the B2 and B3 lanes, per degree) against central
+    // differences of `evaluate` itself (panel bases rebuilt at x ± h).
+    let p = build(&coarse()).unwrap();
+    assert_eq!(p.variables().len(), 2);
+    assert_eq!(p.n_constraints(), 1);
+    // At the start design the normalized values are exactly 1 and 0
+    // (same simulation as the reference values).
+    let e0 = p.evaluate(&[55.0, -55.0], false).unwrap();
+    assert!(
+        (e0.f - 1.0).abs() < 1e-12 && e0.g[0].abs() < 1e-12,
+        "{e0:?}"
+    );
+    let x = [40.0, -25.0];
+    let t = Instant::now();
+    let e = p.evaluate(&x, true).unwrap();
+    println!(
+        "evaluation with gradients: {:.3} s",
+        t.elapsed().as_secs_f64()
+    );
+    let (gf, gg) = (e.grad_f.unwrap(), e.grad_g.unwrap());
+    // Relative to the largest component of each gradient: dg/dθ1 is
+    // 70 times smaller than dg/dθ2 here, and central differences carry the
+    // integrator's error (rtol 1e-10 on g ≈ 0.3) divided by h, about 2e-9
+    // per degree, which is 1e-5 of dg/dθ1 itself.
+    let h = 0.01; // degrees
+    let mut fd = [[0.0; 2]; 2];
+    for i in 0..2 {
+        let (mut xp, mut xm) = (x, x);
+        xp[i] += h;
+        xm[i] -= h;
+        let (ep, em) = (
+            p.evaluate(&xp, false).unwrap(),
+            p.evaluate(&xm, false).unwrap(),
+        );
+        fd[0][i] = (ep.f - em.f) / (2.0 * h);
+        fd[1][i] = (ep.g[0] - em.g[0]) / (2.0 * h);
+    }
+    for (k, (an, fd)) in [&gf, &gg[0]].into_iter().zip(&fd).enumerate() {
+        let scale = fd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for i in 0..2 {
+            let rel = (an[i] - fd[i]).abs() / scale;
+            println!(
+                "{} d/dx{i}: analytic {:e}, FD {:e}, error {rel:.1e} of the largest component",
+                ["f", "g"][k],
+                an[i],
+                fd[i]
+            );
+            assert!(rel < 1e-5, "{} d/dx{i}: {rel:e}", ["f", "g"][k]);
+        }
+    }
+}
+
+#[test]
+fn ply_angles_repeat_every_180_degrees() {
+    // A ply at θ and θ ± 180° is the same laminate (NUMERICS.md): the
+    // whole evaluation repeats to rounding.
+    let p = build(&coarse()).unwrap();
+    let a = p.evaluate(&[37.3, -61.7], false).unwrap();
+    let b = p.evaluate(&[37.3 + 180.0, -61.7 - 180.0], false).unwrap();
+    println!("f {} vs {}, g {} vs {}", a.f, b.f, a.g[0], b.g[0]);
+    assert!((a.f - b.f).abs() < 1e-10 * a.f.abs(), "{} vs {}", a.f, b.f);
+    assert!((a.g[0] - b.g[0]).abs() < 1e-10, "{} vs {}", a.g[0], b.g[0]);
+    assert!(p.variables().iter().all(|v| v.period == Some(180.0)));
+}
+
+#[test]
+fn bad_input_names_the_key() {
+    let base = coarse();
+    let cases = [
+        (
+            replace(&base, "response = \"psi0\"", "response = \"psi1\"", 1),
+            "scene_problem.objective.response",
+            "psi1",
+        ),
+        (
+            replace(
+                &base,
+                "sets = [\"panel2:theta_1_4\", \"panel3:theta_1_4\"]",
+                "sets = [\"panel2:theta_1_4\", \"panel3:theta_1_2\"]",
+                1,
+            ),
+            "scene_problem.variables[0].sets[1]",
+            "theta_2_3",
+        ),
+        (
+            replace(
+                &base,
+                "sets = [\"panel2:theta_2_3\", \"panel3:theta_2_3\"]",
+                "sets = [\"panel2:theta_2_3\", \"panel9:theta_2_3\"]",
+                1,
+            ),
+            "scene_problem.variables[1].sets[1]",
+            "panel9",
+        ),
+        (
+            replace(&base, "\"B2.design.theta_1_4\", ", "", 1),
+            "scene.sensitivities",
+            "B2.design.theta_1_4",
+        ),
+        (
+            replace(&base, "response = \"u3_peak\"", "response = \"u2_peak\"", 1),
+            "scene_problem.constraints[0].response",
+            "u2_peak",
+        ),
+        (
+            replace(
+                &base,
+                "upper_relative = 1.0",
+                "upper_relative = 1.0\nupper = 2.0",
+                1,
+            ),
+            "scene_problem.constraints[0]",
+            "exactly one",
+        ),
+        (
+            replace(&base, "start = [55.0, -55.0]", "start = [55.0]", 1),
+            "scene_problem.start",
+            "2 finite angles",
+        ),
+    ];
+    for (text, key, detail) in cases {
+        let e = build(&text).err().expect(key);
+        let s = e.to_string();
+        println!("{s}");
+        assert!(matches!(e, plyscape::Error::Input { .. }), "{s}");
+        assert!(s.contains(&format!("`{key}`")) && s.contains(detail), "{s}");
+        assert!(s.starts_with("sar_optimize.toml"), "{s}");
+    }
+}
+
+/// Measurement (ignored): cost of one full-size evaluation (32 divisions,
+/// 14 modes, 0–3 s) with and without gradients, bdf vs tsit45 at the
+/// study's tolerances, and a tsit45 run at rtol 1e-9 as the accuracy
+/// reference.
+/// `cargo test --release --test explore_scene -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn measure_full_evaluation_cost() {
+    for (method, rtol) in [("bdf", "1e-6"), ("tsit45", "1e-6"), ("tsit45", "1e-9")] {
+        let text = replace(
+            STUDY,
+            "method = \"tsit45\"",
+            &format!("method = \"{method}\""),
+            1,
+        );
+        let text = replace(&text, "rtol = 1e-6", &format!("rtol = {rtol}"), 1);
+        let atol = if rtol == "1e-6" { "1e-8" } else { "1e-11" };
+        let text = replace(&text, "atol = 1e-8", &format!("atol = {atol}"), 1);
+        let t = Instant::now();
+        let p = build(&text).unwrap();
+        let setup = t.elapsed().as_secs_f64();
+        let x = [40.0, -25.0];
+        let t = Instant::now();
+        let a = p.evaluate(&x, false).unwrap();
+        let plain = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let b = p.evaluate(&x, true).unwrap();
+        let grad = t.elapsed().as_secs_f64();
+        println!(
+            "{method} rtol {rtol}: setup (start design) {setup:.2} s, f only {plain:.2} s, with gradients {grad:.2} s; f = {:.10}, g = {:.10}, grad f = {:?}",
+            a.f, a.g[0], b.grad_f
+        );
+    }
+}
