@@ -93,6 +93,23 @@ impl Error {
         }
     }
 
+    /// Prefix the place of a numerical failure with `prefix` (e.g. the
+    /// panel or the design it happened at); other errors are unchanged.
+    pub fn at_place(self, prefix: &str) -> Self {
+        match self {
+            Error::Numerical {
+                place,
+                time,
+                detail,
+            } => Error::Numerical {
+                place: format!("{prefix}: {place}"),
+                time,
+                detail,
+            },
+            other => other,
+        }
+    }
+
     /// Attach the study file and a key prefix to an input error: a library
     /// error with key `plies[1].thickness` raised while reading section
     /// `panels[0]` of `study.toml` becomes `study.toml: panels[0].plies[1].thickness`.

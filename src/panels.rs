@@ -439,18 +439,7 @@ pub fn dfreq_hz_per_deg(lambda: f64, dlambda_per_rad: f64) -> f64 {
 
 /// Prefix the place of a numerical error with the panel name.
 fn in_panel(e: Error, panel: &str) -> Error {
-    match e {
-        Error::Numerical {
-            place,
-            time,
-            detail,
-        } => Error::Numerical {
-            place: format!("panel {panel}: {place}"),
-            time,
-            detail,
-        },
-        other => other,
-    }
+    e.at_place(&format!("panel {panel}"))
 }
 
 /// Run the modal analysis of every panel of the study, sharing analyses of

@@ -497,18 +497,7 @@ fn design_label(vars: &[Variable], x: &[f64]) -> String {
 /// A numerical failure of the scene, with the design in its place; other
 /// errors unchanged.
 fn at_design(e: Error, vars: &[Variable], x: &[f64]) -> Error {
-    match e {
-        Error::Numerical {
-            place,
-            time,
-            detail,
-        } => Error::Numerical {
-            place: format!("scene problem at [{}]: {place}", design_label(vars, x)),
-            time,
-            detail,
-        },
-        e => e,
-    }
+    e.at_place(&format!("scene problem at [{}]", design_label(vars, x)))
 }
 
 /// Names of a panel's design variables (`theta_1_4` for plies 1 and 4),
