@@ -26,8 +26,9 @@ pub trait Scalar: RealField + Copy {
 
     /// Factor the constraint-space matrix `a` (lower triangle, row-major
     /// `m × m`) in place as [`ordered_cholesky`] does; for dual numbers
-    /// the real parts receive the factor of the real matrix and the dual
-    /// parts keep `A' + reg·diag(A')` for [`Scalar::spd_solve`].
+    /// the factor of the real matrix goes to `scratch` and the dual parts
+    /// of `a` keep `A' + reg·diag(A')`, for [`Scalar::spd_solve`] with the
+    /// same scratch.
     fn spd_factor(
         a: &mut [Self],
         m: usize,
@@ -117,11 +118,9 @@ impl Scalar for num_dual::Dual64 {
             // The regularised system is (A + reg·diag(A)) x = b.
             a[k * m + k].eps *= 1.0 + tols.1;
         }
-        for (v, r) in a.iter_mut().zip(&sc.re) {
-            v.re = *r;
-        }
+        // The real factor and scaling stay in the scratch for `spd_solve`;
+        // `a` keeps A' in its dual parts.
         scale.clear();
-        scale.extend(sc.scale.iter().map(|&v| Self::from(v)));
         f
     }
     fn spd_solve(
