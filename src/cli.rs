@@ -261,7 +261,14 @@ fn handlers() -> Vec<(&'static str, Handler)> {
         ("map", run_map_handler),
         ("kernel_bench", run_kernel_bench_handler),
         ("events_bench", run_events_bench_handler),
+        ("scene_convergence", run_scene_convergence_handler),
     ]
+}
+
+/// The `[scene_convergence]` section: responses vs mesh and modes, with cost.
+fn run_scene_convergence_handler(cfg: &RunConfig) -> Result<()> {
+    crate::mbs::scene_convergence::run_scene_convergence(&cfg.study, &cfg.out, cfg.quiet)
+        .map(|_| ())
 }
 
 /// The `[events_bench]` section: Eq. 32 segment changes as events or not.

@@ -59,6 +59,7 @@ pub mod model;
 pub mod responses;
 pub mod rows;
 pub mod scene;
+pub mod scene_convergence;
 pub mod scene_parts;
 pub mod simulate;
 pub mod solve;
