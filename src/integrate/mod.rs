@@ -243,17 +243,9 @@ pub fn integrate(
             )?,
             Method::Tsit45 => legs.drive(problem.tsit45().map_err(setup)?, &mut observe)?,
         };
-        stats.absorb(&leg);
-        let Some(mut e) = event else { break };
-        stats.events += 1;
-        stats.last_event = Some(e.t);
-        ev.borrow_mut()
-            .switch(sys, (e.t, &e.y), &mut e.s, &mut ws.borrow_mut(), e.crossing)?;
-        set_segments(&ev, &ws, &wsd);
-        if !legs.restart_or_finish(&e, &mut observe)? {
+        let Some(e) = legs.end_leg(&mut stats, (leg, event), (&ws, &wsd), &mut observe)? else {
             break;
-        }
-        stats.restarts += 1;
+        };
         problem.t0 = e.t;
         *start_y.borrow_mut() = e.y;
     }
@@ -418,17 +410,9 @@ pub fn integrate_sens(
             )?,
             Method::Tsit45 => legs.drive(problem.tsit45_sens().map_err(setup)?, &mut observe)?,
         };
-        stats.absorb(&leg);
-        let Some(mut e) = event else { break };
-        stats.events += 1;
-        stats.last_event = Some(e.t);
-        ev.borrow_mut()
-            .switch(sys, (e.t, &e.y), &mut e.s, &mut ws.borrow_mut(), e.crossing)?;
-        set_segments(&ev, &ws, &wsd);
-        if !legs.restart_or_finish(&e, &mut observe)? {
+        let Some(e) = legs.end_leg(&mut stats, (leg, event), (&ws, &wsd), &mut observe)? else {
             break;
-        }
-        stats.restarts += 1;
+        };
         problem.t0 = e.t;
         *start_y.borrow_mut() = e.y;
         *start_s.borrow_mut() = e.s;
@@ -590,6 +574,32 @@ impl Legs<'_> {
             ..Stats::default()
         };
         Ok((stats, event))
+    }
+
+    /// The end of a leg: count it; at an event, switch the law (the
+    /// sensitivities jump), refreeze the workspaces' segments, and return
+    /// the event when a new leg must start from it.
+    fn end_leg(
+        &mut self,
+        stats: &mut Stats,
+        leg: (Stats, Option<Event>),
+        workspaces: (&RefCell<Workspace<f64>>, &RefCell<Workspace<Dual64>>),
+        observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+    ) -> Result<Option<Event>> {
+        let (ws, wsd) = workspaces;
+        stats.absorb(&leg.0);
+        let Some(mut e) = leg.1 else { return Ok(None) };
+        stats.events += 1;
+        stats.last_event = Some(e.t);
+        self.events
+            .borrow_mut()
+            .switch(self.sys, (e.t, &e.y), &mut e.s, &mut ws.borrow_mut(), e.crossing)?;
+        set_segments(self.events, ws, wsd);
+        if !self.restart_or_finish(&e, observe)? {
+            return Ok(None);
+        }
+        stats.restarts += 1;
+        Ok(Some(e))
     }
 
     /// After the switch at event `e` (sensitivities already jumped):

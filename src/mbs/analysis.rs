@@ -280,14 +280,7 @@ impl System {
 
     /// Strain energy `½ wᵀΛw` of flexible slot `s` (J).
     pub fn strain_energy(&self, y: &[f64], s: usize) -> f64 {
-        let b = self.moving[s];
-        let Some(flex) = self.model.bodies[b].flex.as_ref() else {
-            return 0.0;
-        };
-        let p = self.pos_off(s) + 7;
-        (0..self.modes[s])
-            .map(|j| 0.5 * flex.inv.lambda[j] * y[p + j] * y[p + j])
-            .sum()
+        self.strain_energy_dual(y, s, &[])
     }
 
     /// Whether [`System::energy`] is conserved by the exact flow: no
@@ -396,6 +389,7 @@ impl<T: Scalar> Workspace<T> {
             tmp: Vec::new(),
             kin: Vec::new(),
             mk: Vec::new(),
+            shapes: Vec::new(),
             by_body: Vec::new(),
             arena: Vec::new(),
             mjac: Vec::new(),

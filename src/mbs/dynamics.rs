@@ -91,6 +91,11 @@ pub struct Workspace<T: Scalar> {
     pub kin: Vec<BodyKin<T>>,
     /// Kinematics of every marker at the current state.
     pub mk: Vec<MarkerKin<T>>,
+    /// Per marker: its node's mode-shape rows `(Φ_k, Ψ_k)` at the current
+    /// design seeds (empty for markers not on a flexible node), built once
+    /// per evaluation for the kinematics, the constraint rows and the
+    /// forces.
+    pub(crate) shapes: Vec<NodeShapes<T>>,
     /// Per moving body: the rows touching it as `(row, offset)`; the
     /// arena holds `d` then `M⁻¹d` (each `dof` long) at the offset.
     pub(crate) by_body: Vec<Vec<(usize, usize)>>,
@@ -123,6 +128,9 @@ pub struct Workspace<T: Scalar> {
     /// segment is picked by the value of θ.
     pub segments: Vec<usize>,
 }
+
+/// Translational and rotational mode-shape rows of a node (n columns each).
+pub type NodeShapes<T> = (Vec<Vector3<T>>, Vec<Vector3<T>>);
 
 /// Kinematics of one body at the current state.
 #[derive(Debug, Clone)]
@@ -406,8 +414,32 @@ impl System {
         (phi, psi)
     }
 
+    /// The node shapes of marker `m` (empty unless it sits on a node of a
+    /// moving flexible body).
+    fn marker_shapes<T: Scalar>(&self, kin: &[BodyKin<T>], m: usize) -> NodeShapes<T> {
+        let mk = &self.model.markers[m];
+        match (mk.node, mk.body) {
+            (Some(node), Some(b)) => match self.slot[b] {
+                Some(s) if !kin[s].q.is_empty() => self.node_shapes(&kin[s], b, node),
+                _ => (Vec::new(), Vec::new()),
+            },
+            _ => (Vec::new(), Vec::new()),
+        }
+    }
+
     /// Global kinematics of marker `m`.
     pub fn marker_kin<T: Scalar>(&self, kin: &[BodyKin<T>], m: usize) -> MarkerKin<T> {
+        let shapes = self.marker_shapes(kin, m);
+        self.marker_kin_with(kin, m, &shapes)
+    }
+
+    /// [`System::marker_kin`] with the marker's node shapes given.
+    fn marker_kin_with<T: Scalar>(
+        &self,
+        kin: &[BodyKin<T>],
+        m: usize,
+        shapes: &NodeShapes<T>,
+    ) -> MarkerKin<T> {
         let mk = &self.model.markers[m];
         let pos = mk.pos.map(cst::<T>);
         let frame = mk.frame.map(cst::<T>);
@@ -446,7 +478,7 @@ impl System {
                 let k = &kin[s];
                 match (mk.node, mk.body) {
                     (Some(node), Some(b)) if !k.q.is_empty() => {
-                        let (phi, psi) = self.node_shapes(k, b, node);
+                        let (phi, psi) = shapes;
                         let (mut du, mut th) = (Vector3::zeros(), Vector3::zeros());
                         let (mut vd, mut wd) = (Vector3::zeros(), Vector3::zeros());
                         for j in 0..phi.len() {
@@ -494,12 +526,16 @@ impl System {
         }
     }
 
-    /// Kinematics of every marker into `ws.mk` (from `ws.kin`).
+    /// Kinematics of every marker into `ws.mk`, and their node shapes
+    /// into `ws.shapes` (from `ws.kin`).
     pub fn markers_kin<T: Scalar>(&self, ws: &mut Workspace<T>) {
         ws.mk.clear();
+        ws.shapes.clear();
         for m in 0..self.model.markers.len() {
-            let k = self.marker_kin(&ws.kin, m);
+            let shapes = self.marker_shapes(&ws.kin, m);
+            let k = self.marker_kin_with(&ws.kin, m, &shapes);
             ws.mk.push(k);
+            ws.shapes.push(shapes);
         }
     }
 
@@ -560,9 +596,9 @@ impl System {
                 let dv = Vector3::new(blk[0], blk[1], blk[2]);
                 let wg = Vector3::new(blk[3], blk[4], blk[5]);
                 let mk = &ws.mk[row.markers[side]];
-                if let Some((b, node)) = mk.node {
+                if mk.node.is_some() {
                     // ∂/∂ẇ_j = (Aᵀdv)·Φ_kj + (Tᵀ Aᵀ(dw_g − s×dv))·Ψ_kj.
-                    let (phi, psi) = self.node_shapes(k, b, node);
+                    let (phi, psi) = &ws.shapes[row.markers[side]];
                     let av = k.a.transpose() * dv;
                     let aw = mk.tangent.transpose() * (k.a.transpose() * (wg - mk.s.cross(&dv)));
                     row.modal[side] = ws.mjac.len();
@@ -778,8 +814,8 @@ impl System {
                     }
                     let axis: Vector3<T> = mi.frame.column(2).into();
                     let tau = axis * (-m);
-                    self.apply_torque(ws, &mj, &tau);
-                    self.apply_torque(ws, &mi, &(-tau));
+                    self.apply_torque(ws, jt.j, &tau);
+                    self.apply_torque(ws, jt.i, &(-tau));
                 }
                 Force::SpringDamper {
                     i,
@@ -799,33 +835,34 @@ impl System {
                     let c = pval(&ws.params, Param::Damping(fi), *damping);
                     let tension = k * (l - cst::<T>(*length)) + c * ldot;
                     let f = u * tension; // on i, towards j
-                    self.apply_force(ws, &mi, &f);
-                    self.apply_force(ws, &mj, &(-f));
+                    self.apply_force(ws, *i, &f);
+                    self.apply_force(ws, *j, &(-f));
                 }
             }
         }
     }
 
-    /// Add a global torque on the carrier of marker `mk` (and on the modes
+    /// Add a global torque on the carrier of marker `m` (and on the modes
     /// through `Ψ_kᵀ` for a flexible node).
-    fn apply_torque<T: Scalar>(&self, ws: &mut Workspace<T>, mk: &MarkerKin<T>, tau: &Vector3<T>) {
+    fn apply_torque<T: Scalar>(&self, ws: &mut Workspace<T>, m: usize, tau: &Vector3<T>) {
+        let mk = ws.mk[m];
         let Some(s) = mk.slot else { return };
         let o = self.vel_local(s);
         let tb = ws.kin[s].a.transpose() * tau;
         for c in 0..3 {
             ws.q[o + 3 + c] += tb[c];
         }
-        if let Some((b, node)) = mk.node {
-            let (_, psi) = self.node_shapes(&ws.kin[s], b, node);
+        if mk.node.is_some() {
             let tt = mk.tangent.transpose() * tb;
-            for (j, p) in psi.iter().enumerate() {
+            for (j, p) in ws.shapes[m].1.iter().enumerate() {
                 ws.q[o + 6 + j] += p.dot(&tt);
             }
         }
     }
 
-    /// Add a global force at marker `mk` (and on the modes through `Φ_kᵀ`).
-    fn apply_force<T: Scalar>(&self, ws: &mut Workspace<T>, mk: &MarkerKin<T>, f: &Vector3<T>) {
+    /// Add a global force at marker `m` (and on the modes through `Φ_kᵀ`).
+    fn apply_force<T: Scalar>(&self, ws: &mut Workspace<T>, m: usize, f: &Vector3<T>) {
+        let mk = ws.mk[m];
         let Some(s) = mk.slot else { return };
         let o = self.vel_local(s);
         let at = ws.kin[s].a.transpose();
@@ -834,10 +871,9 @@ impl System {
             ws.q[o + c] += f[c];
             ws.q[o + 3 + c] += tb[c];
         }
-        if let Some((b, node)) = mk.node {
+        if mk.node.is_some() {
             let fb = at * f;
-            let (phi, _) = self.node_shapes(&ws.kin[s], b, node);
-            for (j, p) in phi.iter().enumerate() {
+            for (j, p) in ws.shapes[m].0.iter().enumerate() {
                 ws.q[o + 6 + j] += p.dot(&fb);
             }
         }
