@@ -82,10 +82,7 @@ dt_out = 0.5
 [scene.outputs]
 quantities = ["box.position"]
 "#;
-    let table: toml::Table = toml::from_str(text).unwrap();
-    let spec: plyscape::mbs::scene::SceneSpec = table["scene"].clone().try_into().unwrap();
-    let scene = spec.build().unwrap();
-    let (_, sim) = plyscape::mbs::simulate::simulate(&scene).unwrap();
+    let sim = simulate_text(text);
     for r in &sim.rows {
         let t = r[0];
         for (k, f) in [1.0, -2.0, 4.0].iter().enumerate() {
@@ -128,10 +125,7 @@ dt_out = 0.25
 [scene.outputs]
 quantities = ["box.position"]
 "#;
-    let table: toml::Table = toml::from_str(text).unwrap();
-    let spec: plyscape::mbs::scene::SceneSpec = table["scene"].clone().try_into().unwrap();
-    let scene = spec.build().unwrap();
-    let (_, sim) = plyscape::mbs::simulate::simulate(&scene).unwrap();
+    let sim = simulate_text(text);
     // a(t) = F/m: 2t on [0,1], 2 on [1,2], 2(3 − t) on [2,3], 0 after.
     let exact = |t: f64| -> f64 {
         let (v1, x1) = (1.0, 1.0 / 3.0); // v = t², x = t³/3 on [0, 1]
@@ -159,4 +153,12 @@ quantities = ["box.position"]
             r[1]
         );
     }
+}
+
+/// Build the `[scene]` of a study text and simulate it.
+fn simulate_text(text: &str) -> plyscape::mbs::simulate::Simulation {
+    let table: toml::Table = toml::from_str(text).unwrap();
+    let spec: plyscape::mbs::scene::SceneSpec = table["scene"].clone().try_into().unwrap();
+    let scene = spec.build().unwrap();
+    plyscape::mbs::simulate::simulate(&scene).unwrap().1
 }

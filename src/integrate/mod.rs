@@ -591,9 +591,13 @@ impl Legs<'_> {
         let Some(mut e) = leg.1 else { return Ok(None) };
         stats.events += 1;
         stats.last_event = Some(e.t);
-        self.events
-            .borrow_mut()
-            .switch(self.sys, (e.t, &e.y), &mut e.s, &mut ws.borrow_mut(), e.crossing)?;
+        self.events.borrow_mut().switch(
+            self.sys,
+            (e.t, &e.y),
+            &mut e.s,
+            &mut ws.borrow_mut(),
+            e.crossing,
+        )?;
         set_segments(self.events, ws, wsd);
         if !self.restart_or_finish(&e, observe)? {
             return Ok(None);

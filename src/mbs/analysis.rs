@@ -227,8 +227,17 @@ impl System {
         }
     }
 
-    /// Global position of the (deformed) centre of mass of slot `s`, from
-    /// the kinematics in `ws`.
+    /// Global position of the (deformed) centre of mass of slot `s` at
+    /// state `y`.
+    pub fn centre_of_mass(&self, y: &[f64], s: usize) -> Vector3<f64> {
+        let mut ws = Workspace::empty();
+        self.kinematics(y, &mut ws);
+        self.mass_factors(&mut ws);
+        self.mass_centre(s, &ws)
+    }
+
+    /// [`System::centre_of_mass`] from the kinematics and flexible
+    /// invariants already in `ws`.
     pub fn mass_centre(&self, s: usize, ws: &Workspace<f64>) -> Vector3<f64> {
         let k = &ws.kin[s];
         match ws.inv.get(s).and_then(|i| i.as_ref()) {
