@@ -6,7 +6,7 @@
 //! - the natural frequencies of each flexible body's modal basis (Hz);
 //! - the cost of the pieces of one right-hand side in `f64` and in
 //!   `Dual64` (one Jacobian-vector product), from
-//!   [`plyscape::mbs::bench::rhs_pieces`] (fastest of 7 batches, µs);
+//!   [`plyscape::sections::kernel_bench::rhs_pieces`] (fastest of 7 batches, µs);
 //! - the cost of one dense Jacobian by `n` dual evaluations (what an
 //!   implicit method pays per Jacobian without column compression);
 //! - the eigenvalues of that Jacobian with the largest modulus and the
@@ -14,9 +14,9 @@
 //!   stiffness an integrator meets.
 use nalgebra::{DMatrix, DVector};
 use num_dual::Dual64;
-use plyscape::mbs::bench::{rhs_pieces, PIECES};
-use plyscape::mbs::simulate::load_scene;
 use plyscape::mbs::{System, Workspace};
+use plyscape::scene::load_scene;
+use plyscape::sections::kernel_bench::{rhs_pieces, PIECES};
 use plyscape::study::Study;
 use std::time::Instant;
 

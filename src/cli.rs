@@ -267,18 +267,18 @@ fn handlers() -> Vec<(&'static str, Handler)> {
 
 /// The `[scene_convergence]` section: responses vs mesh and modes, with cost.
 fn run_scene_convergence_handler(cfg: &RunConfig) -> Result<()> {
-    crate::mbs::scene_convergence::run_scene_convergence(&cfg.study, &cfg.out, cfg.quiet)
+    crate::sections::scene_convergence::run_scene_convergence(&cfg.study, &cfg.out, cfg.quiet)
         .map(|_| ())
 }
 
 /// The `[events_bench]` section: Eq. 32 segment changes as events or not.
 fn run_events_bench_handler(cfg: &RunConfig) -> Result<()> {
-    crate::mbs::events_bench::run_events_bench(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
+    crate::sections::events_bench::run_events_bench(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
 }
 
 /// The `[kernel_bench]` section: multibody kernel cost and accuracy table.
 fn run_kernel_bench_handler(cfg: &RunConfig) -> Result<()> {
-    crate::mbs::bench::run_kernel_bench(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
+    crate::sections::kernel_bench::run_kernel_bench(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
 }
 
 /// The `[modes]` section: panel modal analysis.
@@ -289,8 +289,8 @@ fn run_modes_handler(cfg: &RunConfig) -> Result<()> {
 /// The `[scene]` handler: simulate the multibody scene and write
 /// `history.csv`, `stats.csv` (and an SVG) into the study's output folder.
 pub fn run_scene(cfg: &RunConfig) -> Result<()> {
-    use crate::mbs::simulate;
-    let scene = simulate::load_scene(&cfg.study)?;
+    use crate::simulate;
+    let scene = crate::scene::load_scene(&cfg.study)?;
     let (_, sim) = simulate::simulate(&scene).map_err(cfg.study.locate("scene"))?;
     let dir = cfg.study.output_dir(&cfg.out)?;
     let files = simulate::write_results(&scene, &sim, &dir)?;

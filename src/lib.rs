@@ -53,6 +53,9 @@ pub mod modal;
 pub mod optimize;
 pub mod panels;
 pub mod report;
+pub mod scene;
+pub mod sections;
+pub mod simulate;
 pub mod study;
 
 pub use error::{Error, Result};

@@ -25,7 +25,7 @@
 
 pub mod basis;
 
-pub use basis::{basis_for_study, panel_basis, BasisBuilder};
+pub use basis::{basis_for_study, panel_basis, unknown_panel, BasisBuilder};
 
 use crate::error::{Error, Result};
 use crate::fe::{Derivatives, Panel, PanelSystem};
@@ -438,7 +438,7 @@ pub fn dfreq_hz_per_deg(lambda: f64, dlambda_per_rad: f64) -> f64 {
 }
 
 /// Prefix the place of a numerical error with the panel name.
-fn in_panel(e: Error, panel: &str) -> Error {
+pub(crate) fn in_panel(e: Error, panel: &str) -> Error {
     e.at_place(&format!("panel {panel}"))
 }
 

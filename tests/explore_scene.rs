@@ -94,6 +94,72 @@ fn gradients_match_central_differences_of_evaluate() {
     }
 }
 
+/// The study text at design `x` [deg] by the old road: the ply angles
+/// written into the `[[panels]]` text (plies 1 and 4 take x[0], plies 2
+/// and 3 take x[1], in both panels), the scene's outputs dropped.
+fn text_at(x: [f64; 2]) -> String {
+    let plies = "plies = [{ angle = 55.0, thickness = 0.5e-3 }, { angle = -55.0, thickness = 0.5e-3 }, { angle = -55.0, thickness = 0.5e-3 }, { angle = 55.0, thickness = 0.5e-3 }]";
+    let new = format!(
+        "plies = [{{ angle = {a:?}, thickness = 0.5e-3 }}, {{ angle = {b:?}, thickness = 0.5e-3 }}, {{ angle = {b:?}, thickness = 0.5e-3 }}, {{ angle = {a:?}, thickness = 0.5e-3 }}]",
+        a = x[0],
+        b = x[1]
+    );
+    replace(&coarse(), plies, &new, 2)
+}
+
+/// Ψ₀, peak U3 and their gradients per degree (lanes of B2 and B3 summed
+/// per variable) from a scene loaded from text.
+fn responses_from_text(x: [f64; 2]) -> [(f64, [f64; 2]); 2] {
+    let study = Study::parse("sar_optimize.toml", &text_at(x)).unwrap();
+    let scene = plyscape::scene::load_scene(&study).unwrap();
+    let names: Vec<&str> = scene.params.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "B3.design.theta_1_4",
+            "B3.design.theta_2_3",
+            "B2.design.theta_1_4",
+            "B2.design.theta_2_3"
+        ]
+    );
+    let sim = plyscape::simulate::simulate(&scene).unwrap().1;
+    let deg = std::f64::consts::PI / 180.0;
+    ["psi0", "u3_peak"].map(|name| {
+        let r = sim.responses.iter().find(|r| r.name == name).unwrap();
+        let g = &r.gradient;
+        (r.value, [(g[0] + g[2]) * deg, (g[1] + g[3]) * deg])
+    })
+}
+
+#[test]
+fn design_as_numbers_matches_the_text_road() {
+    // The scene problem takes a design as numbers through a plan built
+    // once (pooled basis builders, no TOML written or parsed). The old
+    // road rewrote the study's text, reloaded the scene and rebuilt both
+    // panel analyses per design: it must give the same f, g and gradients
+    // to 1e-12 relative. f = Ψ₀/Ψ₀(start), g = U3peak/U3peak(start) − 1.
+    let study = Study::parse("sar_optimize.toml", &coarse()).unwrap();
+    let p = plyscape::explore::scene_problem::SceneProblem::from_study(&study).unwrap();
+    let [(psi_s, _), (u3_s, _)] = responses_from_text([55.0, -55.0]);
+    let x = [40.0, -25.0];
+    let [(psi, dpsi), (u3, du3)] = responses_from_text(x);
+    let e = p.evaluate(&x, true).unwrap();
+    let close = |a: f64, b: f64, what: &str| {
+        let rel = (a - b).abs() / b.abs().max(1e-300);
+        println!("{what}: plan {a:e}, text {b:e}, relative {rel:.1e}");
+        assert!(rel <= 1e-12, "{what}: {a:e} vs {b:e} ({rel:e})");
+    };
+    close(p.objective_scale(), psi_s, "psi0 at start");
+    close(p.bounds()[0], u3_s, "u3 peak at start");
+    close(e.f, psi / psi_s, "f");
+    close(e.g[0] + 1.0, u3 / u3_s, "g + 1");
+    let (gf, gg) = (e.grad_f.unwrap(), e.grad_g.unwrap());
+    for i in 0..2 {
+        close(gf[i], dpsi[i] / psi_s, &format!("df/dx{i}"));
+        close(gg[0][i], du3[i] / u3_s, &format!("dg/dx{i}"));
+    }
+}
+
 #[test]
 fn ply_angles_repeat_every_180_degrees() {
     // A ply at θ and θ ± 180° is the same laminate (NUMERICS.md): the

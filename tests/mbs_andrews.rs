@@ -15,7 +15,8 @@
 // Reference values are quoted with the test set's digits.
 #![allow(clippy::excessive_precision)]
 use plyscape::integrate::Method;
-use plyscape::mbs::simulate::{load_scene, simulate};
+use plyscape::scene::load_scene;
+use plyscape::simulate::simulate;
 use plyscape::study::Study;
 
 // Test-set parameters (andrews.f).

@@ -6,7 +6,8 @@
 //! Andrews test checks an independent published reference).
 
 use plyscape::integrate::Method;
-use plyscape::mbs::simulate::{load_scene, simulate};
+use plyscape::scene::load_scene;
+use plyscape::simulate::simulate;
 use plyscape::study::Study;
 
 fn run(file: &str, method: Method, rtol: f64) -> (Vec<f64>, usize) {

@@ -2,8 +2,8 @@
 //! integration events: a 1-DOF rotor with a closed-form motion, and the
 //! sensitivity jump at the event against central finite differences.
 use plyscape::integrate::{integrate, integrate_sens, Method, Options, Stats};
-use plyscape::mbs::scene::SceneSpec;
 use plyscape::mbs::{Model, Param, System, Workspace};
+use plyscape::scene::SceneSpec;
 
 /// A rotor (J_zz = 1 kg·m², centre of mass on the axis) on a revolute
 /// joint about global z to the ground, started at rest at θ = 2 rad, with

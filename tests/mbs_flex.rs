@@ -6,8 +6,9 @@
 
 use num_dual::Dual64;
 use plyscape::mbs::beam::{Beam, Plane};
-use plyscape::mbs::simulate::{load_scene, simulate};
 use plyscape::mbs::{System, Workspace};
+use plyscape::scene::load_scene;
+use plyscape::simulate::simulate;
 use plyscape::study::Study;
 
 fn study(text: &str) -> Study {

@@ -2,8 +2,8 @@
 //! effect): energy and angular momentum are invariants of the exact flow
 //! (Euler's equations), so their drift measures the integrator error.
 use plyscape::integrate::{integrate, Method, Options};
-use plyscape::mbs::simulate::load_scene;
 use plyscape::mbs::{System, Workspace};
+use plyscape::scene::load_scene;
 use plyscape::study::Study;
 
 /// The body of studies/dzhanibekov.toml: 1.5 kg, principal inertia
@@ -156,9 +156,9 @@ quantities = ["box.position"]
 }
 
 /// Build the `[scene]` of a study text and simulate it.
-fn simulate_text(text: &str) -> plyscape::mbs::simulate::Simulation {
+fn simulate_text(text: &str) -> plyscape::simulate::Simulation {
     let table: toml::Table = toml::from_str(text).unwrap();
-    let spec: plyscape::mbs::scene::SceneSpec = table["scene"].clone().try_into().unwrap();
+    let spec: plyscape::scene::SceneSpec = table["scene"].clone().try_into().unwrap();
     let scene = spec.build().unwrap();
-    plyscape::mbs::simulate::simulate(&scene).unwrap().1
+    plyscape::simulate::simulate(&scene).unwrap().1
 }

@@ -1,7 +1,8 @@
 //! Scene input errors (one clear error each, naming file, key and value),
 //! the effects list (what is not listed is not built), and the
 //! `plyscape simulate` command end to end.
-use plyscape::mbs::simulate::{load_scene, simulate};
+use plyscape::scene::load_scene;
+use plyscape::simulate::simulate;
 use plyscape::study::Study;
 use plyscape::Error;
 

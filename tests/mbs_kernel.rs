@@ -2,9 +2,10 @@
 //! central finite differences, projection of perturbed initial positions,
 //! driven joints and their reactions against closed forms.
 use num_dual::Dual64;
-use plyscape::mbs::scene::SceneSpec;
-use plyscape::mbs::simulate::{load_scene, simulate};
 use plyscape::mbs::{System, Workspace};
+use plyscape::scene::load_scene;
+use plyscape::scene::SceneSpec;
+use plyscape::simulate::simulate;
 use plyscape::study::Study;
 
 fn sar_system() -> System {

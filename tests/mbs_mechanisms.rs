@@ -4,8 +4,8 @@
 //! (studies/fourbar.toml, studies/bricard.toml); the generators below
 //! derive the same geometry and check that the files hold it.
 use nalgebra::{Matrix3, Vector3};
-use plyscape::mbs::scene::SceneSpec;
-use plyscape::mbs::simulate::{simulate, Simulation};
+use plyscape::scene::SceneSpec;
+use plyscape::simulate::{simulate, Simulation};
 
 /// A rod of mass `m` from `a` to `b` (radius 10 mm): `[[scene.bodies]]` text.
 /// Inertia about the centre: `m L²/12 (I − uuᵀ) + m r²/2 uuᵀ`.
@@ -201,8 +201,8 @@ fn bricard_at_loose_tolerance_completes_with_bdf() {
         "study tolerance changed: update this test"
     );
     let study = plyscape::study::Study::parse("bricard.toml", &text).unwrap();
-    let scene = plyscape::mbs::simulate::load_scene(&study).unwrap();
-    let (_, sim) = plyscape::mbs::simulate::simulate(&scene).unwrap();
+    let scene = plyscape::scene::load_scene(&study).unwrap();
+    let (_, sim) = plyscape::simulate::simulate(&scene).unwrap();
     assert_eq!(sim.rows.last().unwrap()[0], 10.0);
     let de = sim.energy_error.expect("conservative");
     println!(

@@ -1,11 +1,12 @@
 //! Rigid SAR antenna, phase 1 (studies/sar_phase1_rigid.toml, geometry
 //! from /work/shared/design/sar_geometry.json, a reconstruction).
 use plyscape::integrate::Method;
-use plyscape::mbs::simulate::{load_scene, simulate};
 use plyscape::mbs::Workspace;
+use plyscape::scene::load_scene;
+use plyscape::simulate::simulate;
 use plyscape::study::Study;
 
-fn sar() -> plyscape::mbs::scene::Scene {
+fn sar() -> plyscape::scene::Scene {
     let study = Study::load(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/studies/sar_phase1_rigid.toml"

@@ -7,8 +7,9 @@
 //! closes, θ(t) stays close to the rigid scene, and a ply-angle
 //! sensitivity of panel 3's strain energy matches central differences.
 
-use plyscape::mbs::simulate::{load_scene, simulate, Simulation};
 use plyscape::mbs::{Force, PiecewiseLaw};
+use plyscape::scene::load_scene;
+use plyscape::simulate::{simulate, Simulation};
 use plyscape::study::Study;
 
 const STUDY: &str = include_str!("../studies/sar_phase1_flexible.toml");

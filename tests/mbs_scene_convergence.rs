@@ -1,7 +1,7 @@
 //! `[scene_convergence]`: a grid of panel meshes × modes over a flexible
 //! scene with responses; the finest variant is the reference.
 
-use plyscape::mbs::scene_convergence::{reference, run_grid, write_csv, ConvergenceSpec};
+use plyscape::sections::scene_convergence::{reference, run_grid, write_csv, ConvergenceSpec};
 use plyscape::study::Study;
 
 #[test]

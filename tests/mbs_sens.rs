@@ -1,8 +1,8 @@
 //! Forward sensitivities (direct differentiation with exact dual-number
 //! products) against central finite differences of the simulation.
 use plyscape::integrate::{integrate, integrate_sens, Method, Options};
-use plyscape::mbs::scene::SceneSpec;
 use plyscape::mbs::{Force, Model, Param, System};
+use plyscape::scene::SceneSpec;
 
 /// A rod pendulum (pin about y at the origin) with gravity, a spring-damper
 /// from its tip to a ground point, and a rotational spring-damper-actuator
@@ -144,7 +144,7 @@ fn sar_sensitivities_of_deployment_angle() {
         "/studies/sar_phase1_rigid.toml"
     ))
     .unwrap();
-    let m = plyscape::mbs::simulate::load_scene(&study).unwrap().model;
+    let m = plyscape::scene::load_scene(&study).unwrap().model;
     let law = match &m.forces[0] {
         Force::Rotational { law: Some(l), .. } => l.clone(),
         other => panic!("{other:?}"),
@@ -222,7 +222,7 @@ fn scene_sensitivities_of_outputs_match_differences() {
     let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
     let scene = spec.build().unwrap();
     assert_eq!(scene.params.len(), 4);
-    let (_, sim) = plyscape::mbs::simulate::simulate(&scene).unwrap();
+    let (_, sim) = plyscape::simulate::simulate(&scene).unwrap();
     assert_eq!(sim.sens_headers.len(), 1 + 4 * 2);
     assert_eq!(sim.sens_rows.len(), 3);
     assert!(sim.sens_headers[1].starts_with("d(pin.angle)/d(forces[0].stiffness)"));
@@ -235,7 +235,7 @@ fn scene_sensitivities_of_outputs_match_differences() {
             let mut sc = spec.build().unwrap();
             p.set(&mut sc.model, v + sign * h);
             sc.params.clear();
-            let (_, s) = plyscape::mbs::simulate::simulate(&sc).unwrap();
+            let (_, s) = plyscape::simulate::simulate(&sc).unwrap();
             th[k] = s.rows.last().unwrap()[1];
         }
         let fd = (th[0] - th[1]) / (2.0 * h);

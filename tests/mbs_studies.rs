@@ -6,7 +6,7 @@
 //! the same study files.
 use plyscape::cli::{run_study, RunConfig};
 use plyscape::integrate::Method;
-use plyscape::mbs::bench::{run_bench, write_csv, BenchSpec, HEADERS};
+use plyscape::sections::kernel_bench::{run_bench, write_csv, BenchSpec, HEADERS};
 use plyscape::study::Study;
 use std::path::{Path, PathBuf};
 

@@ -36,27 +36,32 @@
 //! `R₀(x)` without `normalize_at`), each constraint
 //! `g_j = R_j(x) / c_j − 1 <= 0` (Eq. 34 with `c_j` the bound).
 //!
-//! Evaluation: the study's TOML is copied, the ply angles rewritten, the
-//! scene loaded (panel modal bases rebuilt for the new lay-up) and
-//! simulated. Gradients come from the scene's forward sensitivities
+//! Evaluation: a [`ScenePlan`] made once holds the parsed scene, the
+//! resolved panels and, per panel, a basis builder (mesh, sparsity
+//! pattern, symbolic factorization) reused for every design; a design
+//! goes in as numbers (each variable's angle, converted once to radians,
+//! written into the plies of its panel groups with
+//! [`crate::laminate::Laminate`]), the panel modal bases are recomputed for
+//! the new lay-ups, and the scene is built and simulated. Gradients come from the scene's forward sensitivities
 //! (exact, `crate::mbs::responses`): with gradients asked, the scene runs
 //! with exactly the lanes `<body>.design.<variable>` of the bodies built
 //! from the tied panels (each must appear in `[scene] sensitivities`, so
 //! that the study file shows what is differentiated); without, with none.
 //! A variable's derivative is the sum over its lanes, times π/180 (the
 //! scene's lanes are per radian, the variables in degrees). The output
-//! columns of `[scene.outputs]` are dropped (responses need none). Nothing
-//! is shared between evaluations, so drivers may evaluate in parallel.
+//! columns of `[scene.outputs]` are dropped (responses need none). The
+//! plan's builders are pooled, so drivers may evaluate in parallel.
 //!
 //! Ply angles repeat every 180° (NUMERICS.md): a periodic variable is
 //! written as given, and `x` and `x + 180°` give the same laminate up to
 //! the rounding of the rotation's sines and cosines.
 
 use crate::error::{Error, Result};
+use crate::laminate::Laminate;
 use crate::mbs::responses::ResponseValue;
-use crate::mbs::scene::SceneSpec;
-use crate::mbs::simulate::{load_scene, simulate};
 use crate::optimize::{Evaluation, Problem, Variable};
+use crate::scene::ScenePlan;
+use crate::simulate::simulate;
 use crate::study::Study;
 use serde::Deserialize;
 
@@ -126,8 +131,8 @@ struct PlyTarget {
 /// A scene response as an optimization problem (see the module doc).
 pub struct SceneProblem {
     vars: Vec<Variable>,
-    /// Study with `[scene.outputs]` removed; ply angles rewritten per call.
-    base: Study,
+    /// The scene prepared once; a design goes in as laminates.
+    plan: ScenePlan,
     /// Per variable: the plies it sets.
     targets: Vec<Vec<PlyTarget>>,
     /// All sensitivity lanes, in the order they are passed to the scene.
@@ -156,8 +161,9 @@ impl SceneProblem {
             "scene_problem",
             "the scene problem (variables, start, objective)",
         )?;
-        let scene: SceneSpec = study.require_section("scene", "the multibody scene")?;
-        let panels = crate::fe::panels_from_study(study)?;
+        let plan = ScenePlan::new(study)?;
+        let scene = plan.spec();
+        let panels = plan.panels();
         let err = |key: String, value: &dyn std::fmt::Display, exp: String| {
             study.error(format!("scene_problem.{key}"), value, exp)
         };
@@ -238,16 +244,7 @@ impl SceneProblem {
                     panel: p,
                     plies: panels[p].design.groups()[d].clone(),
                 });
-                let bodies: Vec<&str> = scene
-                    .bodies
-                    .iter()
-                    .filter(|b| {
-                        b.flexible
-                            .as_ref()
-                            .is_some_and(|f| f.kind == "panel" && f.panel.as_deref() == Some(pname))
-                    })
-                    .map(|b| b.name.as_str())
-                    .collect();
+                let bodies = plan.bodies_of_panel(pname);
                 if bodies.is_empty() {
                     return Err(err(
                         key,
@@ -322,13 +319,9 @@ impl SceneProblem {
                 return Err(err(format!("{key}.{k}"), &v, "a finite bound > 0".into()));
             }
         }
-        let mut base = study.clone();
-        if let Some(toml::Value::Table(s)) = base.table.get_mut("scene") {
-            s.remove("outputs");
-        }
         let mut problem = SceneProblem {
             vars,
-            base,
+            plan,
             targets,
             lanes,
             lanes_of,
@@ -393,47 +386,24 @@ impl SceneProblem {
         self.constraints.iter().map(|c| c.1).collect()
     }
 
-    /// The study at design `x` \[deg\]: ply angles rewritten, sensitivities
-    /// set to the problem's lanes (with `gradients`) or none.
-    pub fn study_at(&self, x: &[f64], gradients: bool) -> Result<Study> {
-        let mut study = self.base.clone();
-        let panels = study
-            .table
-            .get_mut("panels")
-            .and_then(|p| p.as_array_mut())
-            .ok_or_else(|| Error::input("panels", "(missing)", "[[panels]] entries"))?;
+    /// The panels' lay-ups at design `x` \[deg\]: each variable's angle
+    /// (in rad) in every ply of its targets, the other plies as in the
+    /// study.
+    pub fn laminates_at(&self, x: &[f64]) -> Result<Vec<Laminate>> {
+        let panels = self.plan.panels();
+        let mut angles: Vec<Vec<f64>> = panels.iter().map(|p| p.laminate.angles()).collect();
         for (xi, targets) in x.iter().zip(&self.targets) {
             for t in targets {
-                let plies = panels[t.panel]
-                    .get_mut("plies")
-                    .and_then(|p| p.as_array_mut())
-                    .ok_or_else(|| {
-                        Error::input(format!("panels[{}].plies", t.panel), "(missing)", "plies")
-                    })?;
                 for &k in &t.plies {
-                    let ply = plies[k].as_table_mut().ok_or_else(|| {
-                        Error::input(
-                            format!("panels[{}].plies[{k}]", t.panel),
-                            "(not a table)",
-                            "{ angle = .., thickness = .. }",
-                        )
-                    })?;
-                    ply.insert("angle".into(), toml::Value::Float(*xi));
+                    angles[t.panel][k] = xi.to_radians();
                 }
             }
         }
-        if let Some(toml::Value::Table(s)) = study.table.get_mut("scene") {
-            let lanes = if gradients {
-                self.lanes.clone()
-            } else {
-                vec![]
-            };
-            s.insert(
-                "sensitivities".into(),
-                toml::Value::Array(lanes.into_iter().map(toml::Value::String).collect()),
-            );
-        }
-        Ok(study)
+        panels
+            .iter()
+            .zip(&angles)
+            .map(|(p, a)| p.laminate.with_angles(a))
+            .collect()
     }
 
     /// Simulate at `x` and return the named responses (gradients per
@@ -441,8 +411,9 @@ impl SceneProblem {
     fn raw(&self, x: &[f64], names: &[String], gradients: bool) -> Result<Raw> {
         let design = || design_label(&self.vars, x);
         let at = |e: Error| at_design(e, &self.vars, x);
-        let study = self.study_at(x, gradients)?;
-        let scene = load_scene(&study).map_err(at)?;
+        let lanes: &[String] = if gradients { &self.lanes } else { &[] };
+        let laminates = self.laminates_at(x)?;
+        let scene = self.plan.build(&laminates, lanes, false).map_err(at)?;
         let sim = simulate(&scene).map_err(at)?.1;
         let find = |name: &str| -> Result<&ResponseValue> {
             sim.responses

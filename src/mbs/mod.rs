@@ -1,13 +1,14 @@
 //! Flexible multibody kernel (issue 3): rigid spatial bodies with Euler
 //! parameters, floating-frame flexible bodies with modal coordinates
 //! (paper Eqs. 5–6; [`flex`], [`flexdyn`], bases from closed-form beams
-//! [`beam`] or from composite panels [`crate::panels::panel_basis`]),
+//! [`beam`] or from composite panels `crate::panels::panel_basis`),
 //! markers (on flexible bodies: on mesh nodes, moving and rotating with the
 //! modes), joints (spherical, revolute, driven/locked revolute, fixed),
 //! force elements (gravity, the paper's Eq. 32 spring-damper-actuator,
 //! linear spring-dampers, constant or time-tabulated loads), the equations
 //! of motion with Lagrange multipliers, consistent initial conditions,
-//! outputs, and scenes read from TOML.
+//! and outputs. It knows nothing of files: scenes are built by
+//! [`crate::scene`], simulated by [`crate::simulate`].
 //!
 //! ## Method
 //! The equations of motion are the index-3 DAE of the paper (Eqs. 2–4, 6),
@@ -28,7 +29,7 @@
 //! constraints ([`analysis`]). Forward sensitivities (stiffness, damping,
 //! mass, Eq. 32 breakpoints, ply angles of flexible bodies through
 //! `dΛ/dθ` and `dX/dθ`: [`Param`]) come from
-//! [`crate::integrate::integrate_sens`], with exact products from
+//! `crate::integrate::integrate_sens`, with exact products from
 //! dual-number evaluations of the same right-hand side.
 //!
 //! ## Limitations
@@ -49,19 +50,13 @@
 
 pub mod analysis;
 pub mod beam;
-pub mod bench;
 pub mod dynamics;
-pub mod events_bench;
 pub mod flex;
 pub mod flexdyn;
 pub mod linalg;
 pub mod model;
 pub mod responses;
 pub mod rows;
-pub mod scene;
-pub mod scene_convergence;
-pub mod scene_parts;
-pub mod simulate;
 pub mod solve;
 
 pub use analysis::{Projection, Reaction};

@@ -87,6 +87,25 @@ pub enum ModeUpdate {
     Updated,
 }
 
+impl ModeUpdate {
+    /// The approach named as in study files: `"fixed"` or `"updated"`.
+    pub fn parse(name: &str) -> Option<ModeUpdate> {
+        match name {
+            "fixed" => Some(ModeUpdate::Fixed),
+            "updated" => Some(ModeUpdate::Updated),
+            _ => None,
+        }
+    }
+
+    /// The name written in study files and reports.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ModeUpdate::Fixed => "fixed",
+            ModeUpdate::Updated => "updated",
+        }
+    }
+}
+
 /// Options of [`super::ModalSolver::derivatives`].
 #[derive(Clone, Debug)]
 pub struct DerivativeOptions {

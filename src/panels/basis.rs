@@ -282,14 +282,20 @@ pub fn basis_for_study(
     }
     let panels = crate::fe::panels_from_study(study)?;
     let Some(i) = panels.iter().position(|p| p.name == name) else {
-        let names: Vec<String> = panels.iter().map(|p| format!("\"{}\"", p.name)).collect();
-        let expected = if names.is_empty() {
-            "the name of a [[panels]] entry (the study has none)".to_string()
-        } else {
-            format!("the name of a [[panels]] entry: {}", names.join(", "))
-        };
-        return Err(study.error("panels.name", format!("\"{name}\""), expected));
+        return Err(unknown_panel(study, name, &panels));
     };
     panel_basis(&panels[i], n_modes, derivatives)
         .map_err(|e| e.in_file(&study.path, &format!("panels[{i}]")))
+}
+
+/// The error for a panel name that no `[[panels]]` entry of `study` has:
+/// key `panels.name`, with the names available.
+pub fn unknown_panel(study: &Study, name: &str, panels: &[Panel]) -> Error {
+    let names: Vec<String> = panels.iter().map(|p| format!("\"{}\"", p.name)).collect();
+    let expected = if names.is_empty() {
+        "the name of a [[panels]] entry (the study has none)".to_string()
+    } else {
+        format!("the name of a [[panels]] entry: {}", names.join(", "))
+    };
+    study.error("panels.name", format!("\"{name}\""), expected)
 }

@@ -25,10 +25,11 @@
 //! Output: `kernel_bench.csv` in the study's output folder, one row per
 //! case (columns in [`HEADERS`]).
 
-use super::dynamics::{System, Workspace};
-use super::simulate::{load_scene, simulate};
 use crate::error::{Error, Result};
 use crate::integrate::Method;
+use crate::mbs::{System, Workspace};
+use crate::scene::{load_scene, Scene};
+use crate::simulate::simulate;
 use crate::study::Study;
 use num_dual::Dual64;
 use serde::Deserialize;
@@ -210,7 +211,7 @@ impl BenchRow {
 
 /// Simulate `scene` `repeats` times; the median wall time and the last
 /// run's counts and outputs.
-fn measure(scene: &super::scene::Scene, repeats: usize) -> Result<Measured> {
+fn measure(scene: &Scene, repeats: usize) -> Result<Measured> {
     let mut walls = Vec::with_capacity(repeats);
     let mut last = None;
     for _ in 0..repeats.max(1) {

@@ -1,15 +1,13 @@
-//! `plyscape simulate`: build a scene, make its initial state consistent,
+//! `plyscape simulate`: make a built scene's initial state consistent,
 //! integrate, and write `history.csv` (time + outputs, SI units in the
 //! header), `stats.csv` and an SVG of one output.
 
-use super::analysis::Projection;
-use super::dynamics::{System, Workspace};
-use super::responses::{peak, strain_sum, ResponseValue};
-use super::scene::{Quantity, Response, Scene, SceneSpec};
 use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Stats};
-use crate::mbs::Param;
-use crate::study::Study;
+use crate::mbs::analysis::Projection;
+use crate::mbs::responses::{peak, strain_sum, ResponseValue};
+use crate::mbs::{Param, Reaction, System, Workspace};
+use crate::scene::{Quantity, Response, Scene};
 use num_dual::Dual64;
 use std::path::{Path, PathBuf};
 
@@ -37,21 +35,6 @@ pub struct Simulation {
     pub sens_rows: Vec<Vec<f64>>,
     /// The scene's response functionals with their sensitivities.
     pub responses: Vec<ResponseValue>,
-}
-
-/// Read the `[scene]` section of a study and build it. Panel bodies take
-/// their modal basis from the study's `[[panels]]` (built only when the
-/// scene lists `flexibility`).
-pub fn load_scene(study: &Study) -> Result<Scene> {
-    let spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
-    let panels = |name: &str, modes: usize, derivatives: Option<&str>| {
-        let update = derivatives.map(|d| match d {
-            "fixed" => crate::modal::ModeUpdate::Fixed,
-            _ => crate::modal::ModeUpdate::Updated,
-        });
-        crate::panels::basis_for_study(study, name, modes, update)
-    };
-    spec.build_with(&panels).map_err(study.locate("scene"))
 }
 
 /// Simulate a built scene (no files written).
@@ -154,13 +137,10 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
                 Quantity::Angle(j) => row.push(sys.angle(y, *j, &mut ws).0),
                 Quantity::Rate(j) => row.push(sys.angle(y, *j, &mut ws).1),
                 Quantity::Reaction(j) => {
-                    let r = reactions
-                        .as_ref()
-                        .map(|r| r[*j])
-                        .unwrap_or(super::Reaction {
-                            force: Default::default(),
-                            torque: Default::default(),
-                        });
+                    let r = reactions.as_ref().map(|r| r[*j]).unwrap_or(Reaction {
+                        force: Default::default(),
+                        torque: Default::default(),
+                    });
                     row.extend(r.force.iter().chain(r.torque.iter()));
                 }
                 Quantity::Position(b) => match sys.slot[*b] {

@@ -1,13 +1,32 @@
-//! Pieces of the scene builder ([`super::scene`]): names to parameters
+//! Pieces of the scene builder ([`super::build`]): names to parameters
 //! and outputs, markers (snapped to flexible nodes), load tables and
 //! flexible bodies.
 
-use super::beam::Beam;
-use super::linalg::euler_from_rotation;
-use super::model::{Body, Flex, Force, Marker, Model, Param};
-use super::scene::{finite3, FlexSpec, ForceSpec, PanelBases, Quantity};
+use super::quantity::Quantity;
+use super::spec::{FlexKind, FlexSpec, ForceSpec};
 use crate::error::{Error, Result};
+use crate::mbs::beam::Beam;
+use crate::mbs::flex::ModalBasis;
+use crate::mbs::linalg::euler_from_rotation;
+use crate::mbs::model::{Body, Flex, Force, Marker, Model, Param};
+use crate::modal::ModeUpdate;
 use nalgebra::{Matrix3, Vector3};
+
+/// Builds the modal basis of a `kind = "panel"` body: `(panel name,
+/// modes, derivatives)` → basis; errors name the study's keys.
+pub type PanelBases<'a> = &'a dyn Fn(&str, usize, Option<ModeUpdate>) -> Result<ModalBasis>;
+
+fn vec3(a: [f64; 3]) -> Vector3<f64> {
+    Vector3::new(a[0], a[1], a[2])
+}
+
+pub(crate) fn finite3(key: String, a: [f64; 3]) -> Result<Vector3<f64>> {
+    if a.iter().all(|v| v.is_finite()) {
+        Ok(vec3(a))
+    } else {
+        Err(Error::input(key, format!("{a:?}"), "finite components"))
+    }
+}
 
 /// A sensitivity parameter name → [`Param`], if it names an existing,
 /// built model value.
@@ -230,38 +249,9 @@ pub(super) fn flexible_body(
             "a modal damping ratio in [0, 1)",
         ));
     }
-    let basis = match f.kind.as_str() {
-        "beam" => {
-            let get = |what: &str, v: Option<f64>| {
-                v.ok_or_else(|| {
-                    Error::input(format!("{fk}.{what}"), "(missing)", "a beam property")
-                })
-            };
-            let beam = Beam {
-                length: get("length", f.length)?,
-                ei_y: get("ei_y", f.ei_y)?,
-                ei_z: get("ei_z", f.ei_z)?,
-                rho_a: get("rho_a", f.rho_a)?,
-            };
-            beam.validate(&fk)?;
-            let rho_ip = f.rho_ip.unwrap_or(0.0);
-            if !(rho_ip.is_finite() && rho_ip > 0.0) {
-                return Err(Error::input(
-                    format!("{fk}.rho_ip"),
-                    rho_ip,
-                    "a polar mass moment per length > 0 (kg·m): the frame needs a rotary inertia about the beam axis",
-                ));
-            }
-            let mut b = beam
-                .basis(f.modes, Beam::segments_for(f.modes))?
-                .truncated(f.modes);
-            // Rotary inertia about the beam axis, lumped like the mass.
-            for (k, m) in b.node_mass.iter().enumerate() {
-                b.node_inertia[k].x = rho_ip * m / beam.rho_a;
-            }
-            b
-        }
-        "panel" => {
+    let basis = match f.kind(&fk)? {
+        FlexKind::Beam => beam_basis(&fk, f)?,
+        FlexKind::Panel => {
             let panel = f.panel.as_deref().ok_or_else(|| {
                 Error::input(
                     format!("{fk}.panel"),
@@ -269,19 +259,7 @@ pub(super) fn flexible_body(
                     "the name of a [[panels]] entry",
                 )
             })?;
-            if let Some(d) = f.derivatives.as_deref() {
-                if d != "fixed" && d != "updated" {
-                    return Err(Error::input(
-                        format!("{fk}.derivatives"),
-                        d,
-                        "fixed (Eq. 19) or updated (Eq. 18)",
-                    ));
-                }
-            }
-            panels(panel, f.modes, f.derivatives.as_deref())?
-        }
-        other => {
-            return Err(Error::input(format!("{fk}.kind"), other, "beam or panel"));
+            panels(panel, f.modes, f.derivatives(&fk)?)?
         }
     };
     basis.validate(&fk)?;
@@ -320,6 +298,38 @@ pub(super) fn flexible_body(
         fixed: false,
         flex: Some(flex),
     })
+}
+
+/// The closed-form cantilever basis of a `kind = "beam"` body (`fk` is
+/// the key of its `flexible` table), with the rotary inertia about the
+/// beam axis lumped like the mass.
+fn beam_basis(fk: &str, f: &FlexSpec) -> Result<ModalBasis> {
+    let get = |what: &str, v: Option<f64>| {
+        v.ok_or_else(|| Error::input(format!("{fk}.{what}"), "(missing)", "a beam property"))
+    };
+    let beam = Beam {
+        length: get("length", f.length)?,
+        ei_y: get("ei_y", f.ei_y)?,
+        ei_z: get("ei_z", f.ei_z)?,
+        rho_a: get("rho_a", f.rho_a)?,
+    };
+    beam.validate(fk)?;
+    let rho_ip = f.rho_ip.unwrap_or(0.0);
+    if !(rho_ip.is_finite() && rho_ip > 0.0) {
+        return Err(Error::input(
+            format!("{fk}.rho_ip"),
+            rho_ip,
+            "a polar mass moment per length > 0 (kg·m): the frame needs a rotary inertia about the beam axis",
+        ));
+    }
+    let mut b = beam
+        .basis(f.modes, Beam::segments_for(f.modes))?
+        .truncated(f.modes);
+    // Rotary inertia about the beam axis, lumped like the mass.
+    for (k, m) in b.node_mass.iter().enumerate() {
+        b.node_inertia[k].x = rho_ip * m / beam.rho_a;
+    }
+    Ok(b)
 }
 
 pub(super) fn initial_distance(model: &Model, i: usize, j: usize) -> f64 {

@@ -17,8 +17,9 @@
 //! therefore self-convergence, which the mesh study of the panel modes
 //! (`panel_convergence.toml`) complements with the frequencies.
 
-use super::simulate::{load_scene, simulate};
 use crate::error::{Error, Result};
+use crate::scene::load_scene;
+use crate::simulate::simulate;
 use crate::study::Study;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};

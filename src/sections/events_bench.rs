@@ -17,11 +17,11 @@
 //! Output: `events.csv` in the study's output folder (columns in
 //! [`headers`]); a failed case is a row with `status = failed: …`.
 
-use super::dynamics::System;
-use super::simulate::load_scene;
 use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Method, Options, Stats};
+use crate::mbs::System;
 use crate::mbs::{Force, Param};
+use crate::scene::load_scene;
 use crate::study::Study;
 use num_dual::Dual64;
 use serde::Deserialize;
@@ -59,7 +59,7 @@ fn run(sys: &System, y0: &[f64], opts: &Options, joint: usize, params: &[Param])
     let mut out = None;
     let n = y0.len();
     let final_values = |y: &[f64], s: &[f64]| {
-        let mut ws = super::Workspace::empty();
+        let mut ws = crate::mbs::Workspace::empty();
         let theta = sys.angle(y, joint, &mut ws).0;
         let dtheta = s
             .chunks(n)

@@ -1,0 +1,161 @@
+//! A study → [`Scene`]: the `[scene]` section with the modal bases of its
+//! panel bodies taken from the study's `[[panels]]`.
+//!
+//! [`load_scene`] builds one scene as the study file describes it.
+//! [`ScenePlan`] is the road of a design through the code: the section is
+//! parsed and the panels are resolved (mesh, design map) once; each
+//! [`BasisBuilder`] (sparsity pattern, symbolic factorization, element
+//! geometry) is made once per panel and derivative approach and reused for
+//! every later design; a design goes in as laminates (ply angles in rad,
+//! [`crate::laminate::Laminate::with_design`]), never as text. Builders
+//! are pooled, so one plan serves parallel evaluations: each evaluation
+//! takes a builder from the pool (or makes one when all are busy) and
+//! gives it back.
+
+use super::build::Scene;
+use super::spec::{FlexKind, SceneSpec};
+use crate::error::{Error, Result};
+use crate::fe::Panel;
+use crate::laminate::Laminate;
+use crate::mbs::ModalBasis;
+use crate::modal::ModeUpdate;
+use crate::panels::BasisBuilder;
+use crate::study::Study;
+use std::sync::Mutex;
+
+/// Read the `[scene]` section of a study and build it. Panel bodies take
+/// their modal basis from the study's `[[panels]]` (built only when the
+/// scene lists `flexibility`).
+pub fn load_scene(study: &Study) -> Result<Scene> {
+    let spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
+    let panels = |name: &str, modes: usize, update: Option<ModeUpdate>| {
+        crate::panels::basis_for_study(study, name, modes, update)
+    };
+    spec.build_with(&panels).map_err(study.locate("scene"))
+}
+
+/// A panel's basis builder for one derivative approach.
+struct Prepared {
+    panel: usize,
+    update: Option<ModeUpdate>,
+    builder: BasisBuilder,
+}
+
+/// A study's scene prepared for many designs (module doc).
+pub struct ScenePlan {
+    study: Study,
+    spec: SceneSpec,
+    panels: Vec<Panel>,
+    pool: Mutex<Vec<Prepared>>,
+}
+
+impl ScenePlan {
+    /// Parse `[scene]` and resolve `[[panels]]`. Errors name the file and
+    /// key; no basis is computed yet.
+    pub fn new(study: &Study) -> Result<ScenePlan> {
+        Ok(ScenePlan {
+            study: study.clone(),
+            spec: study.require_section("scene", "the multibody scene")?,
+            panels: crate::fe::panels_from_study(study)?,
+            pool: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// The `[scene]` section.
+    pub fn spec(&self) -> &SceneSpec {
+        &self.spec
+    }
+
+    /// The `[[panels]]` entries, in file order, with the study's lay-ups.
+    pub fn panels(&self) -> &[Panel] {
+        &self.panels
+    }
+
+    /// Names of the bodies whose basis is panel `panel`'s modes.
+    pub fn bodies_of_panel(&self, panel: &str) -> Vec<&str> {
+        self.spec
+            .bodies
+            .iter()
+            .filter(|b| {
+                b.flexible.as_ref().is_some_and(|f| {
+                    f.kind("").ok() == Some(FlexKind::Panel) && f.panel.as_deref() == Some(panel)
+                })
+            })
+            .map(|b| b.name.as_str())
+            .collect()
+    }
+
+    /// The scene with panel `i` laid up as `laminates[i]` (one per
+    /// `[[panels]]` entry, same ply count, angles in rad), the sensitivity
+    /// parameters `sensitivities` (names as in `[scene] sensitivities`) and,
+    /// with `outputs = false`, no output columns (responses need none).
+    pub fn build(
+        &self,
+        laminates: &[Laminate],
+        sensitivities: &[String],
+        outputs: bool,
+    ) -> Result<Scene> {
+        if laminates.len() != self.panels.len() {
+            return Err(Error::input(
+                "laminates",
+                laminates.len(),
+                format!("one laminate per [[panels]] entry ({})", self.panels.len()),
+            ));
+        }
+        let mut spec = self.spec.clone();
+        spec.sensitivities = sensitivities.to_vec();
+        if !outputs {
+            spec.outputs = Default::default();
+        }
+        let bases = |name: &str, modes: usize, update: Option<ModeUpdate>| {
+            self.basis(name, modes, update, laminates)
+        };
+        spec.build_with(&bases).map_err(self.study.locate("scene"))
+    }
+
+    /// The basis of panel `name` with lay-up `laminates[i]`, from a pooled
+    /// builder.
+    fn basis(
+        &self,
+        name: &str,
+        modes: usize,
+        update: Option<ModeUpdate>,
+        laminates: &[Laminate],
+    ) -> Result<ModalBasis> {
+        if modes == 0 {
+            return Err(Error::input("n_modes", 0, "at least 1 mode"));
+        }
+        let Some(i) = self.panels.iter().position(|p| p.name == name) else {
+            return Err(crate::panels::unknown_panel(
+                &self.study,
+                name,
+                &self.panels,
+            ));
+        };
+        let located = |e: Error| {
+            crate::panels::in_panel(e, name).in_file(&self.study.path, &format!("panels[{i}]"))
+        };
+        let taken = {
+            let mut pool = self.pool.lock().unwrap_or_else(|p| p.into_inner());
+            let k = pool.iter().position(|p| p.panel == i && p.update == update);
+            k.map(|k| pool.swap_remove(k))
+        };
+        let mut prepared = match taken {
+            Some(p) => p,
+            None => Prepared {
+                panel: i,
+                update,
+                builder: BasisBuilder::new(&self.panels[i], update).map_err(located)?,
+            },
+        };
+        let basis = prepared
+            .builder
+            .basis(&laminates[i], modes)
+            .map_err(located);
+        self.pool
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .push(prepared);
+        basis
+    }
+}

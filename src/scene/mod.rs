@@ -1,0 +1,67 @@
+//! Scenes: the `[scene]` section of a study file, from data to a
+//! multibody model.
+//!
+//! The stages: [`spec`] (the section as parsed, plain data),
+//! [`build`] (data → [`Scene`]: a [`crate::mbs::Model`] with integrator
+//! options, output plan and sensitivity parameters; [`parts`] holds its
+//! pieces), [`quantity`] (the output plan), and [`load`] (a study →
+//! scene, with the panels' modal bases; [`ScenePlan`] keeps everything
+//! that does not depend on the ply angles and takes a design as numbers).
+//!
+//! Where things go: a new joint type is a [`crate::mbs::JointKind`]
+//! variant (rows in `mbs::rows`), named in [`spec::JointType`] and built
+//! in [`build`]; a new output or response is a [`Quantity`] /
+//! [`Response`] variant parsed in [`parts`] and evaluated in
+//! [`crate::simulate`].
+//!
+//!
+//! ```toml
+//! [scene]
+//! effects = ["gravity", "actuators", "damping", "springs", "loads",
+//!            "flexibility", "quadratic_velocity"]   # what is not listed is not built
+//! gravity = [0.0, 0.0, -9.81]                       # m/s²
+//! baumgarte = 10.0                                  # 1/s
+//! sensitivities = ["forces[0].damping", "forces[0].segments[0].anchor", "B4.mass",
+//!                  "B3.design.theta_1_4"]            # ply angle of a flexible body
+//! [[scene.bodies]]
+//! name = "B4"; mass = 1.5; com = [1.2, 0.0, -0.3]   # kg, m (global, initial)
+//! inertia = [[..], [..], [..]]                      # kg·m², about com, global axes
+//! fixed = false; velocity = [..]; angular_velocity = [..]   # m/s, rad/s (global)
+//! [[scene.bodies]]                                  # floating-frame flexible body
+//! name = "B3"; mass, com, inertia                   # rigid stand-in without "flexibility"
+//! flexible = { kind = "panel", panel = "panel3", modes = 14, origin = [..],
+//!              x_axis = [..], y_axis = [..], derivatives = "updated", damping = 0.0 }
+//! # kind = "beam": length, ei_y, ei_z, rho_a, rho_ip (closed-form cantilever modes)
+//! [[scene.joints]]
+//! name = "R3"; type = "revolute"   # spherical | revolute | locked | driven | fixed
+//! body_i = "B12"; body_j = "B8"    # "ground" allowed
+//! point = [..]; axis = [..]; angle = 3.12   # global initial point, axis, θ0 (rad)
+//! drive = [c0, c1, ..]             # driven: θ(t) = Σ c_k t^k
+//! [[scene.markers]]  name, body, point       # extra points (springs, outputs)
+//! [[scene.forces]]
+//! type = "actuator"; joint = "R3"; damping = 0.5
+//! segments = [{ lower, upper, value, slope, anchor }, ..]  # Eq. 32
+//! type = "spring"; marker_i, marker_j, stiffness, damping, length
+//! type = "load"; body, force, torque       # or table = [[t, fx, fy, fz, tx, ty, tz], ..]
+//! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out, events = true
+//! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation",
+//!                                "B3.strain_energy", "B3.modal", "<marker>.deflection"]
+//!                  plot = "R3.angle"; plot_file = "theta"   # theta.svg
+//! ```
+//! Rigid bodies start with their axes along the global axes, so `inertia`
+//! is both the global and the body-frame tensor at `t = 0`. A flexible
+//! body's frame is its basis frame (the beam's root, the panel's centre),
+//! placed at `origin` with its x and y axes along `x_axis`, `y_axis`;
+//! points on it (joints, markers) must be nodes of its basis.
+
+pub mod build;
+pub mod load;
+pub mod parts;
+pub mod quantity;
+pub mod spec;
+
+pub use build::Scene;
+pub use load::{load_scene, ScenePlan};
+pub use parts::PanelBases;
+pub use quantity::{Quantity, Response};
+pub use spec::SceneSpec;

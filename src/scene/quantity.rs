@@ -1,0 +1,82 @@
+//! The output plan of a scene: output columns ([`Quantity`]) and
+//! response functionals ([`Response`]) resolved to model indices.
+
+/// A built response: the bodies whose strain energies it sums.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Response {
+    /// `∫ scale·ΣU dt`: index into [`Model::integrals`].
+    Integral { name: String, index: usize },
+    /// `max_t scale·ΣU(t)`.
+    Peak {
+        name: String,
+        bodies: Vec<usize>,
+        scale: f64,
+    },
+}
+
+impl Response {
+    /// The response's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Response::Integral { name, .. } | Response::Peak { name, .. } => name,
+        }
+    }
+}
+
+/// One output column.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Quantity {
+    Angle(usize),
+    Rate(usize),
+    /// Reaction force (3) and torque (3) of a joint.
+    Reaction(usize),
+    /// Global position of a body's centre of mass (of a flexible body:
+    /// of its frame origin).
+    Position(usize),
+    /// Modal coordinates `w` of a flexible body (body, n: n columns).
+    Modal(usize, usize),
+    /// Strain energy `½ wᵀΛw` of a flexible body (J).
+    Strain(usize),
+    /// Elastic displacement `Φ_k w` of a marker on a flexible node, in
+    /// the body's frame axes (m).
+    Deflection(usize),
+    Energy,
+    Violation,
+}
+
+impl Quantity {
+    /// CSV column headers with SI units.
+    pub fn headers(&self, label: &str) -> Vec<String> {
+        match self {
+            Quantity::Angle(_) => vec![format!("{label} [rad]")],
+            Quantity::Rate(_) => vec![format!("{label} [rad/s]")],
+            Quantity::Reaction(_) => {
+                let base = label.trim_end_matches(".reaction");
+                let mut h: Vec<String> = ["x", "y", "z"]
+                    .iter()
+                    .map(|c| format!("{base}.force_{c} [N]"))
+                    .collect();
+                h.extend(
+                    ["x", "y", "z"]
+                        .iter()
+                        .map(|c| format!("{base}.torque_{c} [N*m]")),
+                );
+                h
+            }
+            Quantity::Position(_) => ["x", "y", "z"]
+                .iter()
+                .map(|c| format!("{label}_{c} [m]"))
+                .collect(),
+            Quantity::Modal(_, n) => (1..=*n)
+                .map(|j| format!("{label}_{j} [kg^0.5*m]"))
+                .collect(),
+            Quantity::Strain(_) => vec![format!("{label} [J]")],
+            Quantity::Deflection(_) => ["x", "y", "z"]
+                .iter()
+                .map(|c| format!("{label}_{c} [m]"))
+                .collect(),
+            Quantity::Energy => vec!["energy [J]".into()],
+            Quantity::Violation => vec!["violation [m|rad]".into()],
+        }
+    }
+}

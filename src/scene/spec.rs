@@ -1,0 +1,282 @@
+//! The `[scene]` section as parsed from a study file: plain data checked
+//! by serde (unknown keys refused), validated and turned into a model by
+//! [`super::build`].
+
+use crate::error::{Error, Result};
+use crate::integrate::Method;
+use crate::modal::ModeUpdate;
+use serde::Deserialize;
+
+/// Effects a scene may list.
+pub const EFFECTS: [&str; 7] = [
+    "gravity",
+    "actuators",
+    "damping",
+    "springs",
+    "loads",
+    "flexibility",
+    "quadratic_velocity",
+];
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    pub effects: Vec<String>,
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 3],
+    #[serde(default = "default_baumgarte")]
+    pub baumgarte: f64,
+    pub bodies: Vec<BodySpec>,
+    #[serde(default)]
+    pub joints: Vec<JointSpec>,
+    #[serde(default)]
+    pub markers: Vec<MarkerSpec>,
+    #[serde(default)]
+    pub forces: Vec<ForceSpec>,
+    pub integrator: IntegratorSpec,
+    #[serde(default)]
+    pub outputs: OutputSpec,
+    /// Parameters for forward sensitivities of the outputs:
+    /// `"<body>.mass"`, `"forces[i].stiffness"`, `"forces[i].damping"`,
+    /// `"forces[i].segments[k].anchor"` (indices as in `scene.forces`).
+    #[serde(default)]
+    pub sensitivities: Vec<String>,
+    /// Functionals of the motion over time (objective and constraints of
+    /// an optimization): `[[scene.responses]]`.
+    #[serde(default)]
+    pub responses: Vec<ResponseSpec>,
+}
+
+/// `[[scene.responses]] name = "psi0"; kind = "integral" | "peak";
+/// of = ["B2.strain_energy", ..]; scale = 2.0`: the time integral (as an
+/// extra integrated state) or the largest value over the run (located
+/// from dense output) of `scale · Σ` the listed strain energies.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ResponseSpec {
+    pub name: String,
+    pub kind: String,
+    pub of: Vec<String>,
+    #[serde(default = "one")]
+    pub scale: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn default_gravity() -> [f64; 3] {
+    [0.0, 0.0, -9.81]
+}
+/// Baumgarte rate default: 10 1/s damps drift within ~0.5 s, slower than
+/// the mechanisms' dynamics of interest yet far from making them stiff.
+fn default_baumgarte() -> f64 {
+    10.0
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    pub name: String,
+    /// Rigid mass properties: required for rigid bodies, and for flexible
+    /// ones when the scene does not list `flexibility` (then they are
+    /// simulated rigid).
+    pub mass: Option<f64>,
+    pub com: Option<[f64; 3]>,
+    pub inertia: Option<[[f64; 3]; 3]>,
+    #[serde(default)]
+    pub fixed: bool,
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(default)]
+    pub angular_velocity: [f64; 3],
+    /// A floating-frame flexible body (used when `flexibility` is listed).
+    pub flexible: Option<FlexSpec>,
+}
+
+/// `flexible = { kind = "beam" | "panel", modes, origin, .. }`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlexSpec {
+    /// `beam` (closed-form cantilever modes) or `panel` (finite element
+    /// modes of a `[[panels]]` entry), as written; [`FlexSpec::kind`]
+    /// gives the [`FlexKind`].
+    #[serde(rename = "kind")]
+    pub kind_name: String,
+    /// Number of modes kept.
+    pub modes: usize,
+    /// Global position of the basis frame's origin at t = 0 (m): the
+    /// beam's root, the panel's centre.
+    pub origin: [f64; 3],
+    /// Global directions of the basis frame's x and y axes at t = 0.
+    #[serde(default = "unit_x")]
+    pub x_axis: [f64; 3],
+    #[serde(default = "unit_y")]
+    pub y_axis: [f64; 3],
+    /// Modal damping ratio ζ of every mode (with the `damping` effect).
+    #[serde(default)]
+    pub damping: f64,
+    /// Beam: length (m), bending stiffnesses for deflection along y
+    /// (`ei_z`) and z (`ei_y`) (N·m²), mass per length (kg/m), polar mass
+    /// moment per length (kg·m, rotary inertia about the beam axis).
+    pub length: Option<f64>,
+    pub ei_y: Option<f64>,
+    pub ei_z: Option<f64>,
+    pub rho_a: Option<f64>,
+    pub rho_ip: Option<f64>,
+    /// Panel: the `name` of a `[[panels]]` entry of the study.
+    pub panel: Option<String>,
+    /// Panel: design derivatives of the modes for ply-angle sensitivities,
+    /// `fixed` (Eq. 19) or `updated` (Eq. 18), as written;
+    /// [`FlexSpec::derivatives`] gives the [`ModeUpdate`].
+    #[serde(rename = "derivatives")]
+    pub derivatives_name: Option<String>,
+}
+
+/// Where a flexible body's modes come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FlexKind {
+    /// Closed-form Euler–Bernoulli cantilever modes ([`crate::mbs::beam`]).
+    Beam,
+    /// Finite element modes of a `[[panels]]` entry ([`crate::panels`]).
+    Panel,
+}
+
+impl FlexSpec {
+    /// The kind; an unknown name is an input error on `<key>.kind`.
+    pub fn kind(&self, key: &str) -> Result<FlexKind> {
+        match self.kind_name.as_str() {
+            "beam" => Ok(FlexKind::Beam),
+            "panel" => Ok(FlexKind::Panel),
+            other => Err(Error::input(format!("{key}.kind"), other, "beam or panel")),
+        }
+    }
+
+    /// The derivative approach of a panel body (None: no derivatives); an
+    /// unknown name is an input error on `<key>.derivatives`.
+    pub fn derivatives(&self, key: &str) -> Result<Option<ModeUpdate>> {
+        match self.derivatives_name.as_deref() {
+            None => Ok(None),
+            Some(d) => ModeUpdate::parse(d).map(Some).ok_or_else(|| {
+                Error::input(
+                    format!("{key}.derivatives"),
+                    d,
+                    "fixed (Eq. 19) or updated (Eq. 18)",
+                )
+            }),
+        }
+    }
+}
+
+fn unit_x() -> [f64; 3] {
+    [1.0, 0.0, 0.0]
+}
+fn unit_y() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub body_i: String,
+    pub body_j: String,
+    pub point: [f64; 3],
+    pub axis: Option<[f64; 3]>,
+    #[serde(default)]
+    pub angle: f64,
+    pub drive: Option<Vec<f64>>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MarkerSpec {
+    pub name: String,
+    pub body: String,
+    pub point: [f64; 3],
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SegmentSpec {
+    pub lower: f64,
+    pub upper: f64,
+    pub value: f64,
+    #[serde(default)]
+    pub slope: f64,
+    #[serde(default)]
+    pub anchor: f64,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, tag = "type", rename_all = "lowercase")]
+#[allow(clippy::large_enum_variant)]
+pub enum ForceSpec {
+    Actuator {
+        joint: String,
+        #[serde(default)]
+        damping: f64,
+        #[serde(default)]
+        segments: Vec<SegmentSpec>,
+    },
+    Spring {
+        marker_i: String,
+        marker_j: String,
+        stiffness: f64,
+        #[serde(default)]
+        damping: f64,
+        length: Option<f64>,
+    },
+    Load {
+        body: String,
+        #[serde(default)]
+        force: [f64; 3],
+        #[serde(default)]
+        torque: [f64; 3],
+        /// Time table `[[t, fx, fy, fz, tx, ty, tz], ..]` (s, N, N·m),
+        /// linear between rows; replaces `force` and `torque`.
+        table: Option<Vec<[f64; 7]>>,
+    },
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSpec {
+    #[serde(default = "default_method")]
+    pub method: Method,
+    #[serde(default = "default_rtol")]
+    pub rtol: f64,
+    #[serde(default = "default_atol")]
+    pub atol: f64,
+    pub t_end: f64,
+    pub dt_out: f64,
+    /// Segment changes of actuator laws as integration events
+    /// ([`crate::integrate::Options::events`], default `true`).
+    #[serde(default = "default_events")]
+    pub events: bool,
+}
+fn default_events() -> bool {
+    true
+}
+fn default_method() -> Method {
+    Method::Bdf
+}
+fn default_rtol() -> f64 {
+    1e-6
+}
+fn default_atol() -> f64 {
+    1e-8
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    #[serde(default)]
+    pub quantities: Vec<String>,
+    pub plot: Option<String>,
+    /// File stem of the plot (default: the plotted output's name), e.g.
+    /// `theta` for `theta.svg`.
+    pub plot_file: Option<String>,
+}

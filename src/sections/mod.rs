@@ -1,0 +1,12 @@
+//! Study sections that measure rather than model: the kernel benchmark
+//! (`[kernel_bench]`), the Eq. 32 events benchmark (`[events_bench]`) and
+//! the flexible-scene convergence grid (`[scene_convergence]`). Each
+//! reads its section, runs scenes through [`crate::scene`] and
+//! [`crate::simulate`], and writes its table through [`crate::report`].
+//!
+//! A new study section goes here: a file with its serde spec, a `run_*`
+//! entry point called from [`crate::cli`], and its writer.
+
+pub mod events_bench;
+pub mod kernel_bench;
+pub mod scene_convergence;
