@@ -8,7 +8,7 @@ use super::parts::{
     PanelBases,
 };
 use super::quantity::{Quantity, Response};
-use super::spec::{ForceSpec, SceneSpec, EFFECTS};
+use super::spec::{ForceSpec, JointSpec, SceneSpec, SegmentSpec, EFFECTS};
 use crate::error::{Error, Result};
 use crate::integrate::Options;
 use crate::mbs::model::{
@@ -50,6 +50,45 @@ impl SceneSpec {
     /// Build the model; `panels` supplies the bases of panel bodies (only
     /// called when the scene lists `flexibility`).
     pub fn build_with(&self, panels: PanelBases) -> Result<Scene> {
+        self.check_settings()?;
+        let mut model = Model {
+            baumgarte: self.baumgarte,
+            quadratic_velocity: self.has("quadratic_velocity"),
+            ..Model::default()
+        };
+        self.add_bodies(&mut model, panels)?;
+        self.add_markers(&mut model)?;
+        self.add_joints(&mut model)?;
+        let force_index = self.add_forces(&mut model)?;
+        let options = self.options()?;
+        let flex_names: Vec<&str> = self
+            .bodies
+            .iter()
+            .filter(|b| b.flexible.is_some())
+            .map(|b| b.name.as_str())
+            .collect();
+        let outputs = self.outputs(&model, &flex_names)?;
+        let responses = self.responses(&mut model, &flex_names)?;
+        let params = self.params(&model, &force_index)?;
+        Ok(Scene {
+            model,
+            options,
+            outputs,
+            plot: self.outputs.plot.clone(),
+            plot_file: self.outputs.plot_file.clone(),
+            effects: self.effects.clone(),
+            params,
+            responses,
+        })
+    }
+
+    /// Whether the scene lists effect `e`.
+    fn has(&self, e: &str) -> bool {
+        self.effects.iter().any(|x| x == e)
+    }
+
+    /// Known effects and a valid Baumgarte rate.
+    fn check_settings(&self) -> Result<()> {
         for (k, e) in self.effects.iter().enumerate() {
             if !EFFECTS.contains(&e.as_str()) {
                 return Err(Error::input(
@@ -59,7 +98,6 @@ impl SceneSpec {
                 ));
             }
         }
-        let has = |e: &str| self.effects.iter().any(|x| x == e);
         if !(self.baumgarte >= 0.0 && self.baumgarte.is_finite()) {
             return Err(Error::input(
                 "baumgarte",
@@ -67,11 +105,12 @@ impl SceneSpec {
                 "a finite rate ≥ 0 (1/s)",
             ));
         }
-        let mut model = Model {
-            baumgarte: self.baumgarte,
-            quadratic_velocity: has("quadratic_velocity"),
-            ..Model::default()
-        };
+        Ok(())
+    }
+
+    /// Rigid bodies, and flexible ones (with `flexibility`) whose bases
+    /// come from `panels` or the closed-form beam.
+    fn add_bodies(&self, model: &mut Model, panels: PanelBases) -> Result<()> {
         for (k, b) in self.bodies.iter().enumerate() {
             let key = format!("bodies[{k}]");
             if model.body(&b.name).is_some() || b.name == "ground" {
@@ -81,7 +120,7 @@ impl SceneSpec {
                     "a unique body name other than 'ground'",
                 ));
             }
-            let mut body = match (&b.flexible, has("flexibility")) {
+            let mut body = match (&b.flexible, self.has("flexibility")) {
                 (Some(f), true) => {
                     if b.fixed {
                         return Err(Error::input(
@@ -90,7 +129,7 @@ impl SceneSpec {
                             "a moving body (a fixed body cannot be flexible)",
                         ));
                     }
-                    flexible_body(&key, &b.name, f, has("damping"), panels)?
+                    flexible_body(&key, &b.name, f, self.has("damping"), panels)?
                 }
                 _ => {
                     let need = |what: &str| {
@@ -98,7 +137,7 @@ impl SceneSpec {
                             format!("{key}.{what}"),
                             "(missing)",
                             "mass, com and inertia of a rigid body (or a `flexible` table \
-                             with `flexibility` in scene.effects)",
+                         with `flexibility` in scene.effects)",
                         )
                     };
                     let mass = b.mass.ok_or_else(|| need("mass"))?;
@@ -114,24 +153,17 @@ impl SceneSpec {
                 * finite3(format!("{key}.angular_velocity"), b.angular_velocity)?;
             model.bodies.push(body);
         }
-        let find_body = |key: String, name: &str, model: &Model| -> Result<Option<usize>> {
-            if name == "ground" {
-                return Ok(None);
-            }
-            model.body(name).map(Some).ok_or_else(|| {
-                Error::input(
-                    key,
-                    name,
-                    "the name of a body in scene.bodies, or \"ground\"",
-                )
-            })
-        };
+        Ok(())
+    }
+
+    /// Extra markers (`[[scene.markers]]`).
+    fn add_markers(&self, model: &mut Model) -> Result<()> {
         for (k, m) in self.markers.iter().enumerate() {
             let key = format!("markers[{k}]");
-            let body = find_body(format!("{key}.body"), &m.body, &model)?;
+            let body = find_body(format!("{key}.body"), &m.body, model)?;
             let p = finite3(format!("{key}.point"), m.point)?;
             let mk = make_marker(
-                &model,
+                model,
                 &format!("{key}.point"),
                 (&m.name, body),
                 p,
@@ -139,10 +171,15 @@ impl SceneSpec {
             )?;
             model.markers.push(mk);
         }
+        Ok(())
+    }
+
+    /// Joints with their two markers each.
+    fn add_joints(&self, model: &mut Model) -> Result<()> {
         for (k, j) in self.joints.iter().enumerate() {
             let key = format!("joints[{k}]");
-            let bi = find_body(format!("{key}.body_i"), &j.body_i, &model)?;
-            let bj = find_body(format!("{key}.body_j"), &j.body_j, &model)?;
+            let bi = find_body(format!("{key}.body_i"), &j.body_i, model)?;
+            let bj = find_body(format!("{key}.body_j"), &j.body_j, model)?;
             if bi == bj {
                 return Err(Error::input(
                     format!("{key}.body_j"),
@@ -151,56 +188,8 @@ impl SceneSpec {
                 ));
             }
             let point = finite3(format!("{key}.point"), j.point)?;
-            let kind = match j.kind.as_str() {
-                "spherical" => JointKind::Spherical,
-                "revolute" => JointKind::Revolute,
-                "fixed" => JointKind::Fixed,
-                "locked" => JointKind::Driven(Drive {
-                    coefficients: vec![j.angle],
-                }),
-                "driven" => match &j.drive {
-                    Some(c) if !c.is_empty() && c.iter().all(|v| v.is_finite()) => {
-                        JointKind::Driven(Drive {
-                            coefficients: c.clone(),
-                        })
-                    }
-                    other => {
-                        return Err(Error::input(
-                            format!("{key}.drive"),
-                            format!("{other:?}"),
-                            "polynomial coefficients [c0, c1, ..] of θ(t) (rad, s)",
-                        ))
-                    }
-                },
-                other => {
-                    return Err(Error::input(
-                        format!("{key}.type"),
-                        other,
-                        "spherical, revolute, locked, driven or fixed",
-                    ))
-                }
-            };
-            let axis = match (&kind, j.axis) {
-                (JointKind::Spherical, _) => Vector3::z(),
-                (_, Some(a)) => {
-                    let a = finite3(format!("{key}.axis"), a)?;
-                    if a.norm() < 1e-12 {
-                        return Err(Error::input(
-                            format!("{key}.axis"),
-                            format!("{:?}", j.axis.unwrap_or_default()),
-                            "a non-zero axis vector",
-                        ));
-                    }
-                    a
-                }
-                (_, None) => {
-                    return Err(Error::input(
-                        format!("{key}.axis"),
-                        "(missing)",
-                        "an axis vector for this joint type",
-                    ))
-                }
-            };
+            let kind = joint_kind(&key, j)?;
+            let axis = joint_axis(&key, j, &kind)?;
             if !j.angle.is_finite() || j.angle.abs() >= std::f64::consts::PI {
                 return Err(Error::input(
                     format!("{key}.angle"),
@@ -212,8 +201,8 @@ impl SceneSpec {
             let fj = axis_angle(&axis.normalize(), j.angle) * fi;
             let n = model.markers.len();
             let pk = format!("{key}.point");
-            let mi = make_marker(&model, &pk, (&format!("{}.i", j.name), bi), point, fi)?;
-            let mj = make_marker(&model, &pk, (&format!("{}.j", j.name), bj), point, fj)?;
+            let mi = make_marker(model, &pk, (&format!("{}.i", j.name), bi), point, fi)?;
+            let mj = make_marker(model, &pk, (&format!("{}.j", j.name), bj), point, fj)?;
             model.markers.push(mi);
             model.markers.push(mj);
             if model.joint(&j.name).is_some() {
@@ -230,7 +219,13 @@ impl SceneSpec {
                 j: n + 1,
             });
         }
-        if has("gravity") {
+        Ok(())
+    }
+
+    /// Gravity and the `[[scene.forces]]` the effects list builds;
+    /// returns the model index of each scene force (None: not built).
+    fn add_forces(&self, model: &mut Model) -> Result<Vec<Option<usize>>> {
+        if self.has("gravity") {
             model.forces.push(Force::Gravity {
                 g: finite3("gravity".into(), self.gravity)?,
             });
@@ -239,132 +234,173 @@ impl SceneSpec {
         let mut force_index: Vec<Option<usize>> = vec![None; self.forces.len()];
         for (k, f) in self.forces.iter().enumerate() {
             let key = format!("forces[{k}]");
-            match f {
+            let built = match f {
                 ForceSpec::Actuator {
                     joint,
                     damping,
                     segments,
-                } => {
-                    let jt = model.joint(joint).ok_or_else(|| {
-                        Error::input(
-                            format!("{key}.joint"),
-                            joint,
-                            "the name of a joint in scene.joints",
-                        )
-                    })?;
-                    if !model.joints[jt].kind.has_angle()
-                        || matches!(model.joints[jt].kind, JointKind::Driven(_))
-                    {
-                        return Err(Error::input(
-                            format!("{key}.joint"),
-                            joint,
-                            "a free revolute joint",
-                        ));
-                    }
-                    if !(damping.is_finite() && *damping >= 0.0) {
-                        return Err(Error::input(
-                            format!("{key}.damping"),
-                            damping,
-                            "a finite damping ≥ 0 (N·m·s)",
-                        ));
-                    }
-                    let law = if has("actuators") && !segments.is_empty() {
-                        let segs = segments
-                            .iter()
-                            .map(|s| Segment {
-                                lower: s.lower,
-                                upper: s.upper,
-                                value: s.value,
-                                slope: s.slope,
-                                anchor: s.anchor,
-                            })
-                            .collect();
-                        Some(PiecewiseLaw::new(&format!("{key}.segments"), segs)?)
-                    } else {
-                        None
-                    };
-                    let c = if has("damping") { *damping } else { 0.0 };
-                    if law.is_some() || c != 0.0 {
-                        force_index[k] = Some(model.forces.len());
-                        model.forces.push(Force::Rotational {
-                            joint: jt,
-                            law,
-                            damping: c,
-                        });
-                    }
-                }
+                } => self.actuator(model, &key, joint, *damping, segments)?,
                 ForceSpec::Spring {
                     marker_i,
                     marker_j,
                     stiffness,
                     damping,
                     length,
-                } => {
-                    let find = |key: String, name: &str| {
-                        model.marker(name).ok_or_else(|| {
-                            Error::input(key, name, "the name of a marker in scene.markers")
-                        })
-                    };
-                    let i = find(format!("{key}.marker_i"), marker_i)?;
-                    let j = find(format!("{key}.marker_j"), marker_j)?;
-                    let l0 = initial_distance(&model, i, j);
-                    let length = length.unwrap_or(l0);
-                    for (name, v) in [
-                        ("stiffness", *stiffness),
-                        ("damping", *damping),
-                        ("length", length),
-                    ] {
-                        if !(v.is_finite() && v >= 0.0) {
-                            return Err(Error::input(
-                                format!("{key}.{name}"),
-                                v,
-                                "a finite value ≥ 0",
-                            ));
-                        }
-                    }
-                    if l0 < 1e-9 {
-                        return Err(Error::input(
-                            format!("{key}.marker_j"),
-                            marker_j,
-                            "a point distinct from marker_i",
-                        ));
-                    }
-                    if !has("springs") {
-                        continue;
-                    }
-                    let c = if has("damping") { *damping } else { 0.0 };
-                    force_index[k] = Some(model.forces.len());
-                    model.forces.push(Force::SpringDamper {
-                        i,
-                        j,
-                        stiffness: *stiffness,
-                        damping: c,
-                        length,
-                    });
-                }
+                } => self.spring(
+                    model,
+                    &key,
+                    [marker_i, marker_j],
+                    [*stiffness, *damping],
+                    *length,
+                )?,
                 ForceSpec::Load {
                     body,
                     force,
                     torque,
                     table,
-                } => {
-                    let b = find_body(format!("{key}.body"), body, &model)?.ok_or_else(|| {
-                        Error::input(format!("{key}.body"), body, "a body (not ground)")
-                    })?;
-                    let force = finite3(format!("{key}.force"), *force)?;
-                    let torque = finite3(format!("{key}.torque"), *torque)?;
-                    let load = match table {
-                        None => Load::Constant { force, torque },
-                        Some(rows) => Load::Table(load_table(&format!("{key}.table"), rows)?),
-                    };
-                    if !has("loads") {
-                        continue;
-                    }
-                    force_index[k] = Some(model.forces.len());
-                    model.forces.push(Force::BodyLoad { body: b, load });
-                }
+                } => self.load(model, &key, body, [*force, *torque], table.as_deref())?,
+            };
+            if let Some(force) = built {
+                force_index[k] = Some(model.forces.len());
+                model.forces.push(force);
             }
         }
+        Ok(force_index)
+    }
+
+    /// The Eq. 32 spring-damper-actuator of a revolute joint (None when
+    /// the effects build neither its law nor its damping).
+    fn actuator(
+        &self,
+        model: &Model,
+        key: &str,
+        joint: &str,
+        damping: f64,
+        segments: &[SegmentSpec],
+    ) -> Result<Option<Force>> {
+        let jt = model.joint(joint).ok_or_else(|| {
+            Error::input(
+                format!("{key}.joint"),
+                joint,
+                "the name of a joint in scene.joints",
+            )
+        })?;
+        if !model.joints[jt].kind.has_angle()
+            || matches!(model.joints[jt].kind, JointKind::Driven(_))
+        {
+            return Err(Error::input(
+                format!("{key}.joint"),
+                joint,
+                "a free revolute joint",
+            ));
+        }
+        if !(damping.is_finite() && damping >= 0.0) {
+            return Err(Error::input(
+                format!("{key}.damping"),
+                damping,
+                "a finite damping ≥ 0 (N·m·s)",
+            ));
+        }
+        let law = if self.has("actuators") && !segments.is_empty() {
+            let segs = segments
+                .iter()
+                .map(|s| Segment {
+                    lower: s.lower,
+                    upper: s.upper,
+                    value: s.value,
+                    slope: s.slope,
+                    anchor: s.anchor,
+                })
+                .collect();
+            Some(PiecewiseLaw::new(&format!("{key}.segments"), segs)?)
+        } else {
+            None
+        };
+        let c = if self.has("damping") { damping } else { 0.0 };
+        Ok((law.is_some() || c != 0.0).then_some(Force::Rotational {
+            joint: jt,
+            law,
+            damping: c,
+        }))
+    }
+
+    /// A linear spring-damper between two markers (None without the
+    /// `springs` effect); the rest length defaults to the initial distance.
+    fn spring(
+        &self,
+        model: &Model,
+        key: &str,
+        [marker_i, marker_j]: [&String; 2],
+        [stiffness, damping]: [f64; 2],
+        length: Option<f64>,
+    ) -> Result<Option<Force>> {
+        let find = |key: String, name: &str| {
+            model
+                .marker(name)
+                .ok_or_else(|| Error::input(key, name, "the name of a marker in scene.markers"))
+        };
+        let i = find(format!("{key}.marker_i"), marker_i)?;
+        let j = find(format!("{key}.marker_j"), marker_j)?;
+        let l0 = initial_distance(model, i, j);
+        let length = length.unwrap_or(l0);
+        for (name, v) in [
+            ("stiffness", stiffness),
+            ("damping", damping),
+            ("length", length),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::input(
+                    format!("{key}.{name}"),
+                    v,
+                    "a finite value ≥ 0",
+                ));
+            }
+        }
+        if l0 < 1e-9 {
+            return Err(Error::input(
+                format!("{key}.marker_j"),
+                marker_j,
+                "a point distinct from marker_i",
+            ));
+        }
+        if !self.has("springs") {
+            return Ok(None);
+        }
+        let c = if self.has("damping") { damping } else { 0.0 };
+        Ok(Some(Force::SpringDamper {
+            i,
+            j,
+            stiffness,
+            damping: c,
+            length,
+        }))
+    }
+
+    /// A constant or tabulated load at a body's centre of mass (None
+    /// without the `loads` effect).
+    fn load(
+        &self,
+        model: &Model,
+        key: &str,
+        body: &str,
+        [force, torque]: [[f64; 3]; 2],
+        table: Option<&[[f64; 7]]>,
+    ) -> Result<Option<Force>> {
+        let b = find_body(format!("{key}.body"), body, model)?
+            .ok_or_else(|| Error::input(format!("{key}.body"), body, "a body (not ground)"))?;
+        let force = finite3(format!("{key}.force"), force)?;
+        let torque = finite3(format!("{key}.torque"), torque)?;
+        let load = match table {
+            None => Load::Constant { force, torque },
+            Some(rows) => Load::Table(load_table(&format!("{key}.table"), rows)?),
+        };
+        Ok(self
+            .has("loads")
+            .then_some(Force::BodyLoad { body: b, load }))
+    }
+
+    /// Integrator options with the output times `0, dt_out, .., t_end`.
+    fn options(&self) -> Result<Options> {
         let it = &self.integrator;
         if !(it.dt_out > 0.0 && it.dt_out.is_finite()) {
             return Err(Error::input(
@@ -397,21 +433,20 @@ impl SceneSpec {
             events: it.events,
         };
         options.validate()?;
-        let flex_names: Vec<&str> = self
-            .bodies
-            .iter()
-            .filter(|b| b.flexible.is_some())
-            .map(|b| b.name.as_str())
-            .collect();
+        Ok(options)
+    }
+
+    /// Output columns, the plotted output and its file stem.
+    fn outputs(&self, model: &Model, flex_names: &[&str]) -> Result<Vec<(String, Quantity)>> {
         let mut outputs = Vec::new();
         for (k, q) in self.outputs.quantities.iter().enumerate() {
             outputs.push((
                 q.clone(),
-                parse_quantity(&model, &flex_names, &format!("outputs.quantities[{k}]"), q)?,
+                parse_quantity(model, flex_names, &format!("outputs.quantities[{k}]"), q)?,
             ));
         }
         if let Some(p) = &self.outputs.plot {
-            match parse_quantity(&model, &flex_names, "outputs.plot", p)? {
+            match parse_quantity(model, flex_names, "outputs.plot", p)? {
                 Quantity::Angle(_) | Quantity::Rate(_) | Quantity::Energy | Quantity::Violation => {
                 }
                 _ => {
@@ -437,17 +472,21 @@ impl SceneSpec {
                 ));
             }
         }
-        let responses = self.responses(&mut model, &flex_names)?;
+        Ok(outputs)
+    }
+
+    /// Sensitivity parameters by name (`[scene] sensitivities`).
+    fn params(&self, model: &Model, force_index: &[Option<usize>]) -> Result<Vec<(String, Param)>> {
         let mut params = Vec::new();
         for (k, name) in self.sensitivities.iter().enumerate() {
             let key = format!("sensitivities[{k}]");
-            let p = parse_param(&model, &self.forces, &force_index, name).ok_or_else(|| {
+            let p = parse_param(model, &self.forces, force_index, name).ok_or_else(|| {
                 Error::input(
                     &key,
                     name,
                     "<body>.mass (rigid body), <body>.design.<variable> (flexible body), \
-                     forces[i].stiffness, forces[i].damping or \
-                     forces[i].segments[k].anchor of a force the effects list builds",
+                 forces[i].stiffness, forces[i].damping or \
+                 forces[i].segments[k].anchor of a force the effects list builds",
                 )
             })?;
             if params.iter().any(|(_, q)| *q == p) {
@@ -455,16 +494,7 @@ impl SceneSpec {
             }
             params.push((name.clone(), p));
         }
-        Ok(Scene {
-            model,
-            options,
-            outputs,
-            plot: self.outputs.plot.clone(),
-            plot_file: self.outputs.plot_file.clone(),
-            effects: self.effects.clone(),
-            params,
-            responses,
-        })
+        Ok(params)
     }
 
     /// Build `[[scene.responses]]` (integrals become model states).
@@ -535,4 +565,77 @@ impl SceneSpec {
         }
         Ok(out)
     }
+}
+
+/// A body by name: `None` for `"ground"`; an unknown name is an input
+/// error on `key`.
+fn find_body(key: String, name: &str, model: &Model) -> Result<Option<usize>> {
+    if name == "ground" {
+        return Ok(None);
+    }
+    model.body(name).map(Some).ok_or_else(|| {
+        Error::input(
+            key,
+            name,
+            "the name of a body in scene.bodies, or \"ground\"",
+        )
+    })
+}
+
+/// The joint kind of `[[scene.joints]]` entry `j` (`key` = `joints[k]`).
+fn joint_kind(key: &str, j: &JointSpec) -> Result<JointKind> {
+    Ok(match j.kind.as_str() {
+        "spherical" => JointKind::Spherical,
+        "revolute" => JointKind::Revolute,
+        "fixed" => JointKind::Fixed,
+        "locked" => JointKind::Driven(Drive {
+            coefficients: vec![j.angle],
+        }),
+        "driven" => match &j.drive {
+            Some(c) if !c.is_empty() && c.iter().all(|v| v.is_finite()) => {
+                JointKind::Driven(Drive {
+                    coefficients: c.clone(),
+                })
+            }
+            other => {
+                return Err(Error::input(
+                    format!("{key}.drive"),
+                    format!("{other:?}"),
+                    "polynomial coefficients [c0, c1, ..] of θ(t) (rad, s)",
+                ))
+            }
+        },
+        other => {
+            return Err(Error::input(
+                format!("{key}.type"),
+                other,
+                "spherical, revolute, locked, driven or fixed",
+            ))
+        }
+    })
+}
+
+/// The unit-free axis of joint `j` (any vector for a spherical joint).
+fn joint_axis(key: &str, j: &JointSpec, kind: &JointKind) -> Result<Vector3<f64>> {
+    Ok(match (kind, j.axis) {
+        (JointKind::Spherical, _) => Vector3::z(),
+        (_, Some(a)) => {
+            let a = finite3(format!("{key}.axis"), a)?;
+            if a.norm() < 1e-12 {
+                return Err(Error::input(
+                    format!("{key}.axis"),
+                    format!("{:?}", j.axis.unwrap_or_default()),
+                    "a non-zero axis vector",
+                ));
+            }
+            a
+        }
+        (_, None) => {
+            return Err(Error::input(
+                format!("{key}.axis"),
+                "(missing)",
+                "an axis vector for this joint type",
+            ))
+        }
+    })
 }
