@@ -21,8 +21,8 @@
 use super::assembly::{PanelModel, Support};
 use super::mesh::{Mesh, MeshParams};
 use crate::error::{Error, Result};
-use crate::laminate::spec::resolve_laminate;
-use crate::laminate::{DesignMap, Laminate, MaterialSpec, PlySpec};
+use crate::laminate::spec::{resolve_laminate, MaterialSpec, PlySpec};
+use crate::laminate::{DesignMap, Laminate};
 use serde::Deserialize;
 
 /// Default mesh density: cells along the panel length. Measured on SAR

@@ -526,7 +526,6 @@ pub fn stiffness_generic<T: DualNum<Primitive = f64> + Copy>(
 }
 
 pub mod spec;
-pub use spec::{MaterialSpec, PlySpec};
 
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)]
