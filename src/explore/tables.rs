@@ -16,6 +16,7 @@
 
 use crate::error::{Error, Result};
 use crate::optimize::Variable;
+pub use crate::report::csv::{csv_line, num, write_atomic, write_bytes_atomic};
 use std::io::Write;
 use std::path::Path;
 
@@ -58,17 +59,6 @@ pub struct RunRecord {
     pub wall_seconds: f64,
     /// Optimum id after clustering (empty while running).
     pub optimum: Option<usize>,
-}
-
-/// Shortest round-trip text of a float (never NaN: callers check):
-/// positional for `1e-4 <= |x| < 1e15` and zero, scientific otherwise.
-pub fn num(x: f64) -> String {
-    let a = x.abs();
-    if x == 0.0 || (1e-4..1e15).contains(&a) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
 }
 
 fn opt_num(x: Option<f64>) -> String {
@@ -167,34 +157,6 @@ impl RunRecord {
             },
         })
     }
-}
-
-/// One CSV line (with newline) for these fields.
-pub fn csv_line(fields: &[String]) -> Result<Vec<u8>> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(fields)
-        .map_err(|e| Error::csv("(memory)", e))?;
-    w.into_inner()
-        .map_err(|e| Error::csv("(memory)", e.error()))
-}
-
-/// Write `lines` (header first) to `path` atomically (temporary + rename).
-pub fn write_atomic(path: &Path, rows: &[Vec<String>]) -> Result<()> {
-    let mut bytes = Vec::new();
-    for r in rows {
-        bytes.extend(csv_line(r)?);
-    }
-    write_bytes_atomic(path, &bytes)
-}
-
-/// Write `bytes` to `path` through a temporary file and a rename.
-pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    let mut f = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
-    f.write_all(bytes).map_err(|e| Error::io(&tmp, e))?;
-    f.sync_all().map_err(|e| Error::io(&tmp, e))?;
-    drop(f);
-    std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
 }
 
 /// Rows read back from `runs.csv`, and how many bytes of a torn last line

@@ -5,6 +5,8 @@
 //! and `--quiet` was not given. SVG plots use plotters' SVG backend (text is
 //! laid out by the browser, so no font files are needed).
 
+pub mod csv;
+
 use crate::error::{Error, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use plotters::prelude::*;
@@ -121,7 +123,7 @@ pub fn write_manifest(
     m.insert("study_text".into(), json!(study.text));
     let text = serde_json::to_string_pretty(&serde_json::Value::Object(m))
         .map_err(|e| Error::csv(dir.join("manifest.json"), e))?;
-    crate::explore::tables::write_bytes_atomic(&dir.join("manifest.json"), text.as_bytes())
+    csv::write_bytes_atomic(&dir.join("manifest.json"), text.as_bytes())
 }
 
 /// Read `manifest.json` from `dir`.

@@ -7,6 +7,8 @@ use crate::integrate::{integrate, integrate_sens, Stats};
 use crate::mbs::analysis::Projection;
 use crate::mbs::responses::{peak, strain_sum, ResponseValue};
 use crate::mbs::{Param, Reaction, System, Workspace};
+use crate::report::csv::{sci, write_table};
+use crate::report::{line_plot, Axes, Curve};
 use crate::scene::{Quantity, Response, Scene};
 use num_dual::Dual64;
 use std::path::{Path, PathBuf};
@@ -280,20 +282,18 @@ fn output_sensitivities(
     out
 }
 
-/// Write `history.csv`, `stats.csv` and (if asked) `<plot_file or output>.svg`
-/// into `dir`.
+/// Write `history.csv`, `stats.csv`, `sensitivities.csv` and
+/// `responses.csv` (when the scene has them) and (if asked)
+/// `<plot_file or output>.svg` into `dir`, through [`crate::report`].
 pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>> {
+    let sci_rows = |rows: &[Vec<f64>]| -> Vec<Vec<String>> {
+        rows.iter()
+            .map(|r| r.iter().map(|v| sci(*v, 12)).collect())
+            .collect()
+    };
     let hist = dir.join("history.csv");
-    let mut w = csv::Writer::from_path(&hist).map_err(|e| Error::csv(&hist, e))?;
-    w.write_record(&sim.headers)
-        .map_err(|e| Error::csv(&hist, e))?;
-    for row in &sim.rows {
-        w.write_record(row.iter().map(|v| format!("{v:.12e}")))
-            .map_err(|e| Error::csv(&hist, e))?;
-    }
-    w.flush().map_err(|e| Error::io(&hist, e))?;
+    write_table(&hist, &sim.headers, &sci_rows(&sim.rows))?;
     let stats_path = dir.join("stats.csv");
-    let mut w = csv::Writer::from_path(&stats_path).map_err(|e| Error::csv(&stats_path, e))?;
     let s = &sim.stats;
     let p = &sim.projection;
     let records: Vec<(&str, String)> = vec![
@@ -330,29 +330,19 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
                 .map_or("n/a".into(), |e| format!("{e:.3e}")),
         ),
     ];
-    w.write_record(["quantity", "value"])
-        .map_err(|e| Error::csv(&stats_path, e))?;
-    for (k, v) in &records {
-        w.write_record([*k, v.as_str()])
-            .map_err(|e| Error::csv(&stats_path, e))?;
-    }
-    w.flush().map_err(|e| Error::io(&stats_path, e))?;
+    let rows: Vec<Vec<String>> = records
+        .into_iter()
+        .map(|(k, v)| vec![k.to_string(), v])
+        .collect();
+    write_table(&stats_path, &["quantity", "value"], &rows)?;
     let mut written = vec![hist, stats_path];
     if !sim.sens_rows.is_empty() {
         let path = dir.join("sensitivities.csv");
-        let mut w = csv::Writer::from_path(&path).map_err(|e| Error::csv(&path, e))?;
-        w.write_record(&sim.sens_headers)
-            .map_err(|e| Error::csv(&path, e))?;
-        for row in &sim.sens_rows {
-            w.write_record(row.iter().map(|v| format!("{v:.12e}")))
-                .map_err(|e| Error::csv(&path, e))?;
-        }
-        w.flush().map_err(|e| Error::io(&path, e))?;
+        write_table(&path, &sim.sens_headers, &sci_rows(&sim.sens_rows))?;
         written.push(path);
     }
     if !sim.responses.is_empty() {
         let path = dir.join("responses.csv");
-        let mut w = csv::Writer::from_path(&path).map_err(|e| Error::csv(&path, e))?;
         let mut head = vec![
             "response".to_string(),
             "kind".into(),
@@ -360,18 +350,21 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
             "time [s]".into(),
         ];
         head.extend(scene.params.iter().map(|(p, _)| format!("d/d({p})")));
-        w.write_record(&head).map_err(|e| Error::csv(&path, e))?;
-        for r in &sim.responses {
-            let mut rec = vec![
-                r.name.clone(),
-                r.kind.to_string(),
-                format!("{:.12e}", r.value),
-                r.time.map_or(String::new(), |t| format!("{t:.6}")),
-            ];
-            rec.extend(r.gradient.iter().map(|g| format!("{g:.12e}")));
-            w.write_record(&rec).map_err(|e| Error::csv(&path, e))?;
-        }
-        w.flush().map_err(|e| Error::io(&path, e))?;
+        let rows: Vec<Vec<String>> = sim
+            .responses
+            .iter()
+            .map(|r| {
+                let mut rec = vec![
+                    r.name.clone(),
+                    r.kind.to_string(),
+                    sci(r.value, 12),
+                    r.time.map_or(String::new(), |t| format!("{t:.6}")),
+                ];
+                rec.extend(r.gradient.iter().map(|g| sci(*g, 12)));
+                rec
+            })
+            .collect();
+        write_table(&path, &head, &rows)?;
         written.push(path);
     }
     if let Some(name) = &scene.plot {
@@ -382,43 +375,28 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
         if let Some(col) = col {
             let stem = scene.plot_file.as_deref().unwrap_or(name);
             let path = dir.join(format!("{stem}.svg"));
-            plot_svg(&path, &sim.headers[col], &sim.rows, col)?;
+            plot_column(&path, &sim.headers[col], &sim.rows, col)?;
             written.push(path);
         }
     }
     Ok(written)
 }
 
-/// Plot column `col` of `rows` against time into an SVG file.
-pub fn plot_svg(path: &Path, label: &str, rows: &[Vec<f64>], col: usize) -> Result<()> {
-    use plotters::prelude::*;
-    let (t0, t1) = (rows[0][0], rows[rows.len() - 1][0]);
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for r in rows {
-        lo = lo.min(r[col]);
-        hi = hi.max(r[col]);
-    }
-    let pad = 0.05 * (hi - lo).max(1e-12);
-    let err = |e: String| Error::numerical("simulate: svg plot", e);
-    let root = SVGBackend::new(path, (800, 480)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-    let mut chart = ChartBuilder::on(&root)
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(t0..t1, (lo - pad)..(hi + pad))
-        .map_err(|e| err(e.to_string()))?;
-    chart
-        .configure_mesh()
-        .x_desc("t [s]")
-        .y_desc(label)
-        .draw()
-        .map_err(|e| err(e.to_string()))?;
-    chart
-        .draw_series(LineSeries::new(rows.iter().map(|r| (r[0], r[col])), &BLUE))
-        .map_err(|e| err(e.to_string()))?;
-    root.present().map_err(|e| err(e.to_string()))?;
-    Ok(())
+/// Plot column `col` of `rows` against time (column 0) into an SVG file.
+pub fn plot_column(path: &Path, label: &str, rows: &[Vec<f64>], col: usize) -> Result<()> {
+    let points: Vec<(f64, f64)> = rows.iter().map(|r| (r[0], r[col])).collect();
+    line_plot(
+        path,
+        &Axes {
+            title: label,
+            x: "t [s]",
+            y: label,
+        },
+        &[Curve {
+            label: label.to_string(),
+            points,
+        }],
+    )
 }
 
 /// One-paragraph summary for the terminal.

@@ -1,0 +1,94 @@
+//! CSV tables: the one writer of every table the tool writes.
+//!
+//! A table is a header row and rows of text cells, written whole to a
+//! temporary file and renamed over the old one ([`write_atomic`]), so a
+//! reader sees the old or the new table, never half of one. Cells are
+//! formatted by the caller: [`num`] (shortest round-trip text, so a table
+//! read back gives the same `f64` bits) or [`sci`] (fixed significant
+//! digits, for histories). Units go in the header cells (`t [s]`).
+//! Appending tables (resumable sweeps) write whole lines made by
+//! [`csv_line`].
+
+use crate::error::{Error, Result};
+use std::io::Write;
+use std::path::Path;
+
+/// Shortest round-trip text of a float (never NaN: callers check):
+/// positional for `1e-4 <= |x| < 1e15` and zero, scientific otherwise.
+pub fn num(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || (1e-4..1e15).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// Scientific text with `digits` digits after the point (`{:.12e}` for
+/// `digits = 12`).
+pub fn sci(x: f64, digits: usize) -> String {
+    format!("{x:.digits$e}")
+}
+
+/// One CSV line (with newline) for these fields.
+pub fn csv_line(fields: &[String]) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(fields)
+        .map_err(|e| Error::csv("(memory)", e))?;
+    w.into_inner()
+        .map_err(|e| Error::csv("(memory)", e.error()))
+}
+
+/// Write `lines` (header first) to `path` atomically (temporary + rename).
+pub fn write_atomic(path: &Path, rows: &[Vec<String>]) -> Result<()> {
+    let mut bytes = Vec::new();
+    for r in rows {
+        bytes.extend(csv_line(r)?);
+    }
+    write_bytes_atomic(path, &bytes)
+}
+
+/// Write `bytes` to `path` through a temporary file and a rename.
+pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = path.with_extension("tmp");
+    let mut f = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
+    f.write_all(bytes).map_err(|e| Error::io(&tmp, e))?;
+    f.sync_all().map_err(|e| Error::io(&tmp, e))?;
+    drop(f);
+    std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+}
+
+/// Write a table: `header`, then `rows` (all as text cells), atomically.
+pub fn write_table<S: AsRef<str>>(path: &Path, header: &[S], rows: &[Vec<String>]) -> Result<()> {
+    let mut bytes = csv_line(
+        &header
+            .iter()
+            .map(|h| h.as_ref().to_string())
+            .collect::<Vec<_>>(),
+    )?;
+    for r in rows {
+        bytes.extend(csv_line(r)?);
+    }
+    write_bytes_atomic(path, &bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tables_are_written_whole_and_quoted() {
+        let dir = std::env::temp_dir().join(format!("plyscape-csv-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.csv");
+        let rows = vec![
+            vec!["a,b".to_string(), sci(0.5, 3)],
+            vec![num(1e-7), num(2.0)],
+        ];
+        write_table(&path, &["name", "value [m]"], &rows).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text, "name,value [m]\n\"a,b\",5.000e-1\n1e-7,2\n");
+        assert!(!path.with_extension("tmp").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
