@@ -4,8 +4,8 @@
 use nalgebra::{Matrix2, Matrix3};
 use num_dual::HyperDual64;
 use plyscape::laminate::{
-    spec::resolve_laminate, stiffness_generic, DesignMap, Laminate, MaterialSpec, Orthotropic, Ply,
-    PlySpec, Stiffness, SHEAR_CORRECTION,
+    spec::{resolve_laminate, MaterialSpec, PlySpec},
+    stiffness_generic, DesignMap, Laminate, Orthotropic, Ply, Stiffness, SHEAR_CORRECTION,
 };
 use plyscape::Error;
 
