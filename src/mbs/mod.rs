@@ -58,6 +58,7 @@ pub mod model;
 pub mod responses;
 pub mod rows;
 pub mod solve;
+pub mod workspace;
 
 pub use analysis::{Projection, Reaction};
 pub use dynamics::{System, Workspace};

@@ -1,8 +1,8 @@
 //! Constraint rows of the joints: value, Jacobian blocks per body and the
 //! velocity-dependent part `γ` of the constraint accelerations.
 
-use super::dynamics::{MarkerKin, Row, RIGID};
 use super::linalg::{cst, Scalar};
+use super::workspace::{MarkerKin, Row, RIGID};
 use nalgebra::Vector3;
 
 /// `θ = atan2(z_i·(x_i × x_j), x_i·x_j)` and `θ̇ = z_i·(ω_j − ω_i)`.

@@ -1,0 +1,155 @@
+//! The data of one right-hand-side evaluation: constraint rows, body and
+//! marker kinematics, scratch storage reused across evaluations (one per
+//! scalar type), evaluation counters, and the rank constants of the
+//! constraint-space solve ([`super::dynamics`] has the method).
+
+use super::flexdyn::InvT;
+use super::linalg::{Scalar, SpdScratch};
+use super::model::Param;
+use nalgebra::{Matrix3, Vector3};
+use std::cell::Cell;
+
+/// Relative pivot threshold for counting the rank of the constraint-space
+/// matrix (unit-diagonal scaled): an exactly dependent row gives a pivot at
+/// the regularisation level `RANK_REG` plus round-off (~1e-15); a row whose
+/// pivot exceeds `RANK_REG + RANK_TOL` is counted as independent. The
+/// expected counts of every test mechanism (SAR 6, Andrews 9, four-bar 3,
+/// Bricard 1) are reproduced.
+pub const RANK_TOL: f64 = 1e-8;
+
+/// Tikhonov regularisation of the scaled constraint-space matrix: keeps
+/// the multipliers (and so the accelerations) smooth where the rank
+/// changes (singular configurations such as a parallelogram four-bar
+/// passing its flat position). It perturbs the accelerations of a
+/// well-conditioned mechanism by a relative `O(1e-12/σ²_min)`.
+pub const RANK_REG: f64 = 1e-12;
+
+/// Marks a row side without modal Jacobian entries.
+pub const RIGID: usize = usize::MAX;
+
+/// One constraint row: value, velocity residual, `γ`, up to two body
+/// blocks `(slot, [∂/∂ṙ; ∂/∂ω'])`, the markers of the two sides, and the
+/// offsets of the modal Jacobian entries `∂/∂ẇ` of flexible sides in
+/// [`Workspace::mjac`] ([`RIGID`] otherwise).
+#[derive(Debug, Clone, Copy)]
+pub struct Row<T: Scalar> {
+    pub phi: T,
+    pub phidot: T,
+    pub gamma: T,
+    pub blocks: [(Option<usize>, [T; 6]); 2],
+    pub markers: [usize; 2],
+    pub modal: [usize; 2],
+}
+
+/// Scratch storage reused across evaluations (one per scalar type).
+#[derive(Debug, Clone)]
+pub struct Workspace<T: Scalar> {
+    pub rows: Vec<Row<T>>,
+    pub a: Vec<T>,
+    pub rhs: Vec<T>,
+    pub(crate) scale: Vec<T>,
+    pub(crate) tmp: Vec<T>,
+    pub kin: Vec<BodyKin<T>>,
+    /// Kinematics of every marker at the current state.
+    pub mk: Vec<MarkerKin<T>>,
+    /// Per marker: its node's mode-shape rows `(Φ_k, Ψ_k)` at the current
+    /// design seeds (empty for markers not on a flexible node), built once
+    /// per evaluation for the kinematics, the constraint rows and the
+    /// forces.
+    pub(crate) shapes: Vec<NodeShapes<T>>,
+    /// Per moving body: the rows touching it as `(row, offset)`; the
+    /// arena holds `d` then `M⁻¹d` (each `dof` long) at the offset.
+    pub(crate) by_body: Vec<Vec<(usize, usize)>>,
+    pub(crate) arena: Vec<T>,
+    /// Modal Jacobian entries of the rows' flexible sides.
+    pub mjac: Vec<T>,
+    /// Position of each row in the fill-reducing order.
+    pub(crate) inv_order: Vec<usize>,
+    pub(crate) spd: SpdScratch,
+    /// Applied generalized forces, all bodies (velocity layout).
+    pub q: Vec<T>,
+    /// Per moving body: the Cholesky factor of a flexible body's mass
+    /// matrix (empty for rigid bodies).
+    pub(crate) mfac: Vec<Vec<T>>,
+    /// Per moving body: its invariants in `T` (flexible bodies), rebuilt
+    /// when design seeds are active.
+    pub(crate) inv: Vec<Option<InvT<T>>>,
+    /// Whether `inv[s]` carries design seeds (then it is rebuilt at the
+    /// next evaluation).
+    pub(crate) inv_seeded: Vec<bool>,
+    /// Rank of the last factorization.
+    pub rank: usize,
+    /// Parameter values overriding the model's (sensitivity analysis);
+    /// empty for plain evaluations.
+    pub params: Vec<(Param, T)>,
+    /// Frozen segment of each actuator's Eq. 32 law, by force index, while
+    /// the integrator treats segment changes as events (`integrate::events`):
+    /// the segment's line then extends past its breakpoints, so the
+    /// right-hand side is smooth. Empty (or an out-of-range entry): the
+    /// segment is picked by the value of θ.
+    pub segments: Vec<usize>,
+}
+
+/// Translational and rotational mode-shape rows of a node (n columns each).
+pub type NodeShapes<T> = (Vec<Vector3<T>>, Vec<Vector3<T>>);
+
+/// Kinematics of one body at the current state.
+#[derive(Debug, Clone)]
+pub struct BodyKin<T: Scalar> {
+    pub r: Vector3<T>,
+    pub a: Matrix3<T>,
+    pub v: Vector3<T>,
+    /// Global angular velocity.
+    pub w: Vector3<T>,
+    /// Body-frame angular velocity.
+    pub wb: Vector3<T>,
+    /// Modal coordinates and rates (empty for rigid bodies).
+    pub q: Vec<T>,
+    pub qd: Vec<T>,
+    /// Design seeds `(variable, δ)` of a flexible body's basis (dual
+    /// parts of [`Param::Design`] values; empty in plain evaluations).
+    pub design: Vec<(usize, T)>,
+}
+
+/// Global kinematics of a marker.
+#[derive(Debug, Clone, Copy)]
+pub struct MarkerKin<T: Scalar> {
+    pub slot: Option<usize>,
+    /// Global position.
+    pub x: Vector3<T>,
+    /// Global velocity.
+    pub v: Vector3<T>,
+    /// Lever arm from the body frame origin (global).
+    pub s: Vector3<T>,
+    /// Global frame columns.
+    pub frame: Matrix3<T>,
+    /// Global angular velocity of the marker.
+    pub w: Vector3<T>,
+    /// Velocity-dependent part of the point's acceleration:
+    /// `ω×(ω×s) + 2ω×(AΦẇ)`.
+    pub acc: Vector3<T>,
+    /// Velocity-dependent part of the marker's angular acceleration:
+    /// `ω×(AΨẇ)` (zero on rigid bodies).
+    pub alpha: Vector3<T>,
+    /// `(body, node)` of a marker on a flexible node.
+    pub node: Option<(usize, usize)>,
+    /// Tangent operator `T(Ψ_k w)` of the node rotation (identity on
+    /// rigid bodies): the marker's angular velocity is `ω + A T Ψ_k ẇ`.
+    pub tangent: Matrix3<T>,
+}
+
+/// Evaluation counters (what is not built is never evaluated).
+#[derive(Debug, Default)]
+pub struct Counters {
+    pub rhs: Cell<u64>,
+    pub gravity: Cell<u64>,
+    pub actuators: Cell<u64>,
+    pub springs: Cell<u64>,
+    pub loads: Cell<u64>,
+    /// Flexible-body mass matrices and elastic forces built.
+    pub flexible: Cell<u64>,
+    /// Quadratic-velocity terms evaluated (per body).
+    pub quadratic: Cell<u64>,
+    /// Modal damping forces evaluated (per flexible body).
+    pub modal_damping: Cell<u64>,
+}
