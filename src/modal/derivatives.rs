@@ -60,9 +60,8 @@ use faer::sparse::SparseColMat;
 use faer::Mat;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
-use super::sign_normalize;
+use super::modes::{sign_normalize, Modes};
 use super::sparse::{gmres_refine, spmv, sym_mul_block, Pencil, Refine};
-use super::Modes;
 use crate::error::{Error, Result};
 
 /// Derivatives of the stiffness with respect to one design variable θ_v.

@@ -1,8 +1,6 @@
 //! Mode-shape export for plotting: one row per (mode, node, component).
 
-use std::path::Path;
-
-use super::Modes;
+use super::modes::Modes;
 use crate::error::{Error, Result};
 
 /// Where a reduced DOF lives: FE node number and component
@@ -55,24 +53,4 @@ pub fn mode_shape_rows(modes: &Modes, dofs: &[DofLabel]) -> Result<Vec<ModeShape
         }
     }
     Ok(rows)
-}
-
-/// Write [`mode_shape_rows`] as CSV with header
-/// `mode,frequency_hz,node,component,value`.
-pub fn write_mode_shapes_csv(path: &Path, modes: &Modes, dofs: &[DofLabel]) -> Result<()> {
-    let rows = mode_shape_rows(modes, dofs)?;
-    let mut w = csv::Writer::from_path(path).map_err(|e| Error::csv(path, e))?;
-    w.write_record(["mode", "frequency_hz", "node", "component", "value"])
-        .map_err(|e| Error::csv(path, e))?;
-    for r in rows {
-        w.write_record([
-            r.mode.to_string(),
-            format!("{:e}", r.frequency_hz),
-            r.node.to_string(),
-            r.component.to_string(),
-            format!("{:e}", r.value),
-        ])
-        .map_err(|e| Error::csv(path, e))?;
-    }
-    w.flush().map_err(|e| Error::io(path, e))
 }

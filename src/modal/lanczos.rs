@@ -29,8 +29,8 @@ use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use nalgebra::{DMatrix, SymmetricEigen};
 
+use super::modes::ModalOptions;
 use super::sparse::{Factor, Pencil};
-use super::ModalOptions;
 use crate::error::{Error, Result};
 
 /// Result of the Lanczos iteration (before sign normalisation).

@@ -1,0 +1,131 @@
+//! [`ModalSolver`]: one stiffness pattern, factorizations reused across
+//! designs, the lowest modes by block shift-invert Lanczos
+//! ([`super::lanczos`]) and their design derivatives
+//! ([`super::derivatives`]).
+
+use super::derivatives::{self, DerivativeOptions, DesignDerivative, VariableDerivatives};
+use super::lanczos;
+use super::modes::{sign_normalize, ModalOptions, ModalStats, Modes};
+use super::sparse::Pencil;
+use crate::error::{Error, Result};
+use faer::sparse::SparseColMat;
+use faer::Mat;
+
+/// Sparse modal analysis of one stiffness pattern: holds `K` ∪ diagonal, the
+/// mass, and the symbolic Cholesky structure (AMD ordering), computed once
+/// and reused by every numeric factorization (shift-invert and Nelson).
+pub struct ModalSolver {
+    pencil: Pencil,
+}
+
+impl ModalSolver {
+    /// `k`: reduced stiffness, `n × n`, full symmetric storage; `mass`:
+    /// lumped diagonal mass, length `n`, every entry finite and > 0.
+    pub fn new(k: &SparseColMat<usize, f64>, mass: &[f64]) -> Result<Self> {
+        Ok(ModalSolver {
+            pencil: Pencil::new(k, mass)?,
+        })
+    }
+
+    /// Number of free DOFs `n`.
+    pub fn n_dofs(&self) -> usize {
+        self.pencil.n()
+    }
+
+    /// Replace the stiffness by one with the same sparsity pattern (a new
+    /// design); the symbolic factorization is kept. A different pattern
+    /// rebuilds it.
+    pub fn set_stiffness(&mut self, k: &SparseColMat<usize, f64>) -> Result<()> {
+        self.pencil.set_stiffness(k)
+    }
+
+    /// The `opts.n_modes` lowest modes. Errors: `n_modes` = 0 or > n →
+    /// [`Error::Input`]; `K − σM` not positive definite, or no convergence →
+    /// [`Error::Numerical`].
+    pub fn solve(&self, opts: &ModalOptions) -> Result<Modes> {
+        let n = self.pencil.n();
+        let k = opts.n_modes;
+        if k == 0 || k > n {
+            return Err(Error::input(
+                "n_modes",
+                k,
+                format!("between 1 and the number of free DOFs ({n})"),
+            ));
+        }
+        crate::error::require_finite("shift", opts.shift)?;
+        crate::error::require_positive("tol", opts.tol)?;
+        if opts.block_size == 0 {
+            return Err(Error::input("block_size", 0, "at least 1"));
+        }
+        let t0 = std::time::Instant::now();
+        let mut factor = self.pencil.factor_llt(opts.shift)?;
+        let t1 = std::time::Instant::now();
+        let want = (k + 1).min(n);
+        let out = lanczos::block_lanczos(&self.pencil, &mut factor, opts, want)?;
+        let (factor_seconds, lanczos_seconds) =
+            ((t1 - t0).as_secs_f64(), t1.elapsed().as_secs_f64());
+        let next_lambda = if want > k { Some(out.lambda[k]) } else { None };
+        let mut modes = Mat::<f64>::zeros(n, k);
+        let mut x = vec![0.0; n];
+        for j in 0..k {
+            for (i, xi) in x.iter_mut().enumerate() {
+                *xi = out.vectors[(i, j)];
+            }
+            sign_normalize(&mut x);
+            for (i, &xi) in x.iter().enumerate() {
+                modes[(i, j)] = xi;
+            }
+        }
+        // Residuals of all modes with one pass over K per 4 columns.
+        let mut kx = Mat::<f64>::zeros(n, k);
+        self.pencil.k_mul_block(modes.as_ref(), kx.as_mut());
+        let mut lambda = Vec::with_capacity(k);
+        let mut residuals = Vec::with_capacity(k);
+        let mass = self.pencil.mass();
+        for j in 0..k {
+            let lam = out.lambda[j];
+            let (mut r2, mut m2) = (0.0, 0.0);
+            for i in 0..n {
+                let mx = mass[i] * modes[(i, j)];
+                r2 += (kx[(i, j)] - lam * mx).powi(2);
+                m2 += mx * mx;
+            }
+            let scale = lam.abs().max(opts.shift.abs()).max(f64::MIN_POSITIVE);
+            let res = r2.sqrt() / (scale * m2.sqrt());
+            if !res.is_finite() || !lam.is_finite() {
+                return Err(Error::numerical(
+                    "modal::solve",
+                    format!("mode {j}: lambda = {lam:e}, residual = {res:e}"),
+                ));
+            }
+            lambda.push(lam);
+            residuals.push(res);
+        }
+        Ok(Modes {
+            lambda,
+            modes,
+            residuals,
+            next_lambda,
+            shift: opts.shift,
+            stats: ModalStats {
+                solves: out.solves,
+                restarts: out.restarts,
+                basis: out.basis,
+                factor_nnz: self.pencil.factor_nnz(),
+                factor_seconds,
+                lanczos_seconds,
+            },
+        })
+    }
+
+    /// Eigenvalue (and, in the updated-mode approach, eigenvector)
+    /// derivatives of `modes` for each design variable; see [`derivatives`].
+    pub fn derivatives(
+        &self,
+        modes: &Modes,
+        vars: &[DesignDerivative<'_>],
+        opts: &DerivativeOptions,
+    ) -> Result<Vec<VariableDerivatives>> {
+        derivatives::compute(&self.pencil, modes, vars, opts)
+    }
+}
