@@ -283,7 +283,7 @@ fn run_kernel_bench_handler(cfg: &RunConfig) -> Result<()> {
 
 /// The `[modes]` section: panel modal analysis.
 fn run_modes_handler(cfg: &RunConfig) -> Result<()> {
-    crate::panels::run_modes(&cfg.study, &cfg.out, cfg.quiet)
+    crate::sections::modes::run_modes(&cfg.study, &cfg.out, cfg.quiet)
 }
 
 /// The `[scene]` handler: simulate the multibody scene and write

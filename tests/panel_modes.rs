@@ -300,10 +300,10 @@ fn bad_modes_input_names_file_and_key() {
     let check = |text: &str, key: &str| {
         let s = Study::parse("bad.toml", text).unwrap();
         let spec = s
-            .section::<plyscape::panels::ModesSpec>("modes")
+            .section::<plyscape::sections::modes::ModesSpec>("modes")
             .unwrap()
             .unwrap();
-        let e = plyscape::panels::analyse_study(&s, &spec)
+        let e = plyscape::sections::modes::analyse_study(&s, &spec)
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("bad.toml") && e.contains(key), "{e}");

@@ -78,7 +78,7 @@
 //! `dλ` are the eigenvalues of `X_CᵀK'X_C` (the one-sided derivatives of
 //! the sorted eigenvalues).
 
-use super::{in_panel, PanelAnalysis};
+use super::analysis::{in_panel, PanelAnalysis};
 use crate::error::{Error, Result};
 use crate::fe::{Panel, Triangle, NODE_DOF};
 use crate::laminate::Laminate;

@@ -1,4 +1,5 @@
-//! Study sections that measure rather than model: the kernel benchmark
+//! Study sections: the panel modes table (`plyscape modes`: `[modes]`,
+//! `[convergence]`), the kernel benchmark
 //! (`[kernel_bench]`), the Eq. 32 events benchmark (`[events_bench]`) and
 //! the flexible-scene convergence grid (`[scene_convergence]`). Each
 //! reads its section, runs scenes through [`crate::scene`] and
@@ -9,4 +10,5 @@
 
 pub mod events_bench;
 pub mod kernel_bench;
+pub mod modes;
 pub mod scene_convergence;

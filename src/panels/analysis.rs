@@ -1,0 +1,347 @@
+//! One panel's modal analysis reused across lay-ups ([`PanelAnalysis`]):
+//! laminate → shell FE → reduced `K`, lumped `M` → lowest modes by
+//! shift-invert Lanczos → `dλ/dθ`, `dX/dθ` per design variable (paper
+//! §2.2, §3.1–3.2, §6.2), with each mode labelled by kind (flexural,
+//! in-plane, drilling) and, for flexural modes, the symmetry of `w` under
+//! the mirrors x → −x and y → −y (`SS`, `SA`, `AS`, `AA`; `-` where the
+//! mesh has no mirror nodes or the correlation is weak).
+
+use crate::error::{Error, Result};
+use crate::fe::{Derivatives, Panel, PanelSystem};
+use crate::modal::{
+    DerivativeOptions, DesignDerivative, ModalOptions, ModalSolver, ModeUpdate, Modes,
+    VariableDerivatives,
+};
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// The result of one panel's analysis.
+#[derive(Debug, Clone)]
+pub struct PanelModes {
+    /// Panel name.
+    pub panel: String,
+    /// Lay-up in degrees, e.g. `[0/90/90/0]`.
+    pub layup: String,
+    /// Reduced DOFs.
+    pub dofs: usize,
+    /// Eigen-solution.
+    pub modes: Modes,
+    /// One label pair (kind, symmetry) per mode.
+    pub labels: Vec<(&'static str, &'static str)>,
+    /// Derivatives per design variable (empty unless asked for).
+    pub derivatives: Vec<VariableDerivatives>,
+    /// Design-variable names: `theta_1_4` ties plies 1 and 4.
+    pub variables: Vec<String>,
+    /// Wall times [s]: assembly, modes, derivatives.
+    pub seconds: [f64; 3],
+    /// Reduced DOF → (node, component 0..6 = u, v, w, θx, θy, θz).
+    pub dof_map: Vec<(usize, usize)>,
+    /// Node coordinates, panel frame [m].
+    pub nodes: Vec<[f64; 2]>,
+}
+
+/// Lay-up as `[a/b/c]` in degrees (rounded to 0.01°).
+pub fn layup_label(panel: &Panel) -> String {
+    let a: Vec<String> = panel
+        .laminate
+        .angles()
+        .iter()
+        .map(|t| {
+            let d = (t.to_degrees() * 100.0).round() / 100.0;
+            format!("{}", d + 0.0)
+        })
+        .collect();
+    format!("[{}]", a.join("/"))
+}
+
+/// A panel prepared for repeated modal analyses: mesh, sparsity pattern,
+/// assembly buffers, symbolic factorization and mirror maps are built once
+/// ([`PanelAnalysis::new`]); each [`PanelAnalysis::run`] for a lay-up then
+/// costs one assembly, one numeric factorization, the Lanczos iteration and
+/// (if asked) the derivatives. This is the shape an optimization loop uses.
+pub struct PanelAnalysis {
+    pub(super) panel: Panel,
+    model: crate::fe::PanelModel,
+    pub(super) sys: PanelSystem,
+    solver: ModalSolver,
+    want: Option<ModeUpdate>,
+    mirrors: [Option<Vec<usize>>; 2],
+    /// Wall time of the set-up [s].
+    pub setup_seconds: f64,
+}
+
+impl PanelAnalysis {
+    /// Build everything that does not depend on the ply angles. `want`:
+    /// which derivatives later runs compute (none, fixed-mode λ', or
+    /// updated-mode λ' and X'); only those matrices are ever assembled.
+    pub fn new(panel: &Panel, want: Option<ModeUpdate>) -> Result<PanelAnalysis> {
+        let t0 = Instant::now();
+        let level = match want {
+            None => Derivatives::None,
+            Some(ModeUpdate::Fixed) => Derivatives::First,
+            Some(ModeUpdate::Updated) => Derivatives::Second,
+        };
+        let model = panel.model()?;
+        let sys = model.assemble(&panel.laminate, &panel.design, level)?;
+        let solver = ModalSolver::new(&sys.k, &sys.m_diag)?;
+        let mirrors = [
+            mirror_map(&panel.mesh.nodes, [-1.0, 1.0]),
+            mirror_map(&panel.mesh.nodes, [1.0, -1.0]),
+        ];
+        Ok(PanelAnalysis {
+            panel: panel.clone(),
+            model,
+            sys,
+            solver,
+            want,
+            mirrors,
+            setup_seconds: t0.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Modes (and derivatives) for `laminate` (same ply count as the
+    /// panel's; ply angles may differ).
+    pub fn run(
+        &mut self,
+        laminate: &crate::laminate::Laminate,
+        n_modes: usize,
+    ) -> Result<PanelModes> {
+        let t0 = Instant::now();
+        self.model
+            .assemble_into(laminate, &self.panel.design, &mut self.sys)?;
+        self.solver.set_stiffness(&self.sys.k)?;
+        let t1 = Instant::now();
+        let free = self.panel.support == crate::fe::Support::FreeFree;
+        let mut opts = ModalOptions::new(if free { n_modes + 6 } else { n_modes });
+        if free {
+            opts.shift = FREE_FREE_SHIFT;
+        }
+        let mut modes = self.solver.solve(&opts)?;
+        let t2 = Instant::now();
+        let sys = &self.sys;
+        let mut derivatives = match self.want {
+            None => Vec::new(),
+            Some(update) => {
+                let vars: Vec<DesignDerivative<'_>> = (0..sys.dk.len())
+                    .map(|v| DesignDerivative {
+                        dk: &sys.dk[v],
+                        d2k: sys.d2k.get(v),
+                    })
+                    .collect();
+                let opts = DerivativeOptions {
+                    update,
+                    ..DerivativeOptions::default()
+                };
+                self.solver.derivatives(&modes, &vars, &opts)?
+            }
+        };
+        if free {
+            remove_rigid_modes(&mut modes, &mut derivatives, sys)?;
+        }
+        let t3 = Instant::now();
+        let labels = (0..modes.lambda.len())
+            .map(|j| label_mode(sys, &self.mirrors, &modes, j))
+            .collect();
+        let variables = self
+            .panel
+            .design
+            .groups()
+            .iter()
+            .map(|g| {
+                let plies: Vec<String> = g.iter().map(|k| (k + 1).to_string()).collect();
+                format!("theta_{}", plies.join("_"))
+            })
+            .collect();
+        let mut with_layup = self.panel.clone();
+        with_layup.laminate = laminate.clone();
+        Ok(PanelModes {
+            panel: self.panel.name.clone(),
+            layup: layup_label(&with_layup),
+            dofs: sys.m_diag.len(),
+            modes,
+            labels,
+            derivatives,
+            variables,
+            seconds: [
+                (t1 - t0).as_secs_f64(),
+                (t2 - t1).as_secs_f64(),
+                (t3 - t2).as_secs_f64(),
+            ],
+            dof_map: sys.dof_map.clone(),
+            nodes: self.panel.mesh.nodes.clone(),
+        })
+    }
+}
+
+/// Shift σ [rad²/s²] for free–free panels: K − σM must be positive
+/// definite although K has the six rigid-body modes (λ = 0) as null space.
+/// −1 rad²/s² lifts them to 1 while keeping the pencil well conditioned and
+/// the wanted eigenvalues (flexural λ of order 10–10⁴ for the SAR panel) far
+/// from σ relative to the gaps the shift-invert Lanczos needs.
+pub const FREE_FREE_SHIFT: f64 = -1.0;
+
+/// Identify the six rigid-body modes among the computed ones by their
+/// M-projection onto the rigid-body fields of the model (share of the mode's
+/// M-norm in the rigid subspace > 1/2; elastic modes are M-orthogonal to it)
+/// and remove them, with their derivatives (rigid motions do not depend on
+/// the ply angles). Exactly six must be found, else it is a numerical error.
+fn remove_rigid_modes(
+    modes: &mut Modes,
+    derivatives: &mut [VariableDerivatives],
+    sys: &PanelSystem,
+) -> Result<()> {
+    let n = modes.modes.nrows();
+    let k = modes.lambda.len();
+    let rigid: Vec<bool> = (0..k)
+        .map(|j| {
+            let share: f64 = sys
+                .rigid_modes
+                .iter()
+                .map(|r| {
+                    (0..n)
+                        .map(|i| r[i] * sys.m_diag[i] * modes.modes[(i, j)])
+                        .sum::<f64>()
+                        .powi(2)
+                })
+                .sum();
+            share > 0.5
+        })
+        .collect();
+    let found = rigid.iter().filter(|&&r| r).count();
+    if found != 6 || sys.rigid_modes.len() != 6 {
+        return Err(Error::numerical(
+            "panels::remove_rigid_modes",
+            format!(
+                "free-free panel: {found} computed modes lie in the rigid-body subspace \
+                 (expected 6); lowest eigenvalues {:?}",
+                &modes.lambda[..k.min(8)]
+            ),
+        ));
+    }
+    let keep: Vec<usize> = (0..k).filter(|&j| !rigid[j]).collect();
+    fn columns(m: &faer::Mat<f64>, keep: &[usize]) -> faer::Mat<f64> {
+        faer::Mat::from_fn(m.nrows(), keep.len(), |i, c| m[(i, keep[c])])
+    }
+    modes.modes = columns(&modes.modes, &keep);
+    modes.lambda = keep.iter().map(|&j| modes.lambda[j]).collect();
+    modes.residuals = keep.iter().map(|&j| modes.residuals[j]).collect();
+    for d in derivatives.iter_mut() {
+        d.dlambda = keep.iter().map(|&j| d.dlambda[j]).collect();
+        d.dmodes = d.dmodes.as_ref().map(|m| columns(m, &keep));
+        // Clusters index the full list: keep those wholly among the
+        // elastic modes, renumbered.
+        d.clusters
+            .retain(|c| (c.first..c.first + c.len).all(|j| !rigid[j]));
+        for c in d.clusters.iter_mut() {
+            c.first = keep.iter().position(|&j| j == c.first).unwrap_or(c.first);
+        }
+    }
+    Ok(())
+}
+
+/// Analyse one panel once (set-up + one run).
+pub fn analyse_panel(
+    panel: &Panel,
+    n_modes: usize,
+    want: Option<ModeUpdate>,
+) -> Result<PanelModes> {
+    PanelAnalysis::new(panel, want)?.run(&panel.laminate, n_modes)
+}
+
+/// For every node, the node at its mirror image `(sx·x, sy·y)`, or `None`
+/// if some node has no mirror (then symmetry is not labelled). Hashed on a
+/// grid of 1e-9 of the panel size, checking neighbouring cells so rounding
+/// at a cell edge cannot miss a node.
+fn mirror_map(nodes: &[[f64; 2]], s: [f64; 2]) -> Option<Vec<usize>> {
+    let size = nodes
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
+    let h = 1e-9 * size.max(f64::MIN_POSITIVE);
+    let key = |p: [f64; 2]| ((p[0] / h).round() as i64, (p[1] / h).round() as i64);
+    let index: HashMap<(i64, i64), usize> = nodes
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| (key(p), i))
+        .collect();
+    nodes
+        .iter()
+        .map(|&p| {
+            let (kx, ky) = key([s[0] * p[0], s[1] * p[1]]);
+            (-1..=1)
+                .flat_map(|dx| (-1..=1).map(move |dy| (kx + dx, ky + dy)))
+                .find_map(|k| index.get(&k).copied())
+        })
+        .collect()
+}
+
+/// Kind (where the kinetic energy sits) and symmetry of mode `j`.
+fn label_mode(
+    sys: &PanelSystem,
+    mirrors: &[Option<Vec<usize>>; 2],
+    modes: &Modes,
+    j: usize,
+) -> (&'static str, &'static str) {
+    // Energy share per component class: u, v in-plane; w, θx, θy flexural;
+    // θz drilling (the small drilling inertia makes it visible).
+    let mut e = [0.0f64; 3];
+    let mut w = vec![0.0f64; sys.nodes.len()];
+    for (i, &(node, comp)) in sys.dof_map.iter().enumerate() {
+        let x = modes.modes[(i, j)];
+        let class = match comp {
+            0 | 1 => 0,
+            2..=4 => 1,
+            _ => 2,
+        };
+        e[class] += sys.m_diag[i] * x * x;
+        if comp == 2 {
+            w[node] = x;
+        }
+    }
+    let total: f64 = e.iter().sum();
+    let kind = if e[1] >= 0.5 * total {
+        "flexural"
+    } else if e[0] >= e[2] {
+        "in-plane"
+    } else {
+        "drilling"
+    };
+    if kind != "flexural" {
+        return (kind, "-");
+    }
+    // Correlation of w with its mirror image: +1 symmetric, −1 antisymmetric.
+    let letter = |map: &Option<Vec<usize>>| {
+        let map = map.as_ref()?;
+        let (mut c, mut n) = (0.0, 0.0);
+        for (a, &b) in map.iter().enumerate() {
+            c += w[a] * w[b];
+            n += w[a] * w[a];
+        }
+        match c / n {
+            r if r > 0.9 => Some('S'),
+            r if r < -0.9 => Some('A'),
+            _ => None,
+        }
+    };
+    let symmetry = match (letter(&mirrors[0]), letter(&mirrors[1])) {
+        (Some('S'), Some('S')) => "SS",
+        (Some('S'), Some('A')) => "SA",
+        (Some('A'), Some('S')) => "AS",
+        (Some('A'), Some('A')) => "AA",
+        _ => "-",
+    };
+    (kind, symmetry)
+}
+
+/// `df/dθ` [Hz/deg] from `dλ/dθ` [rad²/s² per rad] at `λ`: f = √λ/(2π),
+/// df/dλ = 1/(4π√λ), and 1 rad = 180/π deg.
+pub fn dfreq_hz_per_deg(lambda: f64, dlambda_per_rad: f64) -> f64 {
+    if lambda <= 0.0 {
+        return 0.0;
+    }
+    dlambda_per_rad / (4.0 * std::f64::consts::PI * lambda.sqrt()) * (std::f64::consts::PI / 180.0)
+}
+
+/// Prefix the place of a numerical error with the panel name.
+pub fn in_panel(e: Error, panel: &str) -> Error {
+    e.at_place(&format!("panel {panel}"))
+}

@@ -1,0 +1,14 @@
+//! Composite panels as parts of a mechanism: a panel's modal analysis
+//! across lay-ups ([`analysis`]) and its modes as the
+//! [`crate::mbs::ModalBasis`] of a floating-frame flexible body
+//! ([`basis`]). The `plyscape modes` study section that tabulates them is
+//! [`crate::sections::modes`].
+
+pub mod analysis;
+pub mod basis;
+
+pub use analysis::{
+    analyse_panel, dfreq_hz_per_deg, in_panel, layup_label, PanelAnalysis, PanelModes,
+    FREE_FREE_SHIFT,
+};
+pub use basis::{basis_for_study, panel_basis, unknown_panel, BasisBuilder};
