@@ -72,6 +72,45 @@ pub fn write_table<S: AsRef<str>>(path: &Path, header: &[S], rows: &[Vec<String>
     write_bytes_atomic(path, &bytes)
 }
 
+/// A table built row by row in memory and written whole, atomically, by
+/// [`Table::finish`] (the first row is the header).
+pub struct Table {
+    path: std::path::PathBuf,
+    writer: csv::Writer<Vec<u8>>,
+}
+
+impl Table {
+    /// An empty table to be written to `path`.
+    pub fn new(path: &Path) -> Table {
+        Table {
+            path: path.to_path_buf(),
+            writer: csv::Writer::from_writer(Vec::new()),
+        }
+    }
+
+    /// Append one row of text cells.
+    pub fn row<I, S>(&mut self, cells: I) -> Result<()>
+    where
+        I: IntoIterator<Item = S>,
+        S: AsRef<str>,
+    {
+        let cells: Vec<String> = cells.into_iter().map(|c| c.as_ref().to_string()).collect();
+        self.writer
+            .write_record(&cells)
+            .map_err(|e| Error::csv(&self.path, e))
+    }
+
+    /// Write the table (temporary file + rename) and return its path.
+    pub fn finish(self) -> Result<std::path::PathBuf> {
+        let bytes = self
+            .writer
+            .into_inner()
+            .map_err(|e| Error::csv(&self.path, e.error()))?;
+        write_bytes_atomic(&self.path, &bytes)?;
+        Ok(self.path)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

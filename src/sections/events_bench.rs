@@ -21,6 +21,7 @@ use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Method, Options, Stats};
 use crate::mbs::System;
 use crate::mbs::{Force, Param};
+use crate::report::csv::Table;
 use crate::scene::load_scene;
 use crate::study::Study;
 use num_dual::Dual64;
@@ -258,13 +259,12 @@ pub fn run_events_bench(study: &Study, out: &Path, quiet: bool) -> Result<PathBu
     }
     let dir = study.output_dir(out)?;
     let path = dir.join("events.csv");
-    let mut w = csv::Writer::from_path(&path).map_err(|e| Error::csv(&path, e))?;
-    w.write_record(headers(&names))
-        .map_err(|e| Error::csv(&path, e))?;
+    let mut w = Table::new(&path);
+    w.row(headers(&names))?;
     for r in &rows {
-        w.write_record(r).map_err(|e| Error::csv(&path, e))?;
+        w.row(r)?;
     }
-    w.flush().map_err(|e| Error::io(&path, e))?;
+    w.finish()?;
     if !quiet {
         println!("wrote {}", path.display());
     }

@@ -28,6 +28,7 @@
 use crate::error::{Error, Result};
 use crate::integrate::Method;
 use crate::mbs::{System, Workspace};
+use crate::report::csv::Table;
 use crate::scene::{load_scene, Scene};
 use crate::simulate::simulate;
 use crate::study::Study;
@@ -427,13 +428,12 @@ fn validate(study: &Study, spec: &BenchSpec) -> Result<()> {
 /// Write `kernel_bench.csv` into `dir`.
 pub fn write_csv(rows: &[BenchRow], dir: &Path) -> Result<PathBuf> {
     let path = dir.join("kernel_bench.csv");
-    let mut w = csv::Writer::from_path(&path).map_err(|e| Error::csv(&path, e))?;
-    w.write_record(HEADERS).map_err(|e| Error::csv(&path, e))?;
+    let mut w = Table::new(&path);
+    w.row(HEADERS)?;
     for r in rows {
-        w.write_record(r.record())
-            .map_err(|e| Error::csv(&path, e))?;
+        w.row(r.record())?;
     }
-    w.flush().map_err(|e| Error::io(&path, e))?;
+    w.finish()?;
     Ok(path)
 }
 

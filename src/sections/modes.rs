@@ -25,6 +25,7 @@
 use crate::error::{Error, Result};
 use crate::modal::ModeUpdate;
 use crate::panels::{analyse_panel, dfreq_hz_per_deg, in_panel, PanelAnalysis, PanelModes};
+use crate::report::csv::Table;
 use crate::study::Study;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -167,38 +168,22 @@ pub fn mode_rows(results: &[PanelModes]) -> Vec<ModeRow> {
     rows
 }
 
-fn csv_writer(path: &Path) -> Result<csv::Writer<std::fs::File>> {
-    csv::Writer::from_path(path).map_err(|e| Error::csv(path, e))
-}
-
-fn write_row<I, S>(w: &mut csv::Writer<std::fs::File>, path: &Path, rec: I) -> Result<()>
-where
-    I: IntoIterator<Item = S>,
-    S: AsRef<[u8]>,
-{
-    w.write_record(rec).map_err(|e| Error::csv(path, e))
-}
-
 /// Write `modes.csv`, and `mode_derivatives.csv` when the spec asks for it.
 /// Returns the files written.
 pub fn write_results(dir: &Path, results: &[PanelModes], spec: &ModesSpec) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     let path = dir.join("modes.csv");
-    let mut w = csv_writer(&path)?;
-    write_row(
-        &mut w,
-        &path,
-        [
-            "panel",
-            "layup",
-            "mode",
-            "frequency_hz",
-            "reference_hz",
-            "residual",
-            "kind",
-            "symmetry",
-        ],
-    )?;
+    let mut w = Table::new(&path);
+    w.row([
+        "panel",
+        "layup",
+        "mode",
+        "frequency_hz",
+        "reference_hz",
+        "residual",
+        "kind",
+        "symmetry",
+    ])?;
     for row in mode_rows(results) {
         let reference = spec
             .reference_hz
@@ -206,39 +191,31 @@ pub fn write_results(dir: &Path, results: &[PanelModes], spec: &ModesSpec) -> Re
             .and_then(|v| v.get(row.mode - 1))
             .map(|f| f.to_string())
             .unwrap_or_default();
-        write_row(
-            &mut w,
-            &path,
-            [
-                row.panel,
-                row.layup,
-                row.mode.to_string(),
-                format!("{:.6}", row.frequency_hz),
-                reference,
-                format!("{:.2e}", row.residual),
-                row.kind.to_string(),
-                row.symmetry.to_string(),
-            ],
-        )?;
+        w.row([
+            row.panel,
+            row.layup,
+            row.mode.to_string(),
+            format!("{:.6}", row.frequency_hz),
+            reference,
+            format!("{:.2e}", row.residual),
+            row.kind.to_string(),
+            row.symmetry.to_string(),
+        ])?;
     }
-    w.flush().map_err(|e| Error::io(&path, e))?;
+    w.finish()?;
     files.push(path);
 
     if spec.derivatives {
         let path = dir.join("mode_derivatives.csv");
-        let mut w = csv_writer(&path)?;
-        write_row(
-            &mut w,
-            &path,
-            [
-                "panel",
-                "mode",
-                "variable",
-                "dlambda_per_rad",
-                "dfreq_hz_per_deg",
-                "cluster_size",
-            ],
-        )?;
+        let mut w = Table::new(&path);
+        w.row([
+            "panel",
+            "mode",
+            "variable",
+            "dlambda_per_rad",
+            "dfreq_hz_per_deg",
+            "cluster_size",
+        ])?;
         for r in results {
             for (v, d) in r.derivatives.iter().enumerate() {
                 for (j, &dl) in d.dlambda.iter().enumerate() {
@@ -247,22 +224,18 @@ pub fn write_results(dir: &Path, results: &[PanelModes], spec: &ModesSpec) -> Re
                         .iter()
                         .find(|c| j >= c.first && j < c.first + c.len)
                         .map_or(1, |c| c.len);
-                    write_row(
-                        &mut w,
-                        &path,
-                        [
-                            r.panel.clone(),
-                            (j + 1).to_string(),
-                            r.variables[v].clone(),
-                            format!("{dl:.9e}"),
-                            format!("{:.9e}", dfreq_hz_per_deg(r.modes.lambda[j], dl)),
-                            cluster.to_string(),
-                        ],
-                    )?;
+                    w.row([
+                        r.panel.clone(),
+                        (j + 1).to_string(),
+                        r.variables[v].clone(),
+                        format!("{dl:.9e}"),
+                        format!("{:.9e}", dfreq_hz_per_deg(r.modes.lambda[j], dl)),
+                        cluster.to_string(),
+                    ])?;
                 }
             }
         }
-        w.flush().map_err(|e| Error::io(&path, e))?;
+        w.finish()?;
         files.push(path);
     }
     Ok(files)
@@ -271,33 +244,25 @@ pub fn write_results(dir: &Path, results: &[PanelModes], spec: &ModesSpec) -> Re
 /// Write `mode_shapes.csv`: panel, mode, node, x, y, component, value.
 pub fn write_mode_shapes(dir: &Path, results: &[PanelModes]) -> Result<PathBuf> {
     let path = dir.join("mode_shapes.csv");
-    let mut w = csv_writer(&path)?;
-    write_row(
-        &mut w,
-        &path,
-        ["panel", "mode", "node", "x_m", "y_m", "component", "value"],
-    )?;
+    let mut w = Table::new(&path);
+    w.row(["panel", "mode", "node", "x_m", "y_m", "component", "value"])?;
     for r in results {
         for j in 0..r.modes.lambda.len() {
             for (i, &(node, comp)) in r.dof_map.iter().enumerate() {
                 let [x, y] = r.nodes[node];
-                write_row(
-                    &mut w,
-                    &path,
-                    [
-                        r.panel.clone(),
-                        (j + 1).to_string(),
-                        node.to_string(),
-                        format!("{x:.6}"),
-                        format!("{y:.6}"),
-                        comp.to_string(),
-                        format!("{:.9e}", r.modes.modes[(i, j)]),
-                    ],
-                )?;
+                w.row([
+                    r.panel.clone(),
+                    (j + 1).to_string(),
+                    node.to_string(),
+                    format!("{x:.6}"),
+                    format!("{y:.6}"),
+                    comp.to_string(),
+                    format!("{:.9e}", r.modes.modes[(i, j)]),
+                ])?;
             }
         }
     }
-    w.flush().map_err(|e| Error::io(&path, e))?;
+    w.finish()?;
     Ok(path)
 }
 
@@ -438,25 +403,21 @@ pub fn convergence(
 /// Write `convergence.csv` (errors relative to the finest mesh).
 pub fn write_convergence(dir: &Path, rows: &[ConvergenceRow]) -> Result<PathBuf> {
     let path = dir.join("convergence.csv");
-    let mut w = csv_writer(&path)?;
-    write_row(
-        &mut w,
-        &path,
-        [
-            "divisions",
-            "dofs",
-            "symmetric_hz",
-            "symmetric_error",
-            "twisting_hz",
-            "twisting_error",
-            "modes_ms",
-            "modes_and_derivatives_ms",
-            "assembly_ms",
-            "eigen_ms",
-            "derivatives_ms",
-            "setup_ms",
-        ],
-    )?;
+    let mut w = Table::new(&path);
+    w.row([
+        "divisions",
+        "dofs",
+        "symmetric_hz",
+        "symmetric_error",
+        "twisting_hz",
+        "twisting_error",
+        "modes_ms",
+        "modes_and_derivatives_ms",
+        "assembly_ms",
+        "eigen_ms",
+        "derivatives_ms",
+        "setup_ms",
+    ])?;
     let fin = rows.last();
     let err = |v: Option<f64>, r: Option<f64>| match (v, r) {
         (Some(v), Some(r)) => format!("{:.3e}", (v - r).abs() / r),
@@ -464,26 +425,22 @@ pub fn write_convergence(dir: &Path, rows: &[ConvergenceRow]) -> Result<PathBuf>
     };
     let opt = |v: Option<f64>| v.map(|v| format!("{v:.6}")).unwrap_or_default();
     for row in rows {
-        write_row(
-            &mut w,
-            &path,
-            [
-                row.divisions.to_string(),
-                row.dofs.to_string(),
-                opt(row.symmetric_hz),
-                err(row.symmetric_hz, fin.and_then(|f| f.symmetric_hz)),
-                opt(row.twisting_hz),
-                err(row.twisting_hz, fin.and_then(|f| f.twisting_hz)),
-                format!("{:.2}", 1e3 * row.modes_seconds),
-                format!("{:.2}", 1e3 * row.with_derivatives_seconds),
-                format!("{:.2}", 1e3 * row.split_seconds[0]),
-                format!("{:.2}", 1e3 * row.split_seconds[1]),
-                format!("{:.2}", 1e3 * row.split_seconds[2]),
-                format!("{:.2}", 1e3 * row.setup_seconds),
-            ],
-        )?;
+        w.row([
+            row.divisions.to_string(),
+            row.dofs.to_string(),
+            opt(row.symmetric_hz),
+            err(row.symmetric_hz, fin.and_then(|f| f.symmetric_hz)),
+            opt(row.twisting_hz),
+            err(row.twisting_hz, fin.and_then(|f| f.twisting_hz)),
+            format!("{:.2}", 1e3 * row.modes_seconds),
+            format!("{:.2}", 1e3 * row.with_derivatives_seconds),
+            format!("{:.2}", 1e3 * row.split_seconds[0]),
+            format!("{:.2}", 1e3 * row.split_seconds[1]),
+            format!("{:.2}", 1e3 * row.split_seconds[2]),
+            format!("{:.2}", 1e3 * row.setup_seconds),
+        ])?;
     }
-    w.flush().map_err(|e| Error::io(&path, e))?;
+    w.finish()?;
     Ok(path)
 }
 

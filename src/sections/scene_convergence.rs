@@ -18,6 +18,7 @@
 //! (`panel_convergence.toml`) complements with the frequencies.
 
 use crate::error::{Error, Result};
+use crate::report::csv::Table;
 use crate::scene::load_scene;
 use crate::simulate::simulate;
 use crate::study::Study;
@@ -177,7 +178,7 @@ pub fn write_csv(rows: &[Variant], dir: &Path) -> Result<PathBuf> {
     let path = dir.join("scene_convergence.csv");
     let reference =
         reference(rows).ok_or_else(|| Error::numerical("scene_convergence", "no variants"))?;
-    let mut w = csv::Writer::from_path(&path).map_err(|e| Error::csv(&path, e))?;
+    let mut w = Table::new(&path);
     let mut head: Vec<String> = [
         "divisions",
         "modes",
@@ -193,7 +194,7 @@ pub fn write_csv(rows: &[Variant], dir: &Path) -> Result<PathBuf> {
         head.push(name.clone());
         head.push(format!("{name}_rel_error"));
     }
-    w.write_record(&head).map_err(|e| Error::csv(&path, e))?;
+    w.row(&head)?;
     for v in rows {
         let mut rec = vec![
             v.divisions.to_string(),
@@ -207,9 +208,9 @@ pub fn write_csv(rows: &[Variant], dir: &Path) -> Result<PathBuf> {
             rec.push(format!("{value:.10e}"));
             rec.push(format!("{:.3e}", (value - r).abs() / r.abs().max(1e-300)));
         }
-        w.write_record(&rec).map_err(|e| Error::csv(&path, e))?;
+        w.row(&rec)?;
     }
-    w.flush().map_err(|e| Error::io(&path, e))?;
+    w.finish()?;
     Ok(path)
 }
 
