@@ -11,26 +11,86 @@
 //!
 //! ```text
 //! study file (TOML) -> Study -> Laminate (ABD + d/dθ) -> Panel FE (K, M + dK/dθ)
-//!   -> ModalBasis (modes + derivatives) -> multibody System -> Integrator
-//!   -> Responses -> Evaluator -> Optimizers -> Drivers -> Reports
+//!   -> ModalBasis (modes + derivatives) -> Scene (multibody System) -> Integrator
+//!   -> Responses -> Evaluator (Problem) -> Optimizers -> Drivers -> Reports
 //! ```
 //!
 //! Each arrow is a module boundary; a module knows the ones before it and
 //! none after it.
 //!
+//! The road in a few lines: a study with a scene (a pendulum released
+//! horizontally under gravity, its hinge 1 m above the datum of the
+//! potential energy), built, simulated, checked against energy
+//! conservation:
+//!
+//! ```
+//! use plyscape::study::Study;
+//!
+//! let text = r#"
+//! [scene]
+//! effects = ["gravity"]
+//! [[scene.bodies]]
+//! name = "bob"
+//! mass = 2.0
+//! com = [0.5, 0.0, 1.0]
+//! inertia = [[1e-3, 0.0, 0.0], [0.0, 1e-3, 0.0], [0.0, 0.0, 1e-3]]
+//! [[scene.joints]]
+//! name = "hinge"
+//! type = "revolute"
+//! body_i = "ground"
+//! body_j = "bob"
+//! point = [0.0, 0.0, 1.0]
+//! axis = [0.0, 1.0, 0.0]
+//! [scene.integrator]
+//! t_end = 1.0
+//! dt_out = 0.1
+//! rtol = 1e-9
+//! atol = 1e-11
+//! [scene.outputs]
+//! quantities = ["hinge.angle", "energy"]
+//! "#;
+//! let study = Study::parse("pendulum.toml", text)?;
+//! let scene = plyscape::scene::load_scene(&study)?;
+//! let (_, sim) = plyscape::simulate::simulate(&scene)?;
+//! assert_eq!(sim.headers, ["t [s]", "hinge.angle [rad]", "energy [J]"]);
+//! assert!(sim.energy_error.unwrap() < 1e-6);
+//! # Ok::<(), plyscape::Error>(())
+//! ```
+//!
 //! ## Modules
+//! In the order of the road; each imports only modules above it.
 //! - [`error`]: the one error type ([`Error`]).
 //! - [`study`]: study files, validation, error locations.
 //! - [`laminate`]: orthotropic plies, ABD and shear stiffness, exact ply-angle
 //!   derivatives.
 //! - [`fe`]: panel mesh, laminated shell triangle, sparse assembly, supports.
 //! - [`modal`]: lowest modes, eigenvalue and eigenvector derivatives.
-//! - [`panels`]: the panel modal-analysis study (`plyscape modes`), and the
-//!   panel's modal basis for a flexible body ([`panels::panel_basis`]).
+//! - [`mbs`]: the multibody kernel: bodies (rigid, floating-frame flexible
+//!   with a [`mbs::ModalBasis`]), joints, forces, equations of motion and
+//!   their constraint-space solve, outputs; no files.
+//! - [`panels`]: a panel's modal analysis reused across lay-ups and its
+//!   modes as a [`mbs::ModalBasis`] ([`panels::BasisBuilder`]).
+//! - [`integrate`]: time integration (BDF, explicit and SDIRK Runge–Kutta)
+//!   with forward sensitivities and Eq. 32 segment events.
+//! - [`scene`]: the `[scene]` section: parsed data → model
+//!   ([`scene::SceneSpec`], [`scene::Scene`]) and [`scene::ScenePlan`], the
+//!   road of a design (ply angles as numbers, panel analyses built once).
+//! - [`simulate`]: integrate a built scene, outputs, responses and their
+//!   sensitivities.
 //! - [`optimize`]: the evaluation interface, MMFD, CMA-ES.
-//! - [`explore`]: multistart, evolutionary comparison, maps, sharding.
-//! - [`report`]: CSV, SVG and terminal output (observers only).
+//! - [`explore`]: multistart, evolutionary comparison, maps, sharding; the
+//!   scene as an optimization problem.
+//! - [`sections`]: study sections that tabulate or measure (panel modes,
+//!   kernel and events benchmarks, scene convergence).
+//! - [`report`]: every writer: CSV tables, SVG plots, manifest, progress.
 //! - [`cli`]: the command line.
+//!
+//! Where to add things: a joint type in [`mbs::model`] (kind and
+//! equations) and [`mbs::rows`] (its constraint rows), named in
+//! [`scene::build`]; an output or response in [`scene::quantity`] (parsed
+//! in [`scene::parts`]) and evaluated in [`simulate`]; a study section in
+//! [`sections`] with its entry in [`cli`]; an optimizer in [`optimize`]
+//! behind [`optimize::Problem`], selectable in [`explore::solvers`].
 //!
 //! ## Glossary
 //! FE finite element; FFRF floating frame of reference; CMS component mode

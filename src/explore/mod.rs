@@ -21,6 +21,26 @@
 //! `[multistart]` ([`MultistartSection`]), `[evolve]` ([`EvolveSection`]),
 //! `[compare]` (no keys), `[map]` ([`MapSection`]) and `[scaling]`
 //! ([`scaling::ScalingSection`]).
+//!
+//! A problem from a study, evaluated with its gradient (Himmelblau's
+//! function has a minimum f = 0 at (3, 2)):
+//!
+//! ```
+//! use plyscape::optimize::Problem;
+//! use plyscape::study::Study;
+//!
+//! let study = Study::parse("himmelblau.toml", "[problem]\nname = \"himmelblau\"\n")?;
+//! let problem = plyscape::explore::problem(&study)?;
+//! let e = problem.evaluate(&[3.0, 2.0], true)?;
+//! assert!(e.f.abs() < 1e-12);
+//! assert!(e.grad_f.unwrap().iter().all(|g| g.abs() < 1e-10));
+//! # Ok::<(), plyscape::Error>(())
+//! ```
+//!
+//! Where things go: a new optimizer goes in [`crate::optimize`] behind the
+//! [`crate::optimize::Problem`] interface and is named in [`solvers`]; a
+//! new driver (a sweep of another kind) is a file here with its section
+//! struct, writing its tables through [`crate::report`].
 
 pub mod cluster;
 pub mod evolve;

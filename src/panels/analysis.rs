@@ -32,11 +32,11 @@ pub struct PanelModes {
     pub derivatives: Vec<VariableDerivatives>,
     /// Design-variable names: `theta_1_4` ties plies 1 and 4.
     pub variables: Vec<String>,
-    /// Wall times [s]: assembly, modes, derivatives.
+    /// Wall times \[s\]: assembly, modes, derivatives.
     pub seconds: [f64; 3],
     /// Reduced DOF → (node, component 0..6 = u, v, w, θx, θy, θz).
     pub dof_map: Vec<(usize, usize)>,
-    /// Node coordinates, panel frame [m].
+    /// Node coordinates, panel frame \[m\].
     pub nodes: Vec<[f64; 2]>,
 }
 
@@ -66,7 +66,7 @@ pub struct PanelAnalysis {
     solver: ModalSolver,
     want: Option<ModeUpdate>,
     mirrors: [Option<Vec<usize>>; 2],
-    /// Wall time of the set-up [s].
+    /// Wall time of the set-up \[s\].
     pub setup_seconds: f64,
 }
 

@@ -9,8 +9,8 @@
 //! that does not depend on the ply angles and takes a design as numbers).
 //!
 //! Where things go: a new joint type is a [`crate::mbs::JointKind`]
-//! variant (rows in `mbs::rows`), named in [`spec::JointType`] and built
-//! in [`build`]; a new output or response is a [`Quantity`] /
+//! variant (rows in `mbs::rows`), given a `type` name in [`build`]
+//! (`joint_kind`); a new output or response is a [`Quantity`] /
 //! [`Response`] variant parsed in [`parts`] and evaluated in
 //! [`crate::simulate`].
 //!
@@ -53,6 +53,43 @@
 //! body's frame is its basis frame (the beam's root, the panel's centre),
 //! placed at `origin` with its x and y axes along `x_axis`, `y_axis`;
 //! points on it (joints, markers) must be nodes of its basis.
+//!
+//! From data to a model, stage by stage (a pendulum: a point-like bob on
+//! a horizontal hinge about y, released horizontally):
+//!
+//! ```
+//! use plyscape::scene::{Quantity, SceneSpec};
+//! use plyscape::study::Study;
+//!
+//! let text = r#"
+//! [scene]
+//! effects = ["gravity"]
+//! [[scene.bodies]]
+//! name = "bob"
+//! mass = 1.0
+//! com = [1.0, 0.0, 0.0]
+//! inertia = [[1e-4, 0.0, 0.0], [0.0, 1e-4, 0.0], [0.0, 0.0, 1e-4]]
+//! [[scene.joints]]
+//! name = "hinge"
+//! type = "revolute"
+//! body_i = "ground"
+//! body_j = "bob"
+//! point = [0.0, 0.0, 0.0]
+//! axis = [0.0, 1.0, 0.0]
+//! [scene.integrator]
+//! t_end = 0.5
+//! dt_out = 0.05
+//! [scene.outputs]
+//! quantities = ["hinge.angle", "energy"]
+//! "#;
+//! let study = Study::parse("pendulum.toml", text)?;
+//! let spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
+//! let scene = spec.build()?;
+//! assert_eq!(scene.model.bodies.len(), 1);
+//! assert_eq!(scene.outputs[0].1, Quantity::Angle(0));
+//! assert_eq!(scene.outputs[0].1.headers("hinge.angle"), ["hinge.angle [rad]"]);
+//! # Ok::<(), plyscape::Error>(())
+//! ```
 
 pub mod build;
 pub mod load;

@@ -4,7 +4,7 @@
 /// A built response: the bodies whose strain energies it sums.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Response {
-    /// `∫ scale·ΣU dt`: index into [`Model::integrals`].
+    /// `∫ scale·ΣU dt`: index into [`crate::mbs::Model::integrals`].
     Integral { name: String, index: usize },
     /// `max_t scale·ΣU(t)`.
     Peak {

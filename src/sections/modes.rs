@@ -58,7 +58,7 @@ pub struct ModesSpec {
     /// Write `mode_shapes.csv` (default false: it is large).
     #[serde(default)]
     pub mode_shapes: bool,
-    /// Reference frequencies [Hz] per panel name, printed beside ours
+    /// Reference frequencies \[Hz\] per panel name, printed beside ours
     /// (e.g. the paper's Tables 2–3; cite the source in the study file).
     #[serde(default)]
     pub reference_hz: BTreeMap<String, Vec<f64>>,
@@ -309,19 +309,19 @@ pub fn print_table(results: &[PanelModes], spec: &ModesSpec) {
 pub struct ConvergenceRow {
     pub divisions: usize,
     pub dofs: usize,
-    /// First flexural mode with symmetry SS [Hz].
+    /// First flexural mode with symmetry SS \[Hz\].
     pub symmetric_hz: Option<f64>,
-    /// First flexural mode with symmetry AA (twisting) [Hz].
+    /// First flexural mode with symmetry AA (twisting) \[Hz\].
     pub twisting_hz: Option<f64>,
-    /// Median wall times per design [s] (set-up excluded): assembly +
+    /// Median wall times per design \[s\] (set-up excluded): assembly +
     /// modes; assembly with derivative matrices + modes + derivatives for
     /// every design variable.
     pub modes_seconds: f64,
     pub with_derivatives_seconds: f64,
-    /// Median split of the second timing [s]: assembly, modes, derivatives.
+    /// Median split of the second timing \[s\]: assembly, modes, derivatives.
     pub split_seconds: [f64; 3],
     /// One-off set-up with derivative matrices (mesh, pattern, symbolic
-    /// factorization) [s].
+    /// factorization) \[s\].
     pub setup_seconds: f64,
 }
 
