@@ -422,18 +422,6 @@ impl Load {
     }
 }
 
-impl Force {
-    /// Effect name as in the scene's `effects` list.
-    pub fn effect(&self) -> &'static str {
-        match self {
-            Force::Gravity { .. } => "gravity",
-            Force::Rotational { .. } => "actuators",
-            Force::SpringDamper { .. } => "springs",
-            Force::BodyLoad { .. } => "loads",
-        }
-    }
-}
-
 /// The whole rigid model.
 #[derive(Debug, Clone, Default)]
 pub struct Model {

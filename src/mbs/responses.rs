@@ -22,12 +22,31 @@ use super::dynamics::System;
 use super::model::Param;
 use num_dual::Dual64;
 
+/// The kind of a response functional (paper Eqs. 33–34).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ResponseKind {
+    /// `∫ scale·ΣU dt` over the run, an integrated state (Eq. 33).
+    Integral,
+    /// `max_t scale·ΣU(t)` at its critical time point (Eq. 34).
+    Peak,
+}
+
+impl std::fmt::Display for ResponseKind {
+    /// The name written in study files and `responses.csv`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ResponseKind::Integral => "integral",
+            ResponseKind::Peak => "peak",
+        })
+    }
+}
+
 /// One evaluated response.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResponseValue {
     pub name: String,
-    /// `integral` or `peak`.
-    pub kind: &'static str,
+    /// Integral over the run or peak value.
+    pub kind: ResponseKind,
     pub value: f64,
     /// Time of the peak (s); `None` for integrals.
     pub time: Option<f64>,

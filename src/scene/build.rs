@@ -8,7 +8,7 @@ use super::parts::{
     PanelBases,
 };
 use super::quantity::{Quantity, Response};
-use super::spec::{ForceSpec, JointSpec, SceneSpec, SegmentSpec, EFFECTS};
+use super::spec::{Effect, ForceSpec, JointSpec, SceneSpec, SegmentSpec};
 use crate::error::{Error, Result};
 use crate::integrate::Options;
 use crate::mbs::model::{
@@ -26,7 +26,8 @@ pub struct Scene {
     pub plot: Option<String>,
     /// File stem of the plot (`<plot_file>.svg`).
     pub plot_file: Option<String>,
-    pub effects: Vec<String>,
+    /// The effects the scene switches on.
+    pub effects: Vec<Effect>,
     /// Sensitivity parameters with their names from the scene file.
     pub params: Vec<(String, Param)>,
     /// Response functionals.
@@ -53,7 +54,7 @@ impl SceneSpec {
         self.check_settings()?;
         let mut model = Model {
             baumgarte: self.baumgarte,
-            quadratic_velocity: self.has("quadratic_velocity"),
+            quadratic_velocity: self.has(Effect::QuadraticVelocity),
             ..Model::default()
         };
         self.add_bodies(&mut model, panels)?;
@@ -76,28 +77,20 @@ impl SceneSpec {
             outputs,
             plot: self.outputs.plot.clone(),
             plot_file: self.outputs.plot_file.clone(),
-            effects: self.effects.clone(),
+            effects: self.effect_list()?,
             params,
             responses,
         })
     }
 
     /// Whether the scene lists effect `e`.
-    fn has(&self, e: &str) -> bool {
-        self.effects.iter().any(|x| x == e)
+    fn has(&self, e: Effect) -> bool {
+        self.effects.iter().any(|x| x == e.name())
     }
 
     /// Known effects and a valid Baumgarte rate.
     fn check_settings(&self) -> Result<()> {
-        for (k, e) in self.effects.iter().enumerate() {
-            if !EFFECTS.contains(&e.as_str()) {
-                return Err(Error::input(
-                    format!("effects[{k}]"),
-                    e,
-                    format!("one of {}", EFFECTS.join(", ")),
-                ));
-            }
-        }
+        self.effect_list()?;
         if !(self.baumgarte >= 0.0 && self.baumgarte.is_finite()) {
             return Err(Error::input(
                 "baumgarte",
@@ -120,7 +113,7 @@ impl SceneSpec {
                     "a unique body name other than 'ground'",
                 ));
             }
-            let mut body = match (&b.flexible, self.has("flexibility")) {
+            let mut body = match (&b.flexible, self.has(Effect::Flexibility)) {
                 (Some(f), true) => {
                     if b.fixed {
                         return Err(Error::input(
@@ -129,7 +122,7 @@ impl SceneSpec {
                             "a moving body (a fixed body cannot be flexible)",
                         ));
                     }
-                    flexible_body(&key, &b.name, f, self.has("damping"), panels)?
+                    flexible_body(&key, &b.name, f, self.has(Effect::Damping), panels)?
                 }
                 _ => {
                     let need = |what: &str| {
@@ -225,7 +218,7 @@ impl SceneSpec {
     /// Gravity and the `[[scene.forces]]` the effects list builds;
     /// returns the model index of each scene force (None: not built).
     fn add_forces(&self, model: &mut Model) -> Result<Vec<Option<usize>>> {
-        if self.has("gravity") {
+        if self.has(Effect::Gravity) {
             model.forces.push(Force::Gravity {
                 g: finite3("gravity".into(), self.gravity)?,
             });
@@ -301,7 +294,7 @@ impl SceneSpec {
                 "a finite damping ≥ 0 (N·m·s)",
             ));
         }
-        let law = if self.has("actuators") && !segments.is_empty() {
+        let law = if self.has(Effect::Actuators) && !segments.is_empty() {
             let segs = segments
                 .iter()
                 .map(|s| Segment {
@@ -316,7 +309,11 @@ impl SceneSpec {
         } else {
             None
         };
-        let c = if self.has("damping") { damping } else { 0.0 };
+        let c = if self.has(Effect::Damping) {
+            damping
+        } else {
+            0.0
+        };
         Ok((law.is_some() || c != 0.0).then_some(Force::Rotational {
             joint: jt,
             law,
@@ -363,10 +360,14 @@ impl SceneSpec {
                 "a point distinct from marker_i",
             ));
         }
-        if !self.has("springs") {
+        if !self.has(Effect::Springs) {
             return Ok(None);
         }
-        let c = if self.has("damping") { damping } else { 0.0 };
+        let c = if self.has(Effect::Damping) {
+            damping
+        } else {
+            0.0
+        };
         Ok(Some(Force::SpringDamper {
             i,
             j,
@@ -395,7 +396,7 @@ impl SceneSpec {
             Some(rows) => Load::Table(load_table(&format!("{key}.table"), rows)?),
         };
         Ok(self
-            .has("loads")
+            .has(Effect::Loads)
             .then_some(Force::BodyLoad { body: b, load }))
     }
 

@@ -101,4 +101,4 @@ pub use build::Scene;
 pub use load::{load_scene, ScenePlan};
 pub use parts::PanelBases;
 pub use quantity::{Quantity, Response};
-pub use spec::SceneSpec;
+pub use spec::{Effect, SceneSpec};

@@ -8,19 +8,82 @@ use crate::modal::ModeUpdate;
 use serde::Deserialize;
 
 /// Effects a scene may list.
-pub const EFFECTS: [&str; 7] = [
-    "gravity",
-    "actuators",
-    "damping",
-    "springs",
-    "loads",
-    "flexibility",
-    "quadratic_velocity",
-];
+/// What a scene may switch on (`[scene] effects`): what is not listed is
+/// neither built nor evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Effect {
+    /// Uniform gravity on every moving body.
+    Gravity,
+    /// The Eq. 32 laws of actuators.
+    Actuators,
+    /// Actuator, spring and modal damping.
+    Damping,
+    /// Spring-dampers between markers.
+    Springs,
+    /// Constant or tabulated loads.
+    Loads,
+    /// Flexible bodies with their `flexible` table (else rigid stand-ins).
+    Flexibility,
+    /// Quadratic-velocity (gyroscopic and centrifugal) terms.
+    QuadraticVelocity,
+}
+
+impl Effect {
+    /// Every effect, in the order of the documentation.
+    pub const ALL: [Effect; 7] = [
+        Effect::Gravity,
+        Effect::Actuators,
+        Effect::Damping,
+        Effect::Springs,
+        Effect::Loads,
+        Effect::Flexibility,
+        Effect::QuadraticVelocity,
+    ];
+
+    /// The name written in study files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Effect::Gravity => "gravity",
+            Effect::Actuators => "actuators",
+            Effect::Damping => "damping",
+            Effect::Springs => "springs",
+            Effect::Loads => "loads",
+            Effect::Flexibility => "flexibility",
+            Effect::QuadraticVelocity => "quadratic_velocity",
+        }
+    }
+
+    /// The effect named `name`, if any.
+    pub fn parse(name: &str) -> Option<Effect> {
+        Effect::ALL.into_iter().find(|e| e.name() == name)
+    }
+}
+
+impl SceneSpec {
+    /// The listed effects; an unknown name is an input error on
+    /// `effects[k]` listing the known ones.
+    pub fn effect_list(&self) -> Result<Vec<Effect>> {
+        self.effects
+            .iter()
+            .enumerate()
+            .map(|(k, e)| {
+                Effect::parse(e).ok_or_else(|| {
+                    let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
+                    Error::input(
+                        format!("effects[{k}]"),
+                        e,
+                        format!("one of {}", names.join(", ")),
+                    )
+                })
+            })
+            .collect()
+    }
+}
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneSpec {
+    /// Effect names as written ([`SceneSpec::effect_list`] checks them).
     pub effects: Vec<String>,
     #[serde(default = "default_gravity")]
     pub gravity: [f64; 3],

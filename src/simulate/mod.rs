@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Stats};
 use crate::mbs::analysis::Projection;
-use crate::mbs::responses::{peak, strain_sum, ResponseValue};
+use crate::mbs::responses::{peak, strain_sum, ResponseKind, ResponseValue};
 use crate::mbs::{Param, Reaction, System, Workspace};
 use crate::report::csv::{sci, write_table};
 use crate::report::{line_plot, Axes, Curve};
@@ -190,7 +190,7 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         responses.push(match r {
             Response::Integral { name, index } => ResponseValue {
                 name: name.clone(),
-                kind: "integral",
+                kind: ResponseKind::Integral,
                 value: y_end[io + index],
                 time: None,
                 gradient: (0..scene.params.len())
@@ -203,7 +203,7 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
                 })?;
                 ResponseValue {
                     name: name.clone(),
-                    kind: "peak",
+                    kind: ResponseKind::Peak,
                     value,
                     time: Some(t),
                     gradient,
