@@ -1,7 +1,9 @@
 //! A study → [`Scene`]: the `[scene]` section with the modal bases of its
 //! panel bodies taken from the study's `[[panels]]`.
 //!
-//! [`load_scene`] builds one scene as the study file describes it.
+//! [`load_scene`] builds one scene as the study file describes it. Both
+//! compute mode derivatives only for the bodies whose ply angles are
+//! sensitivity parameters ([`SceneSpec::prune_derivatives`]).
 //! [`ScenePlan`] is the road of a design through the code: the section is
 //! parsed and the panels are resolved (mesh, design map) once; each
 //! [`BasisBuilder`] (sparsity pattern, symbolic factorization, element
@@ -27,7 +29,8 @@ use std::sync::Mutex;
 /// their modal basis from the study's `[[panels]]` (built only when the
 /// scene lists `flexibility`).
 pub fn load_scene(study: &Study) -> Result<Scene> {
-    let spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
+    let mut spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
+    spec.prune_derivatives();
     let panels = |name: &str, modes: usize, update: Option<ModeUpdate>| {
         crate::panels::basis_for_study(study, name, modes, update)
     };
@@ -104,6 +107,7 @@ impl ScenePlan {
         }
         let mut spec = self.spec.clone();
         spec.sensitivities = sensitivities.to_vec();
+        spec.prune_derivatives();
         if !outputs {
             spec.outputs = Default::default();
         }
