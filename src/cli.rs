@@ -262,6 +262,7 @@ fn handlers() -> Vec<(&'static str, Handler)> {
         ("kernel_bench", run_kernel_bench_handler),
         ("events_bench", run_events_bench_handler),
         ("scene_convergence", run_scene_convergence_handler),
+        ("eval_bench", run_eval_bench_handler),
     ]
 }
 
@@ -269,6 +270,11 @@ fn handlers() -> Vec<(&'static str, Handler)> {
 fn run_scene_convergence_handler(cfg: &RunConfig) -> Result<()> {
     crate::sections::scene_convergence::run_scene_convergence(&cfg.study, &cfg.out, cfg.quiet)
         .map(|_| ())
+}
+
+/// The `[eval_bench]` section: cost of one design evaluation, by stage.
+fn run_eval_bench_handler(cfg: &RunConfig) -> Result<()> {
+    crate::sections::eval_bench::run_eval_bench_section(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
 }
 
 /// The `[events_bench]` section: Eq. 32 segment changes as events or not.

@@ -272,3 +272,59 @@ fn measure_full_evaluation_cost() {
         );
     }
 }
+
+#[test]
+fn evaluations_compute_only_what_they_are_asked() {
+    // f-only: both panel bases, none with mode derivatives, no sensitivity
+    // lanes and no Jacobian-vector products (tsit45 is explicit); f+g: the
+    // four lanes of the two shared ply angles and both bases with
+    // derivatives. The section's CSV carries the same counts.
+    let dir = std::env::temp_dir().join(format!("plyscape-eval-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("coarse.toml"), coarse()).unwrap();
+    let bench = "[eval_bench]\nproblems = [\"coarse.toml\"]\nrepeats = 1\n";
+    let path = dir.join("bench.toml");
+    std::fs::write(&path, bench).unwrap();
+    let study = Study::load(&path).unwrap();
+    let spec: plyscape::sections::eval_bench::EvalBenchSpec =
+        study.require_section("eval_bench", "").unwrap();
+    let rows = plyscape::sections::eval_bench::run_eval_bench(&study, &spec, |_| {}).unwrap();
+    let h = plyscape::sections::eval_bench::HEADERS;
+    let col = |r: &Vec<String>, name: &str| r[h.iter().position(|c| *c == name).unwrap()].clone();
+    assert_eq!(rows.len(), 2);
+    let (f, fg) = (&rows[0], &rows[1]);
+    assert_eq!(col(f, "mode"), "f");
+    assert_eq!(col(f, "design [deg]"), "55 -55");
+    assert_eq!(
+        [
+            col(f, "lanes"),
+            col(f, "bases"),
+            col(f, "derivative_bases"),
+            col(f, "jvp_calls")
+        ],
+        ["0", "2", "0", "0"]
+    );
+    assert_eq!(
+        [
+            col(fg, "lanes"),
+            col(fg, "bases"),
+            col(fg, "derivative_bases")
+        ],
+        ["4", "2", "2"]
+    );
+    assert!(col(fg, "jvp_calls").parse::<u64>().unwrap() > 0);
+    for r in &rows {
+        let total: f64 = col(r, "total [ms]").parse().unwrap();
+        let parts: f64 = [
+            "bases [ms]",
+            "build_other [ms]",
+            "integrate [ms]",
+            "outputs [ms]",
+        ]
+        .iter()
+        .map(|c| col(r, c).parse::<f64>().unwrap())
+        .sum();
+        assert!(total > 0.0 && parts <= total * 1.01 + 0.01, "{r:?}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

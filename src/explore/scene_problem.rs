@@ -60,7 +60,7 @@ use crate::error::{Error, Result};
 use crate::laminate::Laminate;
 use crate::mbs::responses::ResponseValue;
 use crate::optimize::{Evaluation, Problem, Variable};
-use crate::scene::ScenePlan;
+use crate::scene::{BuildProfile, ScenePlan};
 use crate::simulate::simulate;
 use crate::study::Study;
 use serde::Deserialize;
@@ -150,6 +150,28 @@ pub struct SceneProblem {
 struct Raw {
     values: Vec<f64>,
     gradients: Option<Vec<Vec<f64>>>,
+    profile: EvalProfile,
+}
+
+/// What one evaluation computed and where its time went.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EvalProfile {
+    /// The scene build: panel bases (count, with derivatives, seconds).
+    pub build: BuildProfile,
+    /// Sensitivity lanes integrated with the motion (0 without gradients).
+    pub lanes: usize,
+    /// Accepted integration steps.
+    pub steps: usize,
+    /// Right-hand-side evaluations and Jacobian-vector products.
+    pub rhs_calls: u64,
+    pub jvp_calls: u64,
+    /// Wall time of the integration (states and sensitivities, outputs
+    /// excluded) \[s\].
+    pub integrate_seconds: f64,
+    /// Wall time of the output and response evaluation \[s\].
+    pub outputs_seconds: f64,
+    /// Wall time of the whole evaluation \[s\].
+    pub total_seconds: f64,
 }
 
 impl SceneProblem {
@@ -411,9 +433,13 @@ impl SceneProblem {
     fn raw(&self, x: &[f64], names: &[String], gradients: bool) -> Result<Raw> {
         let design = || design_label(&self.vars, x);
         let at = |e: Error| at_design(e, &self.vars, x);
+        let t0 = std::time::Instant::now();
         let lanes: &[String] = if gradients { &self.lanes } else { &[] };
         let laminates = self.laminates_at(x)?;
-        let scene = self.plan.build(&laminates, lanes, false).map_err(at)?;
+        let (scene, build) = self
+            .plan
+            .build_profiled(&laminates, lanes, false)
+            .map_err(at)?;
         let sim = simulate(&scene).map_err(at)?.1;
         let find = |name: &str| -> Result<&ResponseValue> {
             sim.responses
@@ -448,10 +474,70 @@ impl SceneProblem {
                 grads.push(g);
             }
         }
+        let profile = EvalProfile {
+            build,
+            lanes: lanes.len(),
+            steps: sim.stats.steps,
+            rhs_calls: sim.stats.rhs_calls,
+            jvp_calls: sim.stats.jvp_calls,
+            integrate_seconds: sim.stats.wall,
+            outputs_seconds: sim.stats.observer_wall,
+            total_seconds: t0.elapsed().as_secs_f64(),
+        };
         Ok(Raw {
             values,
             gradients: gradients.then_some(grads),
+            profile,
         })
+    }
+
+    /// [`Problem::evaluate`] with what the evaluation computed and where
+    /// its time went.
+    pub fn evaluate_profiled(
+        &self,
+        x: &[f64],
+        gradients: bool,
+    ) -> Result<(Evaluation, EvalProfile)> {
+        if x.len() != self.vars.len() || x.iter().any(|v| !v.is_finite()) {
+            return Err(Error::input(
+                "scene_problem.x",
+                format!("{x:?}"),
+                format!("{} finite angles [deg]", self.vars.len()),
+            ));
+        }
+        let mut names = vec![self.objective.0.clone()];
+        names.extend(self.constraints.iter().map(|c| c.0.clone()));
+        let raw = self.raw(x, &names, gradients)?;
+        let s = self.objective.1;
+        let f = raw.values[0] / s;
+        let g = self
+            .constraints
+            .iter()
+            .zip(&raw.values[1..])
+            .map(|(c, v)| v / c.1 - 1.0)
+            .collect();
+        let (grad_f, grad_g) = match raw.gradients {
+            None => (None, None),
+            Some(gr) => {
+                let gf = gr[0].iter().map(|v| v / s).collect();
+                let gg = self
+                    .constraints
+                    .iter()
+                    .zip(&gr[1..])
+                    .map(|(c, row)| row.iter().map(|v| v / c.1).collect())
+                    .collect();
+                (Some(gf), Some(gg))
+            }
+        };
+        Ok((
+            Evaluation {
+                f,
+                g,
+                grad_f,
+                grad_g,
+            },
+            raw.profile,
+        ))
     }
 }
 
@@ -492,43 +578,7 @@ impl Problem for SceneProblem {
     }
     /// `f = R₀/s`, `g_j = R_j/c_j − 1`, gradients per degree.
     fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
-        if x.len() != self.vars.len() || x.iter().any(|v| !v.is_finite()) {
-            return Err(Error::input(
-                "scene_problem.x",
-                format!("{x:?}"),
-                format!("{} finite angles [deg]", self.vars.len()),
-            ));
-        }
-        let mut names = vec![self.objective.0.clone()];
-        names.extend(self.constraints.iter().map(|c| c.0.clone()));
-        let raw = self.raw(x, &names, gradients)?;
-        let s = self.objective.1;
-        let f = raw.values[0] / s;
-        let g = self
-            .constraints
-            .iter()
-            .zip(&raw.values[1..])
-            .map(|(c, v)| v / c.1 - 1.0)
-            .collect();
-        let (grad_f, grad_g) = match raw.gradients {
-            None => (None, None),
-            Some(gr) => {
-                let gf = gr[0].iter().map(|v| v / s).collect();
-                let gg = self
-                    .constraints
-                    .iter()
-                    .zip(&gr[1..])
-                    .map(|(c, row)| row.iter().map(|v| v / c.1).collect())
-                    .collect();
-                (Some(gf), Some(gg))
-            }
-        };
-        Ok(Evaluation {
-            f,
-            g,
-            grad_f,
-            grad_g,
-        })
+        Ok(self.evaluate_profiled(x, gradients)?.0)
     }
     fn name(&self) -> &str {
         "scene"

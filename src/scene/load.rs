@@ -23,7 +23,25 @@ use crate::mbs::ModalBasis;
 use crate::modal::ModeUpdate;
 use crate::panels::BasisBuilder;
 use crate::study::Study;
+use std::cell::Cell;
 use std::sync::Mutex;
+use std::time::Instant;
+
+/// What one [`ScenePlan::build_profiled`] computed: panel bases (and how
+/// many with mode derivatives), and the wall time spent in them and in the
+/// whole build.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BuildProfile {
+    /// Panel modal bases computed.
+    pub bases: usize,
+    /// Of those, bases with mode derivatives (dΛ/dθ, dX/dθ).
+    pub derivative_bases: usize,
+    /// Wall time in the panel bases \[s\] (assembly, factorization,
+    /// Lanczos, derivatives, basis conversion).
+    pub bases_seconds: f64,
+    /// Wall time of the whole build \[s\] (bases included).
+    pub total_seconds: f64,
+}
 
 /// Read the `[scene]` section of a study and build it. Panel bodies take
 /// their modal basis from the study's `[[panels]]` (built only when the
@@ -98,6 +116,17 @@ impl ScenePlan {
         sensitivities: &[String],
         outputs: bool,
     ) -> Result<Scene> {
+        Ok(self.build_profiled(laminates, sensitivities, outputs)?.0)
+    }
+
+    /// [`ScenePlan::build`] with what it computed and its cost.
+    pub fn build_profiled(
+        &self,
+        laminates: &[Laminate],
+        sensitivities: &[String],
+        outputs: bool,
+    ) -> Result<(Scene, BuildProfile)> {
+        let t0 = Instant::now();
         if laminates.len() != self.panels.len() {
             return Err(Error::input(
                 "laminates",
@@ -111,10 +140,23 @@ impl ScenePlan {
         if !outputs {
             spec.outputs = Default::default();
         }
+        let profile = Cell::new(BuildProfile::default());
         let bases = |name: &str, modes: usize, update: Option<ModeUpdate>| {
-            self.basis(name, modes, update, laminates)
+            let t = Instant::now();
+            let basis = self.basis(name, modes, update, laminates);
+            let mut p = profile.get();
+            p.bases += 1;
+            p.derivative_bases += usize::from(update.is_some());
+            p.bases_seconds += t.elapsed().as_secs_f64();
+            profile.set(p);
+            basis
         };
-        spec.build_with(&bases).map_err(self.study.locate("scene"))
+        let scene = spec
+            .build_with(&bases)
+            .map_err(self.study.locate("scene"))?;
+        let mut p = profile.get();
+        p.total_seconds = t0.elapsed().as_secs_f64();
+        Ok((scene, p))
     }
 
     /// The basis of panel `name` with lay-up `laminates[i]`, from a pooled

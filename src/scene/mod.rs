@@ -98,7 +98,7 @@ pub mod quantity;
 pub mod spec;
 
 pub use build::Scene;
-pub use load::{load_scene, ScenePlan};
+pub use load::{load_scene, BuildProfile, ScenePlan};
 pub use parts::PanelBases;
 pub use quantity::{Quantity, Response};
 pub use spec::{Effect, SceneSpec};

@@ -1,14 +1,17 @@
 //! Study sections: the panel modes table (`plyscape modes`: `[modes]`,
 //! `[convergence]`), the kernel benchmark
 //! (`[kernel_bench]`), the Eq. 32 events benchmark (`[events_bench]`) and
-//! the flexible-scene convergence grid (`[scene_convergence]`). Each
+//! the flexible-scene convergence grid (`[scene_convergence]`) and the
+//! cost of one design evaluation (`[eval_bench]`). Each
 //! reads its section, runs scenes through [`crate::scene`] and
 //! [`crate::simulate`], and writes its table through [`crate::report`].
 //!
 //! A new study section goes here: a file with its serde spec, a `run_*`
 //! entry point called from [`crate::cli`], and its writer.
 
+pub mod eval_bench;
 pub mod events_bench;
 pub mod kernel_bench;
 pub mod modes;
 pub mod scene_convergence;
+pub mod stats;

@@ -22,6 +22,7 @@
 //!
 //! The analysis itself is [`crate::panels`].
 
+use super::stats::median;
 use crate::error::{Error, Result};
 use crate::modal::ModeUpdate;
 use crate::panels::{analyse_panel, dfreq_hz_per_deg, in_panel, PanelAnalysis, PanelModes};
@@ -323,11 +324,6 @@ pub struct ConvergenceRow {
     /// One-off set-up with derivative matrices (mesh, pattern, symbolic
     /// factorization) \[s\].
     pub setup_seconds: f64,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn first_with(r: &PanelModes, symmetry: &str) -> Option<f64> {

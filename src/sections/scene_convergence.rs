@@ -17,6 +17,7 @@
 //! therefore self-convergence, which the mesh study of the panel modes
 //! (`panel_convergence.toml`) complements with the frequencies.
 
+use super::stats::median;
 use crate::error::{Error, Result};
 use crate::report::csv::Table;
 use crate::scene::load_scene;
@@ -80,11 +81,6 @@ fn variant(base: &Study, divisions: usize, modes: usize) -> Study {
         }
     }
     s
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// Run the grid (coarse to fine, in the order given).

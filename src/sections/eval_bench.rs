@@ -1,0 +1,160 @@
+//! `[eval_bench]`: what one design evaluation of a scene problem costs and
+//! where its time goes (issue 14's benchmark).
+//!
+//! For every listed study with a scene problem (`[problem] name = "scene"`)
+//! and every design (default: the problem's start), the evaluation is run
+//! without gradients (`f`) and with them (`f+g`), `repeats` times each
+//! after one untimed warm-up of each kind (which makes the pooled panel
+//! analyses: pattern, symbolic factorization). Reported per case, medians
+//! over the repeats, one thread: the panel bases computed (and how many
+//! with mode derivatives) and their time, the rest of the scene build, the
+//! integration (states and, for `f+g`, the sensitivity lanes), the output
+//! and response evaluation, the total, the integrator's steps,
+//! right-hand-side calls and Jacobian-vector products and the integration
+//! time per right-hand-side call. The problem's set-up (plan, start
+//! design and normalization evaluations) is timed once.
+//!
+//! Output: `eval_bench.csv` in the study's output folder (columns in
+//! [`HEADERS`]).
+
+use super::stats::median;
+use crate::error::Result;
+use crate::explore::scene_problem::{EvalProfile, SceneProblem};
+use crate::optimize::Problem;
+use crate::report::csv::Table;
+use crate::study::Study;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The `[eval_bench]` section.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EvalBenchSpec {
+    /// Study files with a scene problem (paths relative to this study).
+    pub problems: Vec<PathBuf>,
+    /// Designs to evaluate \[deg\], one value per problem variable;
+    /// default: each problem's start.
+    #[serde(default)]
+    pub designs: Vec<Vec<f64>>,
+    /// Timed repetitions of each case (≥ 1); medians are reported.
+    pub repeats: usize,
+}
+
+/// Column headers of `eval_bench.csv`.
+pub const HEADERS: [&str; 17] = [
+    "problem",
+    "design [deg]",
+    "mode",
+    "setup [ms]",
+    "lanes",
+    "bases",
+    "derivative_bases",
+    "bases [ms]",
+    "build_other [ms]",
+    "integrate [ms]",
+    "outputs [ms]",
+    "total [ms]",
+    "steps",
+    "rhs_calls",
+    "jvp_calls",
+    "integrate_per_rhs [us]",
+    "repeats",
+];
+
+/// The medians of one case.
+fn row(name: &str, x: &[f64], mode: &str, setup: f64, runs: &[EvalProfile]) -> Vec<String> {
+    let med = |f: &dyn Fn(&EvalProfile) -> f64| median(runs.iter().map(f).collect());
+    let ms = |f: &dyn Fn(&EvalProfile) -> f64| format!("{:.3}", 1e3 * med(f));
+    let p = &runs[0];
+    let design: Vec<String> = x.iter().map(|v| v.to_string()).collect();
+    let per_rhs = med(&|r| r.integrate_seconds / r.rhs_calls.max(1) as f64);
+    vec![
+        name.to_string(),
+        design.join(" "),
+        mode.to_string(),
+        format!("{:.1}", 1e3 * setup),
+        p.lanes.to_string(),
+        p.build.bases.to_string(),
+        p.build.derivative_bases.to_string(),
+        ms(&|r| r.build.bases_seconds),
+        ms(&|r| r.build.total_seconds - r.build.bases_seconds),
+        ms(&|r| r.integrate_seconds),
+        ms(&|r| r.outputs_seconds),
+        ms(&|r| r.total_seconds),
+        p.steps.to_string(),
+        p.rhs_calls.to_string(),
+        p.jvp_calls.to_string(),
+        format!("{:.2}", 1e6 * per_rhs),
+        runs.len().to_string(),
+    ]
+}
+
+/// Run every case; `progress` gets each finished row.
+pub fn run_eval_bench(
+    study: &Study,
+    spec: &EvalBenchSpec,
+    mut progress: impl FnMut(&[String]),
+) -> Result<Vec<Vec<String>>> {
+    if spec.repeats == 0 {
+        return Err(study.error("eval_bench.repeats", 0, "at least 1 repetition"));
+    }
+    if spec.problems.is_empty() {
+        return Err(study.error("eval_bench.problems", "[]", "at least one study file"));
+    }
+    let base = study.path.parent().unwrap_or(Path::new("."));
+    let mut rows = Vec::new();
+    for (k, file) in spec.problems.iter().enumerate() {
+        let at = format!("eval_bench.problems[{k}]");
+        let inner = Study::load(base.join(file)).map_err(|e| e.in_file(&study.path, &at))?;
+        let t = Instant::now();
+        let problem = SceneProblem::from_study(&inner)?;
+        let setup = t.elapsed().as_secs_f64();
+        let designs = if spec.designs.is_empty() {
+            vec![problem.start().to_vec()]
+        } else {
+            spec.designs.clone()
+        };
+        for (j, x) in designs.iter().enumerate() {
+            if x.len() != problem.variables().len() {
+                return Err(study.error(
+                    format!("eval_bench.designs[{j}]"),
+                    format!("{x:?}"),
+                    format!("{} angles [deg]", problem.variables().len()),
+                ));
+            }
+            for (mode, gradients) in [("f", false), ("f+g", true)] {
+                problem.evaluate_profiled(x, gradients)?;
+                let runs = (0..spec.repeats)
+                    .map(|_| Ok(problem.evaluate_profiled(x, gradients)?.1))
+                    .collect::<Result<Vec<_>>>()?;
+                let r = row(&inner.name(), x, mode, setup, &runs);
+                progress(&r);
+                rows.push(r);
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// The `[eval_bench]` handler: run the section and write the CSV.
+pub fn run_eval_bench_section(study: &Study, out: &Path, quiet: bool) -> Result<PathBuf> {
+    let spec: EvalBenchSpec =
+        study.require_section("eval_bench", "the design-evaluation benchmark")?;
+    let rows = run_eval_bench(study, &spec, |r| {
+        if !quiet {
+            println!("{}", r.join(", "));
+        }
+    })?;
+    let path = study.output_dir(out)?.join("eval_bench.csv");
+    let mut table = Table::new(&path);
+    table.row(HEADERS)?;
+    for r in &rows {
+        table.row(r)?;
+    }
+    let path = table.finish()?;
+    if !quiet {
+        println!("wrote {}", path.display());
+    }
+    Ok(path)
+}
