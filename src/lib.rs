@@ -65,13 +65,13 @@
 //!   derivatives.
 //! - [`fe`]: panel mesh, laminated shell triangle, sparse assembly, supports.
 //! - [`modal`]: lowest modes, eigenvalue and eigenvector derivatives.
+//! - [`integrate`]: time integration of any [`integrate::OdeModel`] (BDF,
+//!   explicit and SDIRK Runge–Kutta) with forward sensitivities and events.
 //! - [`mbs`]: the multibody kernel: bodies (rigid, floating-frame flexible
 //!   with a [`mbs::ModalBasis`]), joints, forces, equations of motion and
 //!   their constraint-space solve, outputs; no files.
 //! - [`panels`]: a panel's modal analysis reused across lay-ups and its
 //!   modes as a [`mbs::ModalBasis`] ([`panels::BasisBuilder`]).
-//! - [`integrate`]: time integration (BDF, explicit and SDIRK Runge–Kutta)
-//!   with forward sensitivities and Eq. 32 segment events.
 //! - [`scene`]: the `[scene]` section: parsed data → model
 //!   ([`scene::SceneSpec`], [`scene::Scene`]) and [`scene::ScenePlan`], the
 //!   road of a design (ply angles as numbers, panel analyses built once).

@@ -1,4 +1,6 @@
-//! Time integration of a multibody [`System`] with `diffsol`.
+//! Time integration of an ODE system given by the [`OdeModel`] trait, with
+//! `diffsol`. The integrator knows nothing of multibody dynamics: the
+//! multibody system implements the trait in `crate::mbs::ode`.
 //!
 //! The paper (§3.1) integrates with a variable-step, variable-order
 //! multistep method; diffsol's variable-order BDF ([`Method::Bdf`], the
@@ -11,22 +13,94 @@
 //! Output is dense: the solver steps freely and the state is interpolated
 //! at the requested times, handed to an observer.
 //!
-//! Segment changes of the actuator laws (Eq. 32) are integration events
-//! ([`events`] explains the method): each leg integrates a smooth
-//! right-hand side with frozen segments, diffsol's root finder locates the
-//! crossing, and a fresh solver restarts from the event, with the
-//! sensitivity jump of Hiskens & Pai (2000) applied in [`integrate_sens`].
-//! [`Options::events`] switches this off (segments picked by value).
-
-pub mod events;
+//! ## Events
+//! A piecewise-smooth model (the Eq. 32 actuator laws of the multibody
+//! system) describes its pieces as events through the trait: during one
+//! integration leg every piece is frozen ([`OdeModel::freeze`]), so the
+//! right-hand side is smooth; the model's root functions
+//! ([`OdeModel::roots`]) are handed to diffsol, which locates a sign
+//! change on the dense output of the accepted step; the model says whether
+//! it is a genuine crossing ([`OdeModel::classify`]) and switches the piece
+//! ([`OdeModel::switch`]); a fresh solver restarts from `(t_e, y(t_e))`, so
+//! no multistep history and no Runge–Kutta stage crosses the
+//! discontinuity. [`Options::events`] switches this off (the model then
+//! picks its pieces by value).
+//!
+//! With the switching surface `g(y(t_e), p) = 0` the event time moves with
+//! the parameters and the state sensitivities `s = ∂y/∂p` jump (Hiskens &
+//! Pai, "Trajectory sensitivity analysis of hybrid systems", IEEE TCAS-I
+//! 47(2), 2000, the switching-event case of their Eq. 13 family):
+//! `dt_e/dp = −(g_y s⁻ + g_p)/(g_y f⁻)`, `s⁺ = s⁻ + (f⁻ − f⁺) dt_e/dp`,
+//! with `f⁻`/`f⁺` the right-hand side with the old/new piece at the event.
+//! The trait's switching surfaces do not depend on the parameters
+//! (`g_p = 0`), and `g_y v` is [`OdeModel::crossing_dir`].
 
 use crate::error::{Error, Result};
-use crate::mbs::{Param, System, Workspace};
 use diffsol::{FaerLU, FaerMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason, Vector};
-use events::{Crossing, Events};
-use num_dual::Dual64;
 use std::cell::RefCell;
 use std::time::Instant;
+
+/// An ODE system `ẏ = f(t, y; p)` as the integrator sees it: right-hand
+/// side, exact directional derivatives (for implicit methods and forward
+/// sensitivities), and the events that switch between its smooth pieces.
+/// `n` is the state length; parameter lanes are named by
+/// [`OdeModel::Param`] and carried with their values.
+pub trait OdeModel {
+    /// A parameter of the model (a sensitivity lane).
+    type Param: Copy + std::fmt::Debug;
+    /// Scratch reused by every evaluation of one integration.
+    type Work;
+    /// The state of the model's piece switching (which piece is frozen).
+    type Events;
+    /// An accepted change of piece.
+    type Crossing: Copy;
+
+    /// Scratch for states of length `n`.
+    fn work(&self, n: usize) -> Self::Work;
+    /// The model's value of parameter `p` (None: not a parameter of it).
+    fn param_value(&self, p: Self::Param) -> Option<f64>;
+    /// `dy = f(t, y)` with the parameters `params.0` set to the values
+    /// `params.1` (both empty: the model's own values).
+    fn rhs(
+        &self,
+        w: &mut Self::Work,
+        t: f64,
+        y: &[f64],
+        params: (&[Self::Param], &[f64]),
+        dy: &mut [f64],
+    );
+    /// The exact directional derivative `out = J v_y + (∂f/∂p) v_p` with
+    /// the state seeds `seeds.0` and parameter seeds `seeds.1` (None: 0).
+    fn rhs_dir(
+        &self,
+        w: &mut Self::Work,
+        t: f64,
+        y: &[f64],
+        params: (&[Self::Param], &[f64]),
+        seeds: (Option<&[f64]>, Option<&[f64]>),
+        out: &mut [f64],
+    );
+    /// The event state at `y0` (every piece frozen where `y0` is); with
+    /// `enabled = false`, no root function is active.
+    fn events(&self, enabled: bool, y0: &[f64]) -> Self::Events;
+    /// Make the right-hand side use the pieces frozen in `ev`.
+    fn freeze(&self, ev: &Self::Events, w: &mut Self::Work);
+    /// Number of root functions (≥ 1: diffsol needs one; a constant
+    /// function where there are none).
+    fn nroots(&self, ev: &Self::Events) -> usize;
+    /// Root function values `g(y)` (sign change = a candidate crossing).
+    fn roots(&self, ev: &Self::Events, w: &mut Self::Work, y: &[f64], g: &mut [f64]);
+    /// `g_y v` of every root function.
+    fn roots_dir(&self, ev: &Self::Events, y: &[f64], v: &[f64], g: &mut [f64]);
+    /// Whether the sign change of root `idx` at `y` is a genuine crossing.
+    fn classify(&self, ev: &Self::Events, idx: usize, y: &[f64]) -> Option<Self::Crossing>;
+    /// Switch to the piece after crossing `c` at `y`.
+    fn switch(&self, ev: &mut Self::Events, c: Self::Crossing, y: &[f64]);
+    /// `g_y v` of the switching surface of crossing `c`.
+    fn crossing_dir(&self, ev: &Self::Events, c: Self::Crossing, y: &[f64], v: &[f64]) -> f64;
+    /// What switched, for messages (e.g. `actuator forces[3]`).
+    fn crossing_label(&self, ev: &Self::Events, c: Self::Crossing) -> String;
+}
 
 /// Integration method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
@@ -64,7 +138,7 @@ pub struct Options {
     /// Output times (s), increasing, all ≥ `t0`; the last is the end time.
     pub times: Vec<f64>,
     /// Treat segment changes of piecewise actuator laws (Eq. 32) as events
-    /// (root finding and a restart at each crossing, [`events`]) instead of
+    /// (root finding and a restart at each crossing, module doc) instead of
     /// picking the segment by value inside the right-hand side. Scenes
     /// default to `true`, from the measurement on the rigid SAR scene over
     /// 0–10 s (three crossings; `studies/events.toml`,
@@ -152,28 +226,24 @@ impl Stats {
     }
 }
 
-/// Integrate `sys` from `y0` (already consistent) and call
+/// Integrate `model` from `y0` (already consistent) and call
 /// `observe(t, y)` at every output time.
-pub fn integrate(
-    sys: &System,
+pub fn integrate<M: OdeModel>(
+    model: &M,
     y0: &[f64],
     opts: &Options,
     mut observe: impl FnMut(f64, &[f64]) -> Result<()>,
 ) -> Result<Stats> {
     opts.validate()?;
     let n = y0.len();
-    let ev = RefCell::new(Events::new(sys, opts.events));
-    ev.borrow_mut().start(sys, y0);
-    let nroots = ev.borrow().nroots();
-    let ws = RefCell::new(Workspace::<f64>::empty());
-    let wsd = RefCell::new(Workspace::<Dual64>::empty());
-    set_segments(&ev, &ws, &wsd);
-    let kin = RefCell::new(Vec::new());
-    let ydual = RefCell::new(vec![Dual64::from(0.0); n]);
-    let dydual = RefCell::new(vec![Dual64::from(0.0); n]);
+    let ev = RefCell::new(model.events(opts.events, y0));
+    let nroots = model.nroots(&ev.borrow());
+    let work = RefCell::new(model.work(n));
+    model.freeze(&ev.borrow(), &mut work.borrow_mut());
     let jvps = std::cell::Cell::new(0u64);
     let rhs_calls = std::cell::Cell::new(0u64);
     let observer_time = std::cell::Cell::new(0.0f64);
+    let none: (&[M::Param], &[f64]) = (&[], &[]);
     // Start of the current leg (the initial state, then each event state).
     let start_y = RefCell::new(y0.to_vec());
     let mut problem = OdeBuilder::<FaerMat<f64>>::new()
@@ -186,19 +256,11 @@ pub fn integrate(
         .rhs_implicit(
             |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
                 rhs_calls.set(rhs_calls.get() + 1);
-                sys.rhs(t, x, y, &mut ws.borrow_mut());
+                model.rhs(&mut work.borrow_mut(), t, x, none, y);
             },
             |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
                 jvps.set(jvps.get() + 1);
-                let mut yd = ydual.borrow_mut();
-                let mut dyd = dydual.borrow_mut();
-                for k in 0..x.len() {
-                    yd[k] = Dual64::new(x[k], v[k]);
-                }
-                sys.rhs(t, &yd, &mut dyd, &mut wsd.borrow_mut());
-                for k in 0..x.len() {
-                    y[k] = dyd[k].eps;
-                }
+                model.rhs_dir(&mut work.borrow_mut(), t, x, none, (Some(v), None), y);
             },
         )
         .init(
@@ -207,7 +269,7 @@ pub fn integrate(
         )
         .root(
             |x: &[f64], _p: &[f64], _t: f64, g: &mut [f64]| {
-                ev.borrow().roots(sys, x, &mut kin.borrow_mut(), g)
+                model.roots(&ev.borrow(), &mut work.borrow_mut(), x, g)
             },
             nroots,
         )
@@ -228,8 +290,10 @@ pub fn integrate(
         opts,
         nsens: 0,
         next: 0,
-        sys,
+        model,
         events: &ev,
+        work: &work,
+        params: none,
     };
     let mut stats = Stats::default();
     loop {
@@ -243,7 +307,7 @@ pub fn integrate(
             )?,
             Method::Tsit45 => legs.drive(problem.tsit45().map_err(setup)?, &mut observe)?,
         };
-        let Some(e) = legs.end_leg(&mut stats, (leg, event), (&ws, &wsd), &mut observe)? else {
+        let Some(e) = legs.end_leg(&mut stats, (leg, event), &mut observe)? else {
             break;
         };
         problem.t0 = e.t;
@@ -256,30 +320,19 @@ pub fn integrate(
     Ok(stats)
 }
 
-/// Copy the frozen segments of `ev` into both workspaces.
-fn set_segments(
-    ev: &RefCell<Events>,
-    ws: &RefCell<Workspace<f64>>,
-    wsd: &RefCell<Workspace<Dual64>>,
-) {
-    let segs = ev.borrow().segments();
-    ws.borrow_mut().segments = segs.clone();
-    wsd.borrow_mut().segments = segs;
-}
-
-/// Integrate `sys` from `y0` together with the forward sensitivities of
+/// Integrate `model` from `y0` together with the forward sensitivities of
 /// the state with respect to `params` (direct differentiation, paper Eqs.
-/// 12–16): `ṡ_i = J s_i + ∂f/∂p_i`, both products exact from dual-number
-/// evaluations of the same right-hand side. The initial state is taken as
-/// independent of the parameters (`s_i(t0) = 0`). `observe(t, y, s)` gets
-/// `s` lane-major: `s[i·n..(i+1)·n] = ∂y/∂p_i`. Sensitivities take part in
-/// the error control. With [`Options::events`], `s` jumps at each segment
-/// change by `(f⁻ − f⁺) dt_e/dp` ([`events`]).
-pub fn integrate_sens(
-    sys: &System,
+/// 12–16): `ṡ_i = J s_i + ∂f/∂p_i`, both products exact
+/// ([`OdeModel::rhs_dir`]). The initial state is taken as independent of
+/// the parameters (`s_i(t0) = 0`). `observe(t, y, s)` gets `s`
+/// lane-major: `s[i·n..(i+1)·n] = ∂y/∂p_i`. Sensitivities take part in
+/// the error control. With [`Options::events`], `s` jumps at each change
+/// of piece by `(f⁻ − f⁺) dt_e/dp` (module doc).
+pub fn integrate_sens<M: OdeModel>(
+    model: &M,
     y0: &[f64],
     opts: &Options,
-    params: &[Param],
+    params: &[M::Param],
     mut observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
 ) -> Result<Stats> {
     opts.validate()?;
@@ -287,7 +340,7 @@ pub fn integrate_sens(
     let np = params.len();
     let mut p0 = Vec::with_capacity(np);
     for (k, p) in params.iter().enumerate() {
-        let v = p.value(&sys.model).ok_or_else(|| {
+        let v = model.param_value(*p).ok_or_else(|| {
             Error::input(
                 format!("params[{k}]"),
                 format!("{p:?}"),
@@ -296,39 +349,20 @@ pub fn integrate_sens(
         })?;
         p0.push(v);
     }
-    let ev = RefCell::new(Events::new(sys, opts.events));
-    ev.borrow_mut().start(sys, y0);
-    let nroots = ev.borrow().nroots();
-    let ws = RefCell::new(Workspace::<f64>::empty());
-    let wsd = RefCell::new(Workspace::<Dual64>::empty());
-    set_segments(&ev, &ws, &wsd);
-    let kin = RefCell::new(Vec::new());
-    let yd = RefCell::new(vec![Dual64::from(0.0); n]);
-    let dyd = RefCell::new(vec![Dual64::from(0.0); n]);
+    let ev = RefCell::new(model.events(opts.events, y0));
+    let nroots = model.nroots(&ev.borrow());
+    let work = RefCell::new(model.work(n));
+    model.freeze(&ev.borrow(), &mut work.borrow_mut());
     let rhs_calls = std::cell::Cell::new(0u64);
     let jvps = std::cell::Cell::new(0u64);
     // Start of the current leg: state and sensitivities (lane-major).
     let start_y = RefCell::new(y0.to_vec());
     let start_s = RefCell::new(vec![0.0; n * np]);
-    // One dual evaluation: state seeds `vy`, parameter seeds `vp`.
-    let dual_eval =
-        |x: &[f64], p: &[f64], t: f64, vy: Option<&[f64]>, vp: Option<&[f64]>, out: &mut [f64]| {
+    // One directional derivative: state seeds `vy`, parameter seeds `vp`.
+    let dir =
+        |x: &[f64], p: &[f64], t: f64, seeds: (Option<&[f64]>, Option<&[f64]>), out: &mut [f64]| {
             jvps.set(jvps.get() + 1);
-            let mut w = wsd.borrow_mut();
-            w.params.clear();
-            for (k, par) in params.iter().enumerate() {
-                w.params
-                    .push((*par, Dual64::new(p[k], vp.map_or(0.0, |v| v[k]))));
-            }
-            let mut yv = yd.borrow_mut();
-            let mut dy = dyd.borrow_mut();
-            for k in 0..x.len() {
-                yv[k] = Dual64::new(x[k], vy.map_or(0.0, |v| v[k]));
-            }
-            sys.rhs(t, &yv, &mut dy, &mut w);
-            for k in 0..x.len() {
-                out[k] = dy[k].eps;
-            }
+            model.rhs_dir(&mut work.borrow_mut(), t, x, (params, p), seeds, out);
         };
     let mut problem = OdeBuilder::<FaerMat<f64>>::new()
         .t0(opts.t0)
@@ -339,17 +373,13 @@ pub fn integrate_sens(
         .rhs_sens_implicit(
             |x: &[f64], p: &[f64], t: f64, y: &mut [f64]| {
                 rhs_calls.set(rhs_calls.get() + 1);
-                let mut w = ws.borrow_mut();
-                w.params.clear();
-                w.params
-                    .extend(params.iter().copied().zip(p.iter().copied()));
-                sys.rhs(t, x, y, &mut w);
+                model.rhs(&mut work.borrow_mut(), t, x, (params, p), y);
             },
             |x: &[f64], p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
-                dual_eval(x, p, t, Some(v), None, y)
+                dir(x, p, t, (Some(v), None), y)
             },
             |x: &[f64], p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
-                dual_eval(x, p, t, None, Some(v), y)
+                dir(x, p, t, (None, Some(v)), y)
             },
         )
         .init_sens(
@@ -367,12 +397,12 @@ pub fn integrate_sens(
         )
         .root_sens_implicit(
             |x: &[f64], _p: &[f64], _t: f64, g: &mut [f64]| {
-                ev.borrow().roots(sys, x, &mut kin.borrow_mut(), g)
+                model.roots(&ev.borrow(), &mut work.borrow_mut(), x, g)
             },
             |x: &[f64], _p: &[f64], _t: f64, v: &[f64], g: &mut [f64]| {
-                ev.borrow().roots_jvp(sys, x, v, g)
+                model.roots_dir(&ev.borrow(), x, v, g)
             },
-            // g = θ − b does not depend on any parameter (`events` doc).
+            // The switching surfaces do not depend on the parameters.
             |_x: &[f64], _p: &[f64], _t: f64, _v: &[f64], g: &mut [f64]| g.fill(0.0),
             nroots,
         )
@@ -394,8 +424,10 @@ pub fn integrate_sens(
         opts,
         nsens: np,
         next: 0,
-        sys,
+        model,
         events: &ev,
+        work: &work,
+        params: (params, &p0),
     };
     let mut stats = Stats::default();
     loop {
@@ -410,7 +442,7 @@ pub fn integrate_sens(
             )?,
             Method::Tsit45 => legs.drive(problem.tsit45_sens().map_err(setup)?, &mut observe)?,
         };
-        let Some(e) = legs.end_leg(&mut stats, (leg, event), (&ws, &wsd), &mut observe)? else {
+        let Some(e) = legs.end_leg(&mut stats, (leg, event), &mut observe)? else {
             break;
         };
         problem.t0 = e.t;
@@ -437,27 +469,30 @@ fn lift_failure_cap(o: &mut diffsol::OdeSolverOptions<f64>) {
     o.max_nonlinear_solver_failures = usize::MAX / 2;
 }
 
-/// An accepted segment change: time, state and sensitivities (before the
-/// jump; [`Events::switch`] applies it in place) and the crossing.
-struct Event {
+/// An accepted change of piece: time, state and sensitivities (before the
+/// jump; [`Legs::jump`] applies it in place) and the crossing.
+struct Event<C> {
     t: f64,
     y: Vec<f64>,
     s: Vec<f64>,
-    crossing: Crossing,
+    crossing: C,
 }
 
 /// The legs of one integration: output bookkeeping across restarts.
-struct Legs<'c> {
+struct Legs<'c, M: OdeModel> {
     opts: &'c Options,
     /// Sensitivity lanes (0 without sensitivities).
     nsens: usize,
     /// Next output time to emit.
     next: usize,
-    sys: &'c System,
-    events: &'c RefCell<Events>,
+    model: &'c M,
+    events: &'c RefCell<M::Events>,
+    work: &'c RefCell<M::Work>,
+    /// The sensitivity parameters and their values (empty without).
+    params: (&'c [M::Param], &'c [f64]),
 }
 
-impl Legs<'_> {
+impl<M: OdeModel> Legs<'_, M> {
     /// Step a solver through the output times until the end or an
     /// accepted segment change; with `nsens > 0` the sensitivities
     /// (`nsens` lanes of the state length, lane-major) are interpolated
@@ -468,7 +503,7 @@ impl Legs<'_> {
         &mut self,
         mut solver: S,
         observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
-    ) -> Result<(Stats, Option<Event>)>
+    ) -> Result<(Stats, Option<Event<M::Crossing>>)>
     where
         Eqn: diffsol::OdeEquations<T = f64, V = diffsol::FaerVec<f64>> + 'a,
         S: OdeSolverMethod<'a, Eqn>,
@@ -505,7 +540,7 @@ impl Legs<'_> {
                     .interpolate(tr)
                     .map_err(|e| Error::numerical_at("integrate: event state", tr, e.to_string()))?
                     .clone_as_vec();
-                let crossing = self.events.borrow().classify(self.sys, idx, &yr);
+                let crossing = self.model.classify(&self.events.borrow(), idx, &yr);
                 if let Some(crossing) = crossing {
                     let s = if nsens > 0 {
                         solver
@@ -576,34 +611,66 @@ impl Legs<'_> {
         Ok((stats, event))
     }
 
-    /// The end of a leg: count it; at an event, switch the law (the
-    /// sensitivities jump), refreeze the workspaces' segments, and return
-    /// the event when a new leg must start from it.
+    /// The end of a leg: count it; at an event, switch the piece (the
+    /// sensitivities jump), refreeze the model's pieces, and return the
+    /// event when a new leg must start from it.
     fn end_leg(
         &mut self,
         stats: &mut Stats,
-        leg: (Stats, Option<Event>),
-        workspaces: (&RefCell<Workspace<f64>>, &RefCell<Workspace<Dual64>>),
+        leg: (Stats, Option<Event<M::Crossing>>),
         observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
-    ) -> Result<Option<Event>> {
-        let (ws, wsd) = workspaces;
+    ) -> Result<Option<Event<M::Crossing>>> {
         stats.absorb(&leg.0);
         let Some(mut e) = leg.1 else { return Ok(None) };
         stats.events += 1;
         stats.last_event = Some(e.t);
-        self.events.borrow_mut().switch(
-            self.sys,
-            (e.t, &e.y),
-            &mut e.s,
-            &mut ws.borrow_mut(),
-            e.crossing,
-        )?;
-        set_segments(self.events, ws, wsd);
+        self.jump(&mut e)?;
+        self.model
+            .freeze(&self.events.borrow(), &mut self.work.borrow_mut());
         if !self.restart_or_finish(&e, observe)? {
             return Ok(None);
         }
         stats.restarts += 1;
         Ok(Some(e))
+    }
+
+    /// Switch the piece at event `e` and, with sensitivity lanes, apply
+    /// the jump `s⁺ = s⁻ + (f⁻ − f⁺) dt_e/dp` with
+    /// `dt_e/dp = −g_y s⁻ / (g_y f⁻)` (module doc; `g_p = 0`) in place.
+    fn jump(&mut self, e: &mut Event<M::Crossing>) -> Result<()> {
+        let (model, c) = (self.model, e.crossing);
+        let mut ev = self.events.borrow_mut();
+        if self.nsens == 0 {
+            model.switch(&mut ev, c, &e.y);
+            return Ok(());
+        }
+        let n = e.y.len();
+        let mut work = self.work.borrow_mut();
+        let (mut fm, mut fp) = (vec![0.0; n], vec![0.0; n]);
+        model.freeze(&ev, &mut work);
+        model.rhs(&mut work, e.t, &e.y, self.params, &mut fm);
+        model.switch(&mut ev, c, &e.y);
+        model.freeze(&ev, &mut work);
+        model.rhs(&mut work, e.t, &e.y, self.params, &mut fp);
+        let den = model.crossing_dir(&ev, c, &e.y, &fm);
+        if den.is_nan() || den.abs() <= 1e-12 {
+            return Err(Error::numerical_at(
+                "integrate: segment event",
+                e.t,
+                format!(
+                    "{} grazes a breakpoint (dθ/dt = {den:e}): the event \
+                     time is not differentiable",
+                    model.crossing_label(&ev, c)
+                ),
+            ));
+        }
+        for lane in e.s.chunks_mut(n) {
+            let tau = -model.crossing_dir(&ev, c, &e.y, lane) / den;
+            for k in 0..n {
+                lane[k] += (fm[k] - fp[k]) * tau;
+            }
+        }
+        Ok(())
     }
 
     /// After the switch at event `e` (sensitivities already jumped):
@@ -612,7 +679,7 @@ impl Legs<'_> {
     /// remaining outputs from the event state instead.
     fn restart_or_finish(
         &mut self,
-        e: &Event,
+        e: &Event<M::Crossing>,
         observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
     ) -> Result<bool> {
         let times = &self.opts.times;
@@ -645,4 +712,113 @@ fn emit(
         ));
     }
     observe(t, y, sens)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `ẏ = p` below `y = 1`, `ẏ = 2p` above: a piecewise-smooth scalar
+    /// model with one switching surface `g = y − 1`, independent of `p`.
+    /// The event state is the piece (0, 1), frozen into the work.
+    struct Ramp;
+
+    impl OdeModel for Ramp {
+        type Param = ();
+        type Work = usize;
+        type Events = usize;
+        type Crossing = usize;
+        fn work(&self, _n: usize) -> usize {
+            0
+        }
+        fn param_value(&self, _p: ()) -> Option<f64> {
+            Some(1.0)
+        }
+        fn rhs(&self, w: &mut usize, _t: f64, _y: &[f64], p: (&[()], &[f64]), dy: &mut [f64]) {
+            let p = p.1.first().copied().unwrap_or(1.0);
+            dy[0] = if *w == 0 { p } else { 2.0 * p };
+        }
+        fn rhs_dir(
+            &self,
+            w: &mut usize,
+            _t: f64,
+            _y: &[f64],
+            _p: (&[()], &[f64]),
+            seeds: (Option<&[f64]>, Option<&[f64]>),
+            out: &mut [f64],
+        ) {
+            // f does not depend on y; ∂f/∂p = 1 or 2.
+            let vp = seeds.1.map_or(0.0, |v| v[0]);
+            out[0] = if *w == 0 { vp } else { 2.0 * vp };
+        }
+        fn events(&self, _enabled: bool, _y0: &[f64]) -> usize {
+            0
+        }
+        fn freeze(&self, ev: &usize, w: &mut usize) {
+            *w = *ev;
+        }
+        fn nroots(&self, _ev: &usize) -> usize {
+            1
+        }
+        fn roots(&self, ev: &usize, _w: &mut usize, y: &[f64], g: &mut [f64]) {
+            g[0] = if *ev == 0 { y[0] - 1.0 } else { -1.0 };
+        }
+        fn roots_dir(&self, ev: &usize, _y: &[f64], v: &[f64], g: &mut [f64]) {
+            g[0] = if *ev == 0 { v[0] } else { 0.0 };
+        }
+        fn classify(&self, ev: &usize, _idx: usize, y: &[f64]) -> Option<usize> {
+            (*ev == 0 && (y[0] - 1.0).abs() < 1e-8).then_some(1)
+        }
+        fn switch(&self, ev: &mut usize, c: usize, _y: &[f64]) {
+            *ev = c;
+        }
+        fn crossing_dir(&self, _ev: &usize, _c: usize, _y: &[f64], v: &[f64]) -> f64 {
+            v[0]
+        }
+        fn crossing_label(&self, _ev: &usize, _c: usize) -> String {
+            "ramp".into()
+        }
+    }
+
+    #[test]
+    fn piecewise_ramp_and_its_sensitivity_through_the_trait() {
+        // Closed form at p = 1 from y(0) = 0: y = p t until the crossing
+        // t_e = 1/p, then y = 1 + 2p (t − 1/p) = 2 p t − 1; so y(2) = 3
+        // and s = ∂y/∂p = 2t after the event, s(2) = 4 (the jump at t_e
+        // takes s from t_e = 1 to 2 t_e = 2: Hiskens & Pai with
+        // dt_e/dp = −s⁻/f⁻ = −1 and f⁻ − f⁺ = −1).
+        for method in [Method::Tsit45, Method::Bdf] {
+            let opts = Options {
+                method,
+                rtol: 1e-10,
+                atol: 1e-12,
+                t0: 0.0,
+                times: vec![0.5, 1.5, 2.0],
+                events: true,
+            };
+            let mut out = Vec::new();
+            let stats = integrate_sens(&Ramp, &[0.0], &opts, &[()], |t, y, s| {
+                out.push((t, y[0], s[0]));
+                Ok(())
+            })
+            .unwrap();
+            assert_eq!(stats.events, 1, "{method:?}");
+            for (t, y, s) in out {
+                let (ye, se) = if t < 1.0 {
+                    (t, t)
+                } else {
+                    (2.0 * t - 1.0, 2.0 * t)
+                };
+                assert!((y - ye).abs() < 1e-8, "{method:?} y({t}) = {y}");
+                assert!((s - se).abs() < 1e-7, "{method:?} s({t}) = {s}");
+            }
+            let mut end = 0.0;
+            integrate(&Ramp, &[0.0], &opts, |_, y| {
+                end = y[0];
+                Ok(())
+            })
+            .unwrap();
+            assert!((end - 3.0).abs() < 1e-8, "{method:?} y(2) = {end}");
+        }
+    }
 }

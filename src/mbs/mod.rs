@@ -55,8 +55,10 @@ pub mod flex;
 pub mod flexdyn;
 pub mod linalg;
 pub mod model;
+pub mod ode;
 pub mod responses;
 pub mod rows;
+pub mod segments;
 pub mod solve;
 pub mod workspace;
 

@@ -83,7 +83,7 @@ pub struct Workspace<T: Scalar> {
     /// empty for plain evaluations.
     pub params: Vec<(Param, T)>,
     /// Frozen segment of each actuator's Eq. 32 law, by force index, while
-    /// the integrator treats segment changes as events (`integrate::events`):
+    /// the integrator treats segment changes as events ([`super::segments`]):
     /// the segment's line then extends past its breakpoints, so the
     /// right-hand side is smooth. Empty (or an out-of-range entry): the
     /// segment is picked by the value of θ.

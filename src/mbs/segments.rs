@@ -1,5 +1,8 @@
 //! Segment changes of piecewise-linear actuator laws (paper Eq. 32) as
-//! integration events.
+//! integration events: the model's side of [`crate::integrate::OdeModel`]'s
+//! events (the integrator locates roots, restarts legs and applies the
+//! sensitivity jump; this file says where the roots are and which segment
+//! follows).
 //!
 //! ## Method
 //! Eq. 32 jumps at some breakpoints (0.01 N·m at θ = 3.08 rad, 0.045 N·m at
@@ -37,15 +40,15 @@
 //! `dt_e/dp = −(g_y s⁻ + g_p)/(g_y f⁻)`, `s⁺ = s⁻ + (f⁻ − f⁺) dt_e/dp`,
 //! with `f⁻`/`f⁺` the right-hand side with the old/new segment at the
 //! event. Here `g = θ(y) − b` and the breakpoints `b` (the segments'
-//! `lower`/`upper`) are not parameters: the anchor of [`Param::Anchor`]
+//! `lower`/`upper`) are not parameters: the anchor of [`super::Param::Anchor`]
 //! moves the law's line, not its interval, and damping, stiffness and mass
-//! do not enter `g`. So `g_p = 0` for every [`Param`] (θ of a rigid joint
+//! do not enter `g`. So `g_p = 0` for every [`super::Param`] (θ of a rigid joint
 //! does not depend on a ply angle either), and `g_y v` is one dual-number
 //! evaluation of θ at `y + ε v`.
 
-use crate::error::{Error, Result};
-use crate::mbs::dynamics::BodyKin;
-use crate::mbs::{Force, PiecewiseLaw, System, Workspace};
+use super::dynamics::System;
+use super::model::{Force, PiecewiseLaw};
+use super::workspace::BodyKin;
 use num_dual::Dual64;
 
 /// One actuator law whose segment can change.
@@ -108,7 +111,7 @@ fn switch_of(force: usize, joint: usize, law: &PiecewiseLaw) -> Switch {
 /// The event state of a system: the switching actuators and the interval
 /// each one is frozen in.
 #[derive(Debug, Clone)]
-pub(crate) struct Events {
+pub struct Events {
     switches: Vec<Switch>,
     /// Current interval of each switch.
     mode: Vec<usize>,
@@ -127,7 +130,7 @@ pub(crate) struct Events {
 
 /// An accepted segment change.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Crossing {
+pub struct Crossing {
     switch: usize,
     to: usize,
 }
@@ -210,7 +213,7 @@ impl Events {
         self.shift[k] = sh;
     }
 
-    /// Frozen segment per force for [`Workspace::segments`] (empty when
+    /// Frozen segment per force for [`super::Workspace::segments`] (empty when
     /// events are off: segments by value).
     pub fn segments(&self) -> Vec<usize> {
         if !self.active() {
@@ -303,65 +306,26 @@ impl Events {
         }
     }
 
-    /// Apply a crossing at `(t, y)`: switch the segment and, with `ns`
-    /// sensitivity lanes in `s` (lane-major, `s[i·n..(i+1)·n] = ∂y/∂p_i`
-    /// before the event), apply the jump `s⁺ = s⁻ + (f⁻ − f⁺) dt_e/dp`,
-    /// `dt_e/dp = −g_y s⁻ / (g_y f⁻)` (module doc; `g_p = 0`). `ws` holds
-    /// the parameter overrides of the sensitivity run. Returns `dt_e/dp`.
-    pub fn switch(
-        &mut self,
-        sys: &System,
-        at: (f64, &[f64]),
-        s: &mut [f64],
-        ws: &mut Workspace<f64>,
-        c: Crossing,
-    ) -> Result<Vec<f64>> {
-        let (t, y) = at;
-        let n = y.len();
-        let ns = s.len() / n.max(1);
+    /// Switch to the segment after crossing `c` at the state `y`.
+    pub fn switch(&mut self, sys: &System, c: Crossing, y: &[f64]) {
         let mut kin = Vec::new();
         sys.body_kin(y, &[], &mut kin);
-        if ns == 0 {
-            self.mode[c.switch] = c.to;
-            self.set_shift(sys, c.switch, &kin);
-            return Ok(Vec::new());
-        }
-        let mut fm = vec![0.0; n];
-        let mut fp = vec![0.0; n];
-        ws.segments = self.segments();
-        sys.rhs(t, y, &mut fm, ws);
         self.mode[c.switch] = c.to;
         self.set_shift(sys, c.switch, &kin);
-        ws.segments = self.segments();
-        sys.rhs(t, y, &mut fp, ws);
-        let sw = &self.switches[c.switch];
-        let gy = |v: &[f64]| {
-            let yd: Vec<Dual64> = y.iter().zip(v).map(|(&a, &b)| Dual64::new(a, b)).collect();
-            let mut kin = Vec::new();
-            sys.body_kin(&yd, &[], &mut kin);
-            sys.joint_angle(&kin, sw.joint).0.eps
-        };
-        let den = gy(&fm);
-        if den.is_nan() || den.abs() <= 1e-12 {
-            return Err(Error::numerical_at(
-                "integrate: segment event",
-                t,
-                format!(
-                    "actuator forces[{}] grazes a breakpoint (dθ/dt = {den:e}): the event \
-                     time is not differentiable",
-                    sw.force
-                ),
-            ));
-        }
-        let mut dt = Vec::with_capacity(ns);
-        for lane in s.chunks_mut(n) {
-            let tau = -gy(lane) / den;
-            for k in 0..n {
-                lane[k] += (fm[k] - fp[k]) * tau;
-            }
-            dt.push(tau);
-        }
-        Ok(dt)
+    }
+
+    /// `g_y v` of the root function of crossing `c` (θ of its joint at
+    /// `y + ε v`).
+    pub fn crossing_dir(&self, sys: &System, c: Crossing, y: &[f64], v: &[f64]) -> f64 {
+        let yd: Vec<Dual64> = y.iter().zip(v).map(|(&a, &b)| Dual64::new(a, b)).collect();
+        let mut kin = Vec::new();
+        sys.body_kin(&yd, &[], &mut kin);
+        sys.joint_angle(&kin, self.switches[c.switch].joint).0.eps
+    }
+
+    /// The force index of crossing `c`'s actuator (for messages).
+    pub fn force_of(&self, c: Crossing) -> usize {
+        self.switches[c.switch].force
     }
 }
 
