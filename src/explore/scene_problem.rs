@@ -184,213 +184,66 @@ impl SceneProblem {
             "the scene problem (variables, start, objective)",
         )?;
         let plan = ScenePlan::new(study)?;
-        let scene = plan.spec();
-        let panels = plan.panels();
-        let err = |key: String, value: &dyn std::fmt::Display, exp: String| {
-            study.error(format!("scene_problem.{key}"), value, exp)
-        };
-        if spec.variables.is_empty() {
-            return Err(err(
-                "variables".into(),
-                &"[]",
-                "at least one variable".into(),
-            ));
-        }
-        let mut vars = Vec::new();
-        let mut targets = Vec::new();
-        let mut lanes: Vec<String> = Vec::new();
-        let mut lanes_of = Vec::new();
-        let mut used: Vec<(usize, usize)> = Vec::new();
-        for (i, v) in spec.variables.iter().enumerate() {
-            let key = format!("variables[{i}]");
-            let [lo, hi] = v.bounds;
-            let var = if v.periodic {
-                if !(lo.is_finite() && hi - lo == 180.0) {
-                    return Err(err(
-                        format!("{key}.bounds"),
-                        &format!("[{lo}, {hi}]"),
-                        "finite bounds 180° apart (ply angles repeat every 180°)".into(),
-                    ));
-                }
-                Variable::periodic(v.name.clone(), lo, 180.0)
-            } else {
-                Variable::bounded(v.name.clone(), lo, hi)
-            }
-            .map_err(|e| e.in_file(&study.path, &format!("scene_problem.{key}")))?;
-            vars.push(var);
-            if v.sets.is_empty() {
-                return Err(err(
-                    format!("{key}.sets"),
-                    &"[]",
-                    "at least one \"<panel>:<design variable>\"".into(),
-                ));
-            }
-            let (mut t, mut l) = (Vec::new(), Vec::new());
-            for (k, entry) in v.sets.iter().enumerate() {
-                let key = format!("{key}.sets[{k}]");
-                let (pname, dname) = entry.split_once(':').ok_or_else(|| {
-                    err(
-                        key.clone(),
-                        &format!("\"{entry}\""),
-                        "\"<panel>:<design variable>\", e.g. \"panel3:theta_1_4\"".into(),
-                    )
-                })?;
-                let Some(p) = panels.iter().position(|p| p.name == pname) else {
-                    let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
-                    return Err(err(
-                        key,
-                        &format!("\"{entry}\""),
-                        format!("a [[panels]] name before ':' ({})", names.join(", ")),
-                    ));
-                };
-                let names = design_names(&panels[p].design);
-                let Some(d) = names.iter().position(|n| n == dname) else {
-                    return Err(err(
-                        key,
-                        &format!("\"{entry}\""),
-                        format!(
-                            "a design variable of panel {pname} after ':' ({})",
-                            names.join(", ")
-                        ),
-                    ));
-                };
-                if used.contains(&(p, d)) {
-                    return Err(err(
-                        key,
-                        &format!("\"{entry}\""),
-                        "each panel design variable set by one problem variable".into(),
-                    ));
-                }
-                used.push((p, d));
-                t.push(PlyTarget {
-                    panel: p,
-                    plies: panels[p].design.groups()[d].clone(),
-                });
-                let bodies = plan.bodies_of_panel(pname);
-                if bodies.is_empty() {
-                    return Err(err(
-                        key,
-                        &format!("\"{entry}\""),
-                        format!("a panel of a flexible scene body (no [[scene.bodies]] uses panel {pname})"),
-                    ));
-                }
-                for b in bodies {
-                    let lane = format!("{b}.design.{dname}");
-                    if !scene.sensitivities.contains(&lane) {
-                        return Err(study.error(
-                            "scene.sensitivities",
-                            format!("{:?}", scene.sensitivities),
-                            format!(
-                                "a list containing \"{lane}\" (the gradient of scene_problem.{key})"
-                            ),
-                        ));
-                    }
-                    l.push(lanes.len());
-                    lanes.push(lane);
-                }
-            }
-            targets.push(t);
-            lanes_of.push(l);
-        }
-        let names: Vec<&str> = scene.responses.iter().map(|r| r.name.as_str()).collect();
-        let check_response = |key: String, r: &str| {
-            if names.contains(&r) {
-                Ok(())
-            } else {
-                Err(err(
-                    key,
-                    &format!("\"{r}\""),
-                    format!("a [[scene.responses]] name ({})", names.join(", ")),
-                ))
-            }
-        };
-        check_response("objective.response".into(), &spec.objective.response)?;
-        let check_design = |key: &str, x: &[f64]| -> Result<()> {
-            if x.len() != vars.len()
-                || x.iter()
-                    .zip(&vars)
-                    .any(|(&x, v)| !x.is_finite() || (v.period.is_none() && v.wrap(x) != x))
-            {
-                return Err(err(
-                    key.into(),
-                    &format!("{x:?}"),
-                    format!("{} finite angles [deg] within the bounds", vars.len()),
-                ));
-            }
-            Ok(())
-        };
-        check_design("start", &spec.start)?;
-        if let Some(r) = &spec.objective.normalize_at {
-            check_design("objective.normalize_at", r)?;
-        }
-        for (j, c) in spec.constraints.iter().enumerate() {
-            let key = format!("constraints[{j}]");
-            check_response(format!("{key}.response"), &c.response)?;
-            let (v, k) = match (c.upper, c.upper_relative) {
-                (Some(u), None) => (u, "upper"),
-                (None, Some(u)) => (u, "upper_relative"),
-                _ => {
-                    return Err(err(
-                        key,
-                        &"(table)",
-                        "exactly one of `upper` (absolute) and `upper_relative` (factor of the start value)".into(),
-                    ))
-                }
-            };
-            if !(v.is_finite() && v > 0.0) {
-                return Err(err(format!("{key}.{k}"), &v, "a finite bound > 0".into()));
-            }
-        }
+        let ties = Ties::resolve(study, &spec, &plan)?;
+        check_objective_and_constraints(study, &spec, &plan, &ties.vars)?;
         let mut problem = SceneProblem {
-            vars,
+            vars: ties.vars,
             plan,
-            targets,
-            lanes,
-            lanes_of,
+            targets: ties.targets,
+            lanes: ties.lanes,
+            lanes_of: ties.lanes_of,
             objective: (spec.objective.response.clone(), 1.0),
             constraints: Vec::new(),
             start: spec.start.clone(),
         };
-        // Reference values: the start design (and the normalization one).
+        problem.set_references(study, &spec)?;
+        Ok(problem)
+    }
+
+    /// The constraint bounds and the objective's divisor from the start
+    /// design (and the normalization design).
+    fn set_references(&mut self, study: &Study, spec: &SceneProblemSpec) -> Result<()> {
         let mut wanted = vec![spec.objective.response.clone()];
         wanted.extend(spec.constraints.iter().map(|c| c.response.clone()));
-        let at_start = problem.raw(&spec.start, &wanted, false)?;
+        let at_start = self.raw(&spec.start, &wanted, false)?;
         for (j, c) in spec.constraints.iter().enumerate() {
             let bound = match c.upper {
                 Some(u) => u,
                 None => c.upper_relative.unwrap_or(1.0) * at_start.values[j + 1],
             };
             if !(bound.is_finite() && bound > 0.0) {
-                return Err(err(
+                return Err(problem_error(
+                    study,
                     format!("constraints[{j}].upper_relative"),
-                    &c.upper_relative.unwrap_or(1.0),
+                    c.upper_relative.unwrap_or(1.0),
                     format!(
                         "a bound > 0: {} at the start design is {bound:e}, so the constraint is degenerate",
                         c.response
                     ),
                 ));
             }
-            problem.constraints.push((c.response.clone(), bound));
+            self.constraints.push((c.response.clone(), bound));
         }
         if let Some(r) = &spec.objective.normalize_at {
             let v = if *r == spec.start {
                 at_start.values[0]
             } else {
-                problem.raw(r, &wanted[..1], false)?.values[0]
+                self.raw(r, &wanted[..1], false)?.values[0]
             };
             if !(v.is_finite() && v != 0.0) {
-                return Err(err(
+                return Err(problem_error(
+                    study,
                     "objective.normalize_at".into(),
-                    &format!("{r:?}"),
+                    format!("{r:?}"),
                     format!(
                         "a design where {} is not zero (it is {v:e})",
                         spec.objective.response
                     ),
                 ));
             }
-            problem.objective.1 = v;
+            self.objective.1 = v;
         }
-        Ok(problem)
+        Ok(())
     }
 
     /// The start design \[deg\].
@@ -539,6 +392,227 @@ impl SceneProblem {
             raw.profile,
         ))
     }
+}
+
+/// An input error on `scene_problem.<key>`.
+fn problem_error(
+    study: &Study,
+    key: String,
+    value: impl std::fmt::Display,
+    expected: String,
+) -> Error {
+    study.error(format!("scene_problem.{key}"), value, expected)
+}
+
+/// The problem variables and what each one sets: ply targets in the
+/// panels and sensitivity lanes of the scene.
+struct Ties {
+    vars: Vec<Variable>,
+    targets: Vec<Vec<PlyTarget>>,
+    lanes: Vec<String>,
+    lanes_of: Vec<Vec<usize>>,
+}
+
+impl Ties {
+    /// Resolve `[[scene_problem.variables]]` against the plan's panels and
+    /// scene (each panel design variable tied to one problem variable).
+    fn resolve(study: &Study, spec: &SceneProblemSpec, plan: &ScenePlan) -> Result<Ties> {
+        if spec.variables.is_empty() {
+            return Err(problem_error(
+                study,
+                "variables".into(),
+                "[]",
+                "at least one variable".into(),
+            ));
+        }
+        let mut ties = Ties {
+            vars: Vec::new(),
+            targets: Vec::new(),
+            lanes: Vec::new(),
+            lanes_of: Vec::new(),
+        };
+        let mut used: Vec<(usize, usize)> = Vec::new();
+        for (i, v) in spec.variables.iter().enumerate() {
+            let key = format!("variables[{i}]");
+            ties.vars.push(variable(study, &key, v)?);
+            if v.sets.is_empty() {
+                return Err(problem_error(
+                    study,
+                    format!("{key}.sets"),
+                    "[]",
+                    "at least one \"<panel>:<design variable>\"".into(),
+                ));
+            }
+            let (mut t, mut l) = (Vec::new(), Vec::new());
+            for (k, entry) in v.sets.iter().enumerate() {
+                let key = format!("{key}.sets[{k}]");
+                let (target, lanes) = tie(study, plan, &key, entry, &mut used)?;
+                t.push(target);
+                for lane in lanes {
+                    l.push(ties.lanes.len());
+                    ties.lanes.push(lane);
+                }
+            }
+            ties.targets.push(t);
+            ties.lanes_of.push(l);
+        }
+        Ok(ties)
+    }
+}
+
+/// One `[[scene_problem.variables]]` entry as an optimization variable.
+fn variable(study: &Study, key: &str, v: &VariableSpec) -> Result<Variable> {
+    let [lo, hi] = v.bounds;
+    if v.periodic {
+        if !(lo.is_finite() && hi - lo == 180.0) {
+            return Err(problem_error(
+                study,
+                format!("{key}.bounds"),
+                format!("[{lo}, {hi}]"),
+                "finite bounds 180° apart (ply angles repeat every 180°)".into(),
+            ));
+        }
+        Variable::periodic(v.name.clone(), lo, 180.0)
+    } else {
+        Variable::bounded(v.name.clone(), lo, hi)
+    }
+    .map_err(|e| e.in_file(&study.path, &format!("scene_problem.{key}")))
+}
+
+/// One `"<panel>:<design variable>"` entry: the plies it sets and the
+/// scene's sensitivity lanes of the bodies built from that panel (each
+/// must be listed in `[scene] sensitivities`). `used` holds the panel
+/// design variables already tied.
+fn tie(
+    study: &Study,
+    plan: &ScenePlan,
+    key: &str,
+    entry: &str,
+    used: &mut Vec<(usize, usize)>,
+) -> Result<(PlyTarget, Vec<String>)> {
+    let bad =
+        |expected: String| problem_error(study, key.to_string(), format!("\"{entry}\""), expected);
+    let panels = plan.panels();
+    let (pname, dname) = entry
+        .split_once(':')
+        .ok_or_else(|| bad("\"<panel>:<design variable>\", e.g. \"panel3:theta_1_4\"".into()))?;
+    let Some(p) = panels.iter().position(|p| p.name == pname) else {
+        let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
+        return Err(bad(format!(
+            "a [[panels]] name before ':' ({})",
+            names.join(", ")
+        )));
+    };
+    let names = design_names(&panels[p].design);
+    let Some(d) = names.iter().position(|n| n == dname) else {
+        return Err(bad(format!(
+            "a design variable of panel {pname} after ':' ({})",
+            names.join(", ")
+        )));
+    };
+    if used.contains(&(p, d)) {
+        return Err(bad(
+            "each panel design variable set by one problem variable".into(),
+        ));
+    }
+    used.push((p, d));
+    let bodies = plan.bodies_of_panel(pname);
+    if bodies.is_empty() {
+        return Err(bad(format!(
+            "a panel of a flexible scene body (no [[scene.bodies]] uses panel {pname})"
+        )));
+    }
+    let listed = &plan.spec().sensitivities;
+    let mut lanes = Vec::new();
+    for b in bodies {
+        let lane = format!("{b}.design.{dname}");
+        if !listed.contains(&lane) {
+            return Err(study.error(
+                "scene.sensitivities",
+                format!("{listed:?}"),
+                format!("a list containing \"{lane}\" (the gradient of scene_problem.{key})"),
+            ));
+        }
+        lanes.push(lane);
+    }
+    let target = PlyTarget {
+        panel: p,
+        plies: panels[p].design.groups()[d].clone(),
+    };
+    Ok((target, lanes))
+}
+
+/// The objective's and constraints' responses exist, their bounds are
+/// valid, and the start and normalization designs are within the bounds.
+fn check_objective_and_constraints(
+    study: &Study,
+    spec: &SceneProblemSpec,
+    plan: &ScenePlan,
+    vars: &[Variable],
+) -> Result<()> {
+    let names: Vec<&str> = plan
+        .spec()
+        .responses
+        .iter()
+        .map(|r| r.name.as_str())
+        .collect();
+    let check_response = |key: String, r: &str| {
+        if names.contains(&r) {
+            Ok(())
+        } else {
+            Err(problem_error(
+                study,
+                key,
+                format!("\"{r}\""),
+                format!("a [[scene.responses]] name ({})", names.join(", ")),
+            ))
+        }
+    };
+    check_response("objective.response".into(), &spec.objective.response)?;
+    let check_design = |key: &str, x: &[f64]| -> Result<()> {
+        if x.len() != vars.len()
+            || x.iter()
+                .zip(vars)
+                .any(|(&x, v)| !x.is_finite() || (v.period.is_none() && v.wrap(x) != x))
+        {
+            return Err(problem_error(
+                study,
+                key.into(),
+                format!("{x:?}"),
+                format!("{} finite angles [deg] within the bounds", vars.len()),
+            ));
+        }
+        Ok(())
+    };
+    check_design("start", &spec.start)?;
+    if let Some(r) = &spec.objective.normalize_at {
+        check_design("objective.normalize_at", r)?;
+    }
+    for (j, c) in spec.constraints.iter().enumerate() {
+        let key = format!("constraints[{j}]");
+        check_response(format!("{key}.response"), &c.response)?;
+        let (v, k) = match (c.upper, c.upper_relative) {
+            (Some(u), None) => (u, "upper"),
+            (None, Some(u)) => (u, "upper_relative"),
+            _ => {
+                return Err(problem_error(
+                    study,
+                    key,
+                    "(table)",
+                    "exactly one of `upper` (absolute) and `upper_relative` (factor of the start value)".into(),
+                ))
+            }
+        };
+        if !(v.is_finite() && v > 0.0) {
+            return Err(problem_error(
+                study,
+                format!("{key}.{k}"),
+                v,
+                "a finite bound > 0".into(),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `theta1_deg = 55, theta2_deg = -55`.
