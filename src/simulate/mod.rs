@@ -60,32 +60,8 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         .outputs
         .iter()
         .any(|(_, q)| matches!(q, Quantity::Reaction(_)));
-    let sens_quantities: Vec<(String, Quantity)> = scene
-        .outputs
-        .iter()
-        .filter(|(_, q)| {
-            matches!(
-                q,
-                Quantity::Angle(_)
-                    | Quantity::Rate(_)
-                    | Quantity::Position(_)
-                    | Quantity::Modal(..)
-                    | Quantity::Strain(_)
-                    | Quantity::Deflection(_)
-            )
-        })
-        .cloned()
-        .collect();
-    let mut sens_headers = vec!["t [s]".to_string()];
-    for (pname, _) in &scene.params {
-        for (label, q) in &sens_quantities {
-            for h in q.headers(label) {
-                let (name, unit) = h.split_once(" [").unwrap_or((h.as_str(), "-]"));
-                let unit = unit.trim_end_matches(']');
-                sens_headers.push(format!("d({name})/d({pname}) [{unit} per SI unit of p]"));
-            }
-        }
-    }
+    let sens_quantities = sens_quantities(scene);
+    let sens_headers = sens_headers(scene, &sens_quantities);
     let mut sens_rows = Vec::new();
     let n = y0.len();
     // Sampled peak responses (t, value, gradient) and the final
@@ -133,40 +109,7 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
             let e = sys.energy(y, &mut ws);
             energy_error = energy_error.max((e - e0).abs() / e0.abs().max(1e-300));
         }
-        let mut row = vec![t];
-        for (_, q) in &scene.outputs {
-            match q {
-                Quantity::Angle(j) => row.push(sys.angle(y, *j, &mut ws).0),
-                Quantity::Rate(j) => row.push(sys.angle(y, *j, &mut ws).1),
-                Quantity::Reaction(j) => {
-                    let r = reactions.as_ref().map(|r| r[*j]).unwrap_or(Reaction {
-                        force: Default::default(),
-                        torque: Default::default(),
-                    });
-                    row.extend(r.force.iter().chain(r.torque.iter()));
-                }
-                Quantity::Position(b) => match sys.slot[*b] {
-                    Some(s) => {
-                        let p = sys.pos_off(s);
-                        row.extend_from_slice(&y[p..p + 3])
-                    }
-                    None => row.extend(sys.model.bodies[*b].r0.iter()),
-                },
-                Quantity::Modal(b, n) => match sys.slot[*b] {
-                    Some(s) => {
-                        let p = sys.pos_off(s) + 7;
-                        row.extend_from_slice(&y[p..p + n])
-                    }
-                    None => row.extend(std::iter::repeat_n(0.0, *n)),
-                },
-                Quantity::Strain(b) => {
-                    row.push(sys.slot[*b].map_or(0.0, |s| sys.strain_energy(y, s)))
-                }
-                Quantity::Deflection(m) => row.extend(sys.deflection(y, *m).iter()),
-                Quantity::Energy => row.push(sys.energy(y, &mut ws)),
-                Quantity::Violation => row.push(viol),
-            }
-        }
+        let row = output_row(&sys, scene, (t, y), &mut ws, reactions.as_deref(), viol);
         if let Some(k) = row.iter().position(|v| !v.is_finite()) {
             return Err(Error::numerical_at(
                 "simulate: outputs",
@@ -184,9 +127,121 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
         integrate_sens(&sys, &y0, &scene.options, &params, &mut observe)?
     };
+    let responses = collect_responses(scene, &sys, &peaks, &y_end, &s_end)?;
+    let sim = Simulation {
+        headers,
+        rows,
+        y_end,
+        redundant: projection.equations - projection.rank,
+        equations: projection.equations,
+        projection,
+        stats,
+        max_violation,
+        energy_error: conservative.then_some(energy_error),
+        sens_headers,
+        sens_rows,
+        responses,
+    };
+    Ok((sys, sim))
+}
+
+/// The output columns that have sensitivities (angles, rates, positions,
+/// modal coordinates, strain energies, deflections).
+fn sens_quantities(scene: &Scene) -> Vec<(String, Quantity)> {
+    scene
+        .outputs
+        .iter()
+        .filter(|(_, q)| {
+            matches!(
+                q,
+                Quantity::Angle(_)
+                    | Quantity::Rate(_)
+                    | Quantity::Position(_)
+                    | Quantity::Modal(..)
+                    | Quantity::Strain(_)
+                    | Quantity::Deflection(_)
+            )
+        })
+        .cloned()
+        .collect()
+}
+
+/// Headers of `sensitivities.csv`: `t [s]`, then per parameter the
+/// derivative of every output of `quantities`, with units.
+fn sens_headers(scene: &Scene, quantities: &[(String, Quantity)]) -> Vec<String> {
+    let mut headers = vec!["t [s]".to_string()];
+    for (pname, _) in &scene.params {
+        for (label, q) in quantities {
+            for h in q.headers(label) {
+                let (name, unit) = h.split_once(" [").unwrap_or((h.as_str(), "-]"));
+                let unit = unit.trim_end_matches(']');
+                headers.push(format!("d({name})/d({pname}) [{unit} per SI unit of p]"));
+            }
+        }
+    }
+    headers
+}
+
+/// One row of `history.csv` at `(t, y)`: the scene's outputs, with the
+/// reactions and the violation already computed at that state.
+fn output_row(
+    sys: &System,
+    scene: &Scene,
+    at: (f64, &[f64]),
+    ws: &mut Workspace<f64>,
+    reactions: Option<&[Reaction]>,
+    viol: f64,
+) -> Vec<f64> {
+    let (t, y) = at;
+    let mut row = vec![t];
+    for (_, q) in &scene.outputs {
+        match q {
+            Quantity::Angle(j) => row.push(sys.angle(y, *j, ws).0),
+            Quantity::Rate(j) => row.push(sys.angle(y, *j, ws).1),
+            Quantity::Reaction(j) => {
+                let r = reactions.map(|r| r[*j]).unwrap_or(Reaction {
+                    force: Default::default(),
+                    torque: Default::default(),
+                });
+                row.extend(r.force.iter().chain(r.torque.iter()));
+            }
+            Quantity::Position(b) => match sys.slot[*b] {
+                Some(s) => {
+                    let p = sys.pos_off(s);
+                    row.extend_from_slice(&y[p..p + 3])
+                }
+                None => row.extend(sys.model.bodies[*b].r0.iter()),
+            },
+            Quantity::Modal(b, n) => match sys.slot[*b] {
+                Some(s) => {
+                    let p = sys.pos_off(s) + 7;
+                    row.extend_from_slice(&y[p..p + n])
+                }
+                None => row.extend(std::iter::repeat_n(0.0, *n)),
+            },
+            Quantity::Strain(b) => row.push(sys.slot[*b].map_or(0.0, |s| sys.strain_energy(y, s))),
+            Quantity::Deflection(m) => row.extend(sys.deflection(y, *m).iter()),
+            Quantity::Energy => row.push(sys.energy(y, ws)),
+            Quantity::Violation => row.push(viol),
+        }
+    }
+    row
+}
+
+/// The response values: integrals from the final state (and their
+/// gradients from the final sensitivities `s_end`, lane-major), peaks from
+/// the sampled series at their critical time points.
+fn collect_responses(
+    scene: &Scene,
+    sys: &System,
+    peaks: &[Vec<(f64, f64, Vec<f64>)>],
+    y_end: &[f64],
+    s_end: &[f64],
+) -> Result<Vec<ResponseValue>> {
+    let n = y_end.len();
     let io = sys.integral_off();
     let mut responses = Vec::new();
-    for (r, series) in scene.responses.iter().zip(&peaks) {
+    for (r, series) in scene.responses.iter().zip(peaks) {
         responses.push(match r {
             Response::Integral { name, index } => ResponseValue {
                 name: name.clone(),
@@ -211,21 +266,7 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
             }
         });
     }
-    let sim = Simulation {
-        headers,
-        rows,
-        y_end,
-        redundant: projection.equations - projection.rank,
-        equations: projection.equations,
-        projection,
-        stats,
-        max_violation,
-        energy_error: conservative.then_some(energy_error),
-        sens_headers,
-        sens_rows,
-        responses,
-    };
-    Ok((sys, sim))
+    Ok(responses)
 }
 
 /// Exact derivatives of the outputs along the state sensitivity
