@@ -47,8 +47,13 @@
 //! with exactly the lanes `<body>.design.<variable>` of the bodies built
 //! from the tied panels (each must appear in `[scene] sensitivities`, so
 //! that the study file shows what is differentiated); without, with none.
-//! A variable's derivative is the sum over its lanes, times π/180 (the
-//! scene's lanes are per radian, the variables in degrees). The output
+//! By default the lanes of one variable are tied into one
+//! (`tied_lanes = true`: `B3.design.theta_1_4+B2.design.theta_1_4`, one
+//! dual-number direction that moves every tied ply at once), so a shared
+//! angle costs one sensitivity lane; with `tied_lanes = false` each body's
+//! lane is integrated and the lanes are summed. A variable's derivative is
+//! the sum over its lanes, times π/180 (the scene's lanes are per radian,
+//! the variables in degrees). The output
 //! columns of `[scene.outputs]` are dropped (responses need none). The
 //! plan's builders are pooled, so drivers may evaluate in parallel.
 //!
@@ -79,6 +84,17 @@ pub struct SceneProblemSpec {
     /// Upper-bound constraints on responses.
     #[serde(default)]
     pub constraints: Vec<ConstraintSpec>,
+    /// One sensitivity lane per problem variable (default): the bodies'
+    /// design variables that a variable sets are tied into one lane
+    /// (`"B3.design.theta_1_4+B2.design.theta_1_4"`, the derivative with
+    /// respect to the shared angle), so a shared angle costs one lane.
+    /// `false`: one lane per body and design variable, summed afterwards.
+    #[serde(default = "yes")]
+    pub tied_lanes: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// One `[[scene_problem.variables]]` entry.
@@ -443,16 +459,18 @@ impl Ties {
                     "at least one \"<panel>:<design variable>\"".into(),
                 ));
             }
-            let (mut t, mut l) = (Vec::new(), Vec::new());
+            let (mut t, mut names) = (Vec::new(), Vec::new());
             for (k, entry) in v.sets.iter().enumerate() {
                 let key = format!("{key}.sets[{k}]");
                 let (target, lanes) = tie(study, plan, &key, entry, &mut used)?;
                 t.push(target);
-                for lane in lanes {
-                    l.push(ties.lanes.len());
-                    ties.lanes.push(lane);
-                }
+                names.extend(lanes);
             }
+            if spec.tied_lanes && names.len() > 1 {
+                names = vec![names.join("+")];
+            }
+            let l: Vec<usize> = (ties.lanes.len()..ties.lanes.len() + names.len()).collect();
+            ties.lanes.extend(names);
             ties.targets.push(t);
             ties.lanes_of.push(l);
         }

@@ -223,13 +223,11 @@ impl System {
             if n > 0 {
                 let b = self.moving[s];
                 for (par, val) in params {
-                    if let Param::Design(pb, var) = *par {
-                        if pb == b {
-                            let re = cst::<T>(val.to_subset().unwrap_or(0.0));
-                            let delta = *val - re;
-                            if !delta.is_exact_zero() {
-                                k.design.push((var, delta));
-                            }
+                    if let Some(var) = par.design_of(&self.model, b) {
+                        let re = cst::<T>(val.to_subset().unwrap_or(0.0));
+                        let delta = *val - re;
+                        if !delta.is_exact_zero() {
+                            k.design.push((var, delta));
                         }
                     }
                 }

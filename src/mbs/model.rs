@@ -289,6 +289,11 @@ pub enum Param {
     /// flexible body `bodies[i]`: its exact effect on Λ and the mode
     /// shapes comes from the basis's derivatives (`dΛ/dθ`, `dX/dθ`).
     Design(usize, usize),
+    /// One ply angle shared by several flexible bodies (rad): the design
+    /// variables `Model::ties[g]` (`(body, variable)` pairs) move
+    /// together, so one sensitivity lane gives the derivative with respect
+    /// to the shared angle (the sum of the members' lanes).
+    Tied(usize),
 }
 
 impl Param {
@@ -314,7 +319,32 @@ impl Param {
                 .get(b)
                 .and_then(|b| b.flex.as_ref())
                 .and_then(|f| f.design.get(k).copied()),
+            Param::Tied(g) => {
+                let &(b, k) = model.ties.get(g)?.first()?;
+                Param::Design(b, k).value(model)
+            }
         }
+    }
+
+    /// The design variable of flexible body `body` that this parameter
+    /// seeds, if any ([`Param::Design`] of that body, or a member of a
+    /// [`Param::Tied`] group).
+    pub fn design_of(&self, model: &Model, body: usize) -> Option<usize> {
+        match *self {
+            Param::Design(b, k) if b == body => Some(k),
+            Param::Tied(g) => model
+                .ties
+                .get(g)?
+                .iter()
+                .find(|(b, _)| *b == body)
+                .map(|(_, k)| *k),
+            _ => None,
+        }
+    }
+
+    /// Whether this is a ply-angle parameter (design or tied design).
+    pub fn is_design(&self) -> bool {
+        matches!(self, Param::Design(..) | Param::Tied(_))
     }
 
     /// Set this parameter to `v` in `model` (for finite differences and
@@ -343,6 +373,11 @@ impl Param {
             Param::Design(b, k) => {
                 if let Some(f) = model.bodies[b].flex.as_mut() {
                     f.design[k] = v;
+                }
+            }
+            Param::Tied(g) => {
+                for (b, k) in model.ties[g].clone() {
+                    Param::Design(b, k).set(model, v);
                 }
             }
         }
@@ -439,6 +474,9 @@ pub struct Model {
     /// Time integrals carried as extra states (after the velocities), so
     /// that their sensitivities come with the integration (NUMERICS.md).
     pub integrals: Vec<Integral>,
+    /// Groups of `(body, design variable)` that [`Param::Tied`] lanes move
+    /// together.
+    pub ties: Vec<Vec<(usize, usize)>>,
 }
 
 /// `∫ scale · Σ_b U_b dt` over the strain energies `U_b = ½ wᵀΛw` of the

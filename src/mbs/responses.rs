@@ -82,9 +82,9 @@ pub fn strain_sum(
                 .iter()
                 .filter_map(|&b| sys.slot[b].map(|s| (b, s)))
                 .map(|(b, s)| {
-                    let seeds: Vec<(usize, Dual64)> = match *p {
-                        Param::Design(pb, var) if pb == b => vec![(var, Dual64::new(0.0, 1.0))],
-                        _ => Vec::new(),
+                    let seeds: Vec<(usize, Dual64)> = match p.design_of(&sys.model, b) {
+                        Some(var) => vec![(var, Dual64::new(0.0, 1.0))],
+                        None => Vec::new(),
                     };
                     sys.strain_energy_dual(&yd, s, &seeds).eps
                 })

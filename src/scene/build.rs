@@ -70,7 +70,7 @@ impl SceneSpec {
             .collect();
         let outputs = self.outputs(&model, &flex_names)?;
         let responses = self.responses(&mut model, &flex_names)?;
-        let params = self.params(&model, &force_index)?;
+        let params = self.params(&mut model, &force_index)?;
         Ok(Scene {
             model,
             options,
@@ -477,10 +477,19 @@ impl SceneSpec {
     }
 
     /// Sensitivity parameters by name (`[scene] sensitivities`).
-    fn params(&self, model: &Model, force_index: &[Option<usize>]) -> Result<Vec<(String, Param)>> {
+    fn params(
+        &self,
+        model: &mut Model,
+        force_index: &[Option<usize>],
+    ) -> Result<Vec<(String, Param)>> {
         let mut params = Vec::new();
         for (k, name) in self.sensitivities.iter().enumerate() {
             let key = format!("sensitivities[{k}]");
+            if name.contains('+') {
+                let p = tie(model, &key, name)?;
+                params.push((name.clone(), p));
+                continue;
+            }
             let p = parse_param(model, &self.forces, force_index, name).ok_or_else(|| {
                 Error::input(
                     &key,
@@ -639,4 +648,30 @@ fn joint_axis(key: &str, j: &JointSpec, kind: &JointKind) -> Result<Vector3<f64>
             ))
         }
     })
+}
+
+/// A tied ply-angle lane `"<body>.design.<v>+<body>.design.<v>+.."`: every
+/// member a design variable of a different flexible body; registered as a
+/// group in [`Model::ties`].
+fn tie(model: &mut Model, key: &str, name: &str) -> Result<Param> {
+    let bad = || {
+        Error::input(
+            key,
+            name,
+            "design variables of different flexible bodies joined by '+' \
+             (<body>.design.<variable>+<body>.design.<variable>), one ply angle",
+        )
+    };
+    let mut group: Vec<(usize, usize)> = Vec::new();
+    for part in name.split('+') {
+        match parse_param(model, &[], &[], part.trim()) {
+            Some(Param::Design(b, v)) if group.iter().all(|(g, _)| *g != b) => group.push((b, v)),
+            _ => return Err(bad()),
+        }
+    }
+    if group.len() < 2 {
+        return Err(bad());
+    }
+    model.ties.push(group);
+    Ok(Param::Tied(model.ties.len() - 1))
 }

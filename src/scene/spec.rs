@@ -62,13 +62,18 @@ impl Effect {
 impl SceneSpec {
     /// Drop the mode derivatives of flexible bodies that no sensitivity
     /// parameter differentiates (no `<body>.design.<variable>` in
-    /// `sensitivities`): what a study does not ask for is not computed.
+    /// `sensitivities`, alone or in a tied lane `a+b`): what a study does
+    /// not ask for is not computed.
     /// The modes, and so every output, are the same either way.
     pub fn prune_derivatives(&mut self) {
         let lanes = &self.sensitivities;
         for b in &mut self.bodies {
             let prefix = format!("{}.design.", b.name);
-            if !lanes.iter().any(|l| l.starts_with(&prefix)) {
+            if !lanes
+                .iter()
+                .flat_map(|l| l.split('+'))
+                .any(|l| l.trim().starts_with(&prefix))
+            {
                 if let Some(f) = &mut b.flexible {
                     f.derivatives_name = None;
                 }

@@ -282,7 +282,7 @@ fn output_sensitivities(
     let (s, param) = lane;
     let yd: Vec<Dual64> = y.iter().zip(s).map(|(&a, &b)| Dual64::new(a, b)).collect();
     let seeds: Vec<(Param, Dual64)> = match param {
-        Param::Design(..) => vec![(
+        p if p.is_design() => vec![(
             param,
             Dual64::new(param.value(&sys.model).unwrap_or(0.0), 1.0),
         )],
