@@ -1,0 +1,267 @@
+//! The legs of one integration: stepping a diffsol solver through the
+//! output times, locating the model's events, switching pieces with the
+//! sensitivity jump, and restarting (module doc of [`super`]).
+
+use super::ode::OdeModel;
+use super::options::{Options, Stats};
+use crate::error::{Error, Result};
+use diffsol::{OdeSolverMethod, OdeSolverStopReason, Vector};
+use std::cell::RefCell;
+
+/// diffsol counts nonlinear-solver failures over the WHOLE integration
+/// (`max_nonlinear_solver_failures`, default 50) and aborts past the cap,
+/// so a long, healthy BDF run whose Newton iteration occasionally fails
+/// (each failure just refreshes the Jacobian and cuts the step, as in
+/// CVODE, whose cap is per step) ends in an error: the Bricard linkage at
+/// rtol 1e-4 did at t = 0.45 s. The cap is lifted; a genuine divergence
+/// still ends, with its time, when the step falls below `min_timestep`
+/// (1e-13 s; each failure cuts the step by 0.3, so after about 30
+/// consecutive failures from a 1e-3 s step).
+pub(super) fn lift_failure_cap(o: &mut diffsol::OdeSolverOptions<f64>) {
+    o.max_nonlinear_solver_failures = usize::MAX / 2;
+}
+
+/// An accepted change of piece: time, state and sensitivities (before the
+/// jump; [`Legs::jump`] applies it in place) and the crossing.
+pub(super) struct Event<C> {
+    pub(super) t: f64,
+    pub(super) y: Vec<f64>,
+    pub(super) s: Vec<f64>,
+    pub(super) crossing: C,
+}
+
+/// The legs of one integration: output bookkeeping across restarts.
+pub(super) struct Legs<'c, M: OdeModel> {
+    pub(super) opts: &'c Options,
+    /// Sensitivity lanes (0 without sensitivities).
+    pub(super) nsens: usize,
+    /// Next output time to emit.
+    pub(super) next: usize,
+    pub(super) model: &'c M,
+    pub(super) events: &'c RefCell<M::Events>,
+    pub(super) work: &'c RefCell<M::Work>,
+    /// The sensitivity parameters and their values (empty without).
+    pub(super) params: (&'c [M::Param], &'c [f64]),
+}
+
+impl<M: OdeModel> Legs<'_, M> {
+    /// Step a solver through the output times until the end or an
+    /// accepted segment change; with `nsens > 0` the sensitivities
+    /// (`nsens` lanes of the state length, lane-major) are interpolated
+    /// too and handed to `observe` after the state. Outputs after an
+    /// event are not served by this leg (its law is extended past the
+    /// breakpoint there).
+    pub(super) fn drive<'a, Eqn, S>(
+        &mut self,
+        mut solver: S,
+        observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+    ) -> Result<(Stats, Option<Event<M::Crossing>>)>
+    where
+        Eqn: diffsol::OdeEquations<T = f64, V = diffsol::FaerVec<f64>> + 'a,
+        S: OdeSolverMethod<'a, Eqn>,
+    {
+        let opts = self.opts;
+        let times = &opts.times;
+        let nsens = self.nsens;
+        let t_end = times[times.len() - 1];
+        solver
+            .set_stop_time(t_end)
+            .map_err(|e| Error::numerical("integrate: stop time", e.to_string()))?;
+        // Output times at the start (first leg only: later legs start
+        // after the outputs already served).
+        while self.next < times.len() && times[self.next] <= opts.t0 {
+            let y = solver.state().y.clone_as_vec();
+            // Initial sensitivities are zero (the initial state is given).
+            let s0 = vec![0.0; y.len() * nsens];
+            emit(times[self.next], &y, &s0, observe)?;
+            self.next += 1;
+        }
+        let mut event = None;
+        loop {
+            let t_before = solver.state().t;
+            let reason = solver.step().map_err(|e| {
+                Error::numerical_at(
+                    format!("integrate: {} step", opts.method.name()),
+                    t_before,
+                    e.to_string(),
+                )
+            })?;
+            let mut t = solver.state().t;
+            if let OdeSolverStopReason::RootFound(tr, idx) = reason {
+                let yr = solver
+                    .interpolate(tr)
+                    .map_err(|e| Error::numerical_at("integrate: event state", tr, e.to_string()))?
+                    .clone_as_vec();
+                let crossing = self.model.classify(&self.events.borrow(), idx, &yr);
+                if let Some(crossing) = crossing {
+                    let s = if nsens > 0 {
+                        solver
+                            .interpolate_sens(tr)
+                            .map_err(|e| {
+                                Error::numerical_at(
+                                    "integrate: event sensitivities",
+                                    tr,
+                                    e.to_string(),
+                                )
+                            })?
+                            .clone_as_vec()
+                    } else {
+                        Vec::new()
+                    };
+                    t = tr;
+                    event = Some(Event {
+                        t: tr,
+                        y: yr,
+                        s,
+                        crossing,
+                    });
+                }
+            }
+            while self.next < times.len() && times[self.next] <= t {
+                let tq = times[self.next];
+                if let Some(e) = event.as_ref().filter(|e| e.t == tq) {
+                    emit(tq, &e.y, &e.s, observe)?;
+                    self.next += 1;
+                    continue;
+                }
+                let y = if tq == solver.state().t {
+                    solver.state().y.clone()
+                } else {
+                    solver.interpolate(tq).map_err(|e| {
+                        Error::numerical_at("integrate: dense output", tq, e.to_string())
+                    })?
+                };
+                let sens = if nsens > 0 {
+                    solver
+                        .interpolate_sens(tq)
+                        .map_err(|e| {
+                            Error::numerical_at("integrate: sensitivity output", tq, e.to_string())
+                        })?
+                        .clone_as_vec()
+                } else {
+                    Vec::new()
+                };
+                emit(tq, &y.clone_as_vec(), &sens, observe)?;
+                self.next += 1;
+            }
+            if event.is_some()
+                || matches!(reason, OdeSolverStopReason::TstopReached)
+                || self.next >= times.len()
+            {
+                break;
+            }
+        }
+        let st = solver.get_statistics();
+        let stats = Stats {
+            steps: st.number_of_steps,
+            jacobians: st.number_of_linear_solver_setups,
+            error_test_failures: st.number_of_error_test_failures,
+            nonlinear_iterations: st.number_of_nonlinear_solver_iterations,
+            nonlinear_failures: st.number_of_nonlinear_solver_fails,
+            ..Stats::default()
+        };
+        Ok((stats, event))
+    }
+
+    /// The end of a leg: count it; at an event, switch the piece (the
+    /// sensitivities jump), refreeze the model's pieces, and return the
+    /// event when a new leg must start from it.
+    pub(super) fn end_leg(
+        &mut self,
+        stats: &mut Stats,
+        leg: (Stats, Option<Event<M::Crossing>>),
+        observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+    ) -> Result<Option<Event<M::Crossing>>> {
+        stats.absorb(&leg.0);
+        let Some(mut e) = leg.1 else { return Ok(None) };
+        stats.events += 1;
+        stats.last_event = Some(e.t);
+        self.jump(&mut e)?;
+        self.model
+            .freeze(&self.events.borrow(), &mut self.work.borrow_mut());
+        if !self.restart_or_finish(&e, observe)? {
+            return Ok(None);
+        }
+        stats.restarts += 1;
+        Ok(Some(e))
+    }
+
+    /// Switch the piece at event `e` and, with sensitivity lanes, apply
+    /// the jump `s⁺ = s⁻ + (f⁻ − f⁺) dt_e/dp` with
+    /// `dt_e/dp = −g_y s⁻ / (g_y f⁻)` (module doc; `g_p = 0`) in place.
+    fn jump(&mut self, e: &mut Event<M::Crossing>) -> Result<()> {
+        let (model, c) = (self.model, e.crossing);
+        let mut ev = self.events.borrow_mut();
+        if self.nsens == 0 {
+            model.switch(&mut ev, c, &e.y);
+            return Ok(());
+        }
+        let n = e.y.len();
+        let mut work = self.work.borrow_mut();
+        let (mut fm, mut fp) = (vec![0.0; n], vec![0.0; n]);
+        model.freeze(&ev, &mut work);
+        model.rhs(&mut work, e.t, &e.y, self.params, &mut fm);
+        model.switch(&mut ev, c, &e.y);
+        model.freeze(&ev, &mut work);
+        model.rhs(&mut work, e.t, &e.y, self.params, &mut fp);
+        let den = model.crossing_dir(&ev, c, &e.y, &fm);
+        if den.is_nan() || den.abs() <= 1e-12 {
+            return Err(Error::numerical_at(
+                "integrate: segment event",
+                e.t,
+                format!(
+                    "{} grazes a breakpoint (dθ/dt = {den:e}): the event \
+                     time is not differentiable",
+                    model.crossing_label(&ev, c)
+                ),
+            ));
+        }
+        for lane in e.s.chunks_mut(n) {
+            let tau = -model.crossing_dir(&ev, c, &e.y, lane) / den;
+            for k in 0..n {
+                lane[k] += (fm[k] - fp[k]) * tau;
+            }
+        }
+        Ok(())
+    }
+
+    /// After the switch at event `e` (sensitivities already jumped):
+    /// whether a new leg must start. An event at the end time, or so close
+    /// to it that no step fits (`≤ 1e-12 (1 + |t_end|)`), serves the
+    /// remaining outputs from the event state instead.
+    fn restart_or_finish(
+        &mut self,
+        e: &Event<M::Crossing>,
+        observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+    ) -> Result<bool> {
+        let times = &self.opts.times;
+        if self.next >= times.len() {
+            return Ok(false);
+        }
+        let t_end = times[times.len() - 1];
+        if t_end - e.t > 1e-12 * (1.0 + t_end.abs()) {
+            return Ok(true);
+        }
+        while self.next < times.len() {
+            emit(times[self.next], &e.y, &e.s, observe)?;
+            self.next += 1;
+        }
+        Ok(false)
+    }
+}
+
+fn emit(
+    t: f64,
+    y: &[f64],
+    sens: &[f64],
+    observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+) -> Result<()> {
+    if let Some(k) = y.iter().chain(sens).position(|v| !v.is_finite()) {
+        return Err(Error::numerical_at(
+            "integrate: state",
+            t,
+            format!("component {k} of the state/sensitivities is not finite"),
+        ));
+    }
+    observe(t, y, sens)
+}

@@ -1,0 +1,63 @@
+//! [`OdeModel`]: what the integrator needs of an ODE system.
+
+/// An ODE system `ẏ = f(t, y; p)` as the integrator sees it: right-hand
+/// side, exact directional derivatives (for implicit methods and forward
+/// sensitivities), and the events that switch between its smooth pieces.
+/// `n` is the state length; parameter lanes are named by
+/// [`OdeModel::Param`] and carried with their values.
+pub trait OdeModel {
+    /// A parameter of the model (a sensitivity lane).
+    type Param: Copy + std::fmt::Debug;
+    /// Scratch reused by every evaluation of one integration.
+    type Work;
+    /// The state of the model's piece switching (which piece is frozen).
+    type Events;
+    /// An accepted change of piece.
+    type Crossing: Copy;
+
+    /// Scratch for states of length `n`.
+    fn work(&self, n: usize) -> Self::Work;
+    /// The model's value of parameter `p` (None: not a parameter of it).
+    fn param_value(&self, p: Self::Param) -> Option<f64>;
+    /// `dy = f(t, y)` with the parameters `params.0` set to the values
+    /// `params.1` (both empty: the model's own values).
+    fn rhs(
+        &self,
+        w: &mut Self::Work,
+        t: f64,
+        y: &[f64],
+        params: (&[Self::Param], &[f64]),
+        dy: &mut [f64],
+    );
+    /// The exact directional derivative `out = J v_y + (∂f/∂p) v_p` with
+    /// the state seeds `seeds.0` and parameter seeds `seeds.1` (None: 0).
+    fn rhs_dir(
+        &self,
+        w: &mut Self::Work,
+        t: f64,
+        y: &[f64],
+        params: (&[Self::Param], &[f64]),
+        seeds: (Option<&[f64]>, Option<&[f64]>),
+        out: &mut [f64],
+    );
+    /// The event state at `y0` (every piece frozen where `y0` is); with
+    /// `enabled = false`, no root function is active.
+    fn events(&self, enabled: bool, y0: &[f64]) -> Self::Events;
+    /// Make the right-hand side use the pieces frozen in `ev`.
+    fn freeze(&self, ev: &Self::Events, w: &mut Self::Work);
+    /// Number of root functions (≥ 1: diffsol needs one; a constant
+    /// function where there are none).
+    fn nroots(&self, ev: &Self::Events) -> usize;
+    /// Root function values `g(y)` (sign change = a candidate crossing).
+    fn roots(&self, ev: &Self::Events, w: &mut Self::Work, y: &[f64], g: &mut [f64]);
+    /// `g_y v` of every root function.
+    fn roots_dir(&self, ev: &Self::Events, y: &[f64], v: &[f64], g: &mut [f64]);
+    /// Whether the sign change of root `idx` at `y` is a genuine crossing.
+    fn classify(&self, ev: &Self::Events, idx: usize, y: &[f64]) -> Option<Self::Crossing>;
+    /// Switch to the piece after crossing `c` at `y`.
+    fn switch(&self, ev: &mut Self::Events, c: Self::Crossing, y: &[f64]);
+    /// `g_y v` of the switching surface of crossing `c`.
+    fn crossing_dir(&self, ev: &Self::Events, c: Self::Crossing, y: &[f64], v: &[f64]) -> f64;
+    /// What switched, for messages (e.g. `actuator forces[3]`).
+    fn crossing_label(&self, ev: &Self::Events, c: Self::Crossing) -> String;
+}
