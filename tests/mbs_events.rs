@@ -1,7 +1,7 @@
 //! Segment changes of a piecewise actuator law (paper Eq. 32) as
 //! integration events: a 1-DOF rotor with a closed-form motion, and the
 //! sensitivity jump at the event against central finite differences.
-use plyscape::integrate::{integrate, integrate_sens, Method, Options, Stats};
+use plyscape::integrate::{integrate, integrate_sens, Method, Options, SensitivityForm, Stats};
 use plyscape::mbs::{Model, Param, System, Workspace};
 use plyscape::scene::SceneSpec;
 
@@ -72,6 +72,7 @@ fn options(method: Method, rtol: f64, events: bool, times: Vec<f64>) -> Options 
         t0: 0.0,
         times,
         events,
+        sensitivity: SensitivityForm::Staggered,
     }
 }
 

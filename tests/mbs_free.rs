@@ -1,7 +1,7 @@
 //! Free rigid body spinning about its intermediate axis (Dzhanibekov
 //! effect): energy and angular momentum are invariants of the exact flow
 //! (Euler's equations), so their drift measures the integrator error.
-use plyscape::integrate::{integrate, Method, Options};
+use plyscape::integrate::{integrate, Method, Options, SensitivityForm};
 use plyscape::mbs::{System, Workspace};
 use plyscape::scene::load_scene;
 use plyscape::study::Study;
@@ -30,6 +30,7 @@ fn run(method: Method, rtol: f64) -> (f64, f64, f64) {
         t0: 0.0,
         times: (1..=400).map(|k| k as f64 * 0.025).collect(),
         events: true,
+        sensitivity: SensitivityForm::Staggered,
     };
     integrate(&sys, &y0, &opts, |_t, y| {
         let mut ws = Workspace::empty();

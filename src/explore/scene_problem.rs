@@ -62,6 +62,7 @@
 //! the rounding of the rotation's sines and cosines.
 
 use crate::error::{Error, Result};
+use crate::integrate::SensitivityForm;
 use crate::laminate::Laminate;
 use crate::mbs::responses::ResponseValue;
 use crate::optimize::{Evaluation, Problem, Variable};
@@ -260,6 +261,11 @@ impl SceneProblem {
             self.objective.1 = v;
         }
         Ok(())
+    }
+
+    /// Integrate the gradients' sensitivities in `form` from now on.
+    pub fn set_sensitivity_form(&mut self, form: SensitivityForm) {
+        self.plan.set_sensitivity_form(form);
     }
 
     /// The start design \[deg\].

@@ -33,8 +33,12 @@ pub(super) struct Event<C> {
 /// The legs of one integration: output bookkeeping across restarts.
 pub(super) struct Legs<'c, M: OdeModel> {
     pub(super) opts: &'c Options,
-    /// Sensitivity lanes (0 without sensitivities).
+    /// Sensitivity lanes the solver integrates itself (diffsol's forward
+    /// sensitivities; 0 without, and 0 in the fused form).
     pub(super) nsens: usize,
+    /// Fused form: the solver's state is `[y; s_1; ..; s_np]` and `y` has
+    /// this length.
+    pub(super) fused: Option<usize>,
     /// Next output time to emit.
     pub(super) next: usize,
     pub(super) model: &'c M,
@@ -45,6 +49,18 @@ pub(super) struct Legs<'c, M: OdeModel> {
 }
 
 impl<M: OdeModel> Legs<'_, M> {
+    /// A solver state as `(y, lanes)`: in the fused form the lanes follow
+    /// `y` in the state; otherwise there are none here.
+    fn split(&self, mut z: Vec<f64>) -> (Vec<f64>, Vec<f64>) {
+        match self.fused {
+            Some(n) => {
+                let s = z.split_off(n);
+                (z, s)
+            }
+            None => (z, Vec::new()),
+        }
+    }
+
     /// Step a solver through the output times until the end or an
     /// accepted segment change; with `nsens > 0` the sensitivities
     /// (`nsens` lanes of the state length, lane-major) are interpolated
@@ -70,9 +86,11 @@ impl<M: OdeModel> Legs<'_, M> {
         // Output times at the start (first leg only: later legs start
         // after the outputs already served).
         while self.next < times.len() && times[self.next] <= opts.t0 {
-            let y = solver.state().y.clone_as_vec();
-            // Initial sensitivities are zero (the initial state is given).
-            let s0 = vec![0.0; y.len() * nsens];
+            let (y, mut s0) = self.split(solver.state().y.clone_as_vec());
+            if self.fused.is_none() {
+                // Initial sensitivities are zero (the initial state is given).
+                s0 = vec![0.0; y.len() * nsens];
+            }
             emit(times[self.next], &y, &s0, observe)?;
             self.next += 1;
         }
@@ -88,10 +106,14 @@ impl<M: OdeModel> Legs<'_, M> {
             })?;
             let mut t = solver.state().t;
             if let OdeSolverStopReason::RootFound(tr, idx) = reason {
-                let yr = solver
-                    .interpolate(tr)
-                    .map_err(|e| Error::numerical_at("integrate: event state", tr, e.to_string()))?
-                    .clone_as_vec();
+                let (yr, s_fused) = self.split(
+                    solver
+                        .interpolate(tr)
+                        .map_err(|e| {
+                            Error::numerical_at("integrate: event state", tr, e.to_string())
+                        })?
+                        .clone_as_vec(),
+                );
                 let crossing = self.model.classify(&self.events.borrow(), idx, &yr);
                 if let Some(crossing) = crossing {
                     let s = if nsens > 0 {
@@ -106,7 +128,7 @@ impl<M: OdeModel> Legs<'_, M> {
                             })?
                             .clone_as_vec()
                     } else {
-                        Vec::new()
+                        s_fused
                     };
                     t = tr;
                     event = Some(Event {
@@ -131,6 +153,7 @@ impl<M: OdeModel> Legs<'_, M> {
                         Error::numerical_at("integrate: dense output", tq, e.to_string())
                     })?
                 };
+                let (y, s_fused) = self.split(y.clone_as_vec());
                 let sens = if nsens > 0 {
                     solver
                         .interpolate_sens(tq)
@@ -139,9 +162,9 @@ impl<M: OdeModel> Legs<'_, M> {
                         })?
                         .clone_as_vec()
                 } else {
-                    Vec::new()
+                    s_fused
                 };
-                emit(tq, &y.clone_as_vec(), &sens, observe)?;
+                emit(tq, &y, &sens, observe)?;
                 self.next += 1;
             }
             if event.is_some()
@@ -192,7 +215,7 @@ impl<M: OdeModel> Legs<'_, M> {
     fn jump(&mut self, e: &mut Event<M::Crossing>) -> Result<()> {
         let (model, c) = (self.model, e.crossing);
         let mut ev = self.events.borrow_mut();
-        if self.nsens == 0 {
+        if e.s.is_empty() {
             model.switch(&mut ev, c, &e.y);
             return Ok(());
         }

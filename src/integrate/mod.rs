@@ -35,6 +35,7 @@
 //! The trait's switching surfaces do not depend on the parameters
 //! (`g_p = 0`), and `g_y v` is [`OdeModel::crossing_dir`].
 
+mod fused;
 mod legs;
 mod ode;
 mod options;
@@ -44,6 +45,6 @@ mod sens;
 mod tests;
 
 pub use ode::OdeModel;
-pub use options::{Method, Options, Stats};
+pub use options::{Method, Options, SensitivityForm, Stats};
 pub use plain::integrate;
 pub use sens::integrate_sens;

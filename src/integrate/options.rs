@@ -26,6 +26,29 @@ impl Method {
     }
 }
 
+/// How forward sensitivities are integrated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SensitivityForm {
+    /// diffsol's sensitivity equations: `J s_i` and `∂f/∂p_i` as two
+    /// directional derivatives per lane and stage; every method.
+    Staggered,
+    /// The lanes ride in the state and `J s_i + ∂f/∂p_i` is one
+    /// directional derivative per lane and stage; explicit methods
+    /// (tsit45) only.
+    Fused,
+}
+
+impl SensitivityForm {
+    /// Name as written in study files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            SensitivityForm::Staggered => "staggered",
+            SensitivityForm::Fused => "fused",
+        }
+    }
+}
+
 /// Integration settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Options {
@@ -56,6 +79,9 @@ pub struct Options {
     /// wall at rtol 1e-4, +10–25 % at 1e-6, −6 to +14 % at 1e-8). Scenes
     /// that cross no breakpoint (SAR 0–3 s) are bit-identical either way.
     pub events: bool,
+    /// The form of forward sensitivities ([`SensitivityForm`]); `Fused`
+    /// needs an explicit method.
+    pub sensitivity: SensitivityForm,
 }
 
 impl Options {
@@ -85,6 +111,16 @@ impl Options {
                 "integrator.t_end",
                 format!("t0 = {}, outputs {:?}..", self.t0, self.times.first()),
                 "an end time > start time with increasing output times",
+            ));
+        }
+        if self.sensitivity == SensitivityForm::Fused && self.method != Method::Tsit45 {
+            return Err(Error::input(
+                "integrator.sensitivity_form",
+                "fused",
+                format!(
+                    "\"staggered\" with method {} (the fused form is for explicit methods: tsit45)",
+                    self.method.name()
+                ),
             ));
         }
         Ok(())

@@ -71,6 +71,7 @@ pub fn integrate<M: OdeModel>(
     let mut legs = Legs {
         opts,
         nsens: 0,
+        fused: None,
         next: 0,
         model,
         events: &ev,

@@ -2,7 +2,7 @@
 
 use super::legs::{lift_failure_cap, Legs};
 use super::ode::OdeModel;
-use super::options::{Method, Options, Stats};
+use super::options::{Method, Options, SensitivityForm, Stats};
 use crate::error::{Error, Result};
 use diffsol::{FaerLU, FaerMat, OdeBuilder};
 use std::cell::RefCell;
@@ -13,9 +13,13 @@ use std::time::Instant;
 /// 12–16): `ṡ_i = J s_i + ∂f/∂p_i`, both products exact
 /// ([`OdeModel::rhs_dir`]). The initial state is taken as independent of
 /// the parameters (`s_i(t0) = 0`). `observe(t, y, s)` gets `s`
-/// lane-major: `s[i·n..(i+1)·n] = ∂y/∂p_i`. Sensitivities take part in
-/// the error control. With [`Options::events`], `s` jumps at each change
-/// of piece by `(f⁻ − f⁺) dt_e/dp` (module doc).
+/// lane-major: `s[i·n..(i+1)·n] = ∂y/∂p_i`. In the staggered form the
+/// sensitivities are not error-controlled (diffsol includes them only when
+/// sensitivity tolerances are set, which this integrator does not): the
+/// steps, and so the states, are those of [`super::integrate`]; the
+/// sensitivities inherit the accuracy of those steps. With [`Options::events`], `s` jumps at each change
+/// of piece by `(f⁻ − f⁺) dt_e/dp` (module doc). [`Options::sensitivity`]
+/// selects the staggered or the fused form (`super::fused`).
 pub fn integrate_sens<M: OdeModel>(
     model: &M,
     y0: &[f64],
@@ -36,6 +40,9 @@ pub fn integrate_sens<M: OdeModel>(
             )
         })?;
         p0.push(v);
+    }
+    if opts.sensitivity == SensitivityForm::Fused && np > 0 {
+        return super::fused::integrate_fused(model, y0, opts, (params, &p0), observe);
     }
     let ev = RefCell::new(model.events(opts.events, y0));
     let nroots = model.nroots(&ev.borrow());
@@ -111,6 +118,7 @@ pub fn integrate_sens<M: OdeModel>(
     let mut legs = Legs {
         opts,
         nsens: np,
+        fused: None,
         next: 0,
         model,
         events: &ev,

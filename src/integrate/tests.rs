@@ -71,7 +71,11 @@ fn piecewise_ramp_and_its_sensitivity_through_the_trait() {
     // and s = ∂y/∂p = 2t after the event, s(2) = 4 (the jump at t_e
     // takes s from t_e = 1 to 2 t_e = 2: Hiskens & Pai with
     // dt_e/dp = −s⁻/f⁻ = −1 and f⁻ − f⁺ = −1).
-    for method in [Method::Tsit45, Method::Bdf] {
+    for (method, form) in [
+        (Method::Tsit45, SensitivityForm::Staggered),
+        (Method::Tsit45, SensitivityForm::Fused),
+        (Method::Bdf, SensitivityForm::Staggered),
+    ] {
         let opts = Options {
             method,
             rtol: 1e-10,
@@ -79,6 +83,7 @@ fn piecewise_ramp_and_its_sensitivity_through_the_trait() {
             t0: 0.0,
             times: vec![0.5, 1.5, 2.0],
             events: true,
+            sensitivity: form,
         };
         let mut out = Vec::new();
         let stats = integrate_sens(&Ramp, &[0.0], &opts, &[()], |t, y, s| {
@@ -86,15 +91,15 @@ fn piecewise_ramp_and_its_sensitivity_through_the_trait() {
             Ok(())
         })
         .unwrap();
-        assert_eq!(stats.events, 1, "{method:?}");
+        assert_eq!(stats.events, 1, "{method:?} {form:?}");
         for (t, y, s) in out {
             let (ye, se) = if t < 1.0 {
                 (t, t)
             } else {
                 (2.0 * t - 1.0, 2.0 * t)
             };
-            assert!((y - ye).abs() < 1e-8, "{method:?} y({t}) = {y}");
-            assert!((s - se).abs() < 1e-7, "{method:?} s({t}) = {s}");
+            assert!((y - ye).abs() < 1e-8, "{method:?} {form:?} y({t}) = {y}");
+            assert!((s - se).abs() < 1e-7, "{method:?} {form:?} s({t}) = {s}");
         }
         let mut end = 0.0;
         integrate(&Ramp, &[0.0], &opts, |_, y| {

@@ -18,6 +18,7 @@ use super::build::Scene;
 use super::spec::{FlexKind, SceneSpec};
 use crate::error::{Error, Result};
 use crate::fe::Panel;
+use crate::integrate::SensitivityForm;
 use crate::laminate::Laminate;
 use crate::mbs::ModalBasis;
 use crate::modal::ModeUpdate;
@@ -85,6 +86,12 @@ impl ScenePlan {
     /// The `[scene]` section.
     pub fn spec(&self) -> &SceneSpec {
         &self.spec
+    }
+
+    /// Integrate forward sensitivities in `form` from now on (overrides
+    /// `[scene.integrator] sensitivity_form`).
+    pub fn set_sensitivity_form(&mut self, form: SensitivityForm) {
+        self.spec.integrator.sensitivity_form = Some(form);
     }
 
     /// The `[[panels]]` entries, in file order, with the study's lay-ups.

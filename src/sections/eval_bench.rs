@@ -3,7 +3,8 @@
 //!
 //! For every listed study with a scene problem (`[problem] name = "scene"`)
 //! and every design (default: the problem's start), the evaluation is run
-//! without gradients (`f`) and with them (`f+g`), `repeats` times each
+//! without gradients (`f`) and with them (`f+g`, once per sensitivity
+//! form listed in `forms`, e.g. `f+g fused`), `repeats` times each
 //! after one untimed warm-up of each kind (which makes the pooled panel
 //! analyses: pattern, symbolic factorization). Reported per case, medians
 //! over the repeats, one thread: the panel bases computed (and how many
@@ -20,6 +21,7 @@
 use super::stats::median;
 use crate::error::Result;
 use crate::explore::scene_problem::{EvalProfile, SceneProblem};
+use crate::integrate::SensitivityForm;
 use crate::optimize::Problem;
 use crate::report::csv::Table;
 use crate::study::Study;
@@ -39,6 +41,10 @@ pub struct EvalBenchSpec {
     pub designs: Vec<Vec<f64>>,
     /// Timed repetitions of each case (≥ 1); medians are reported.
     pub repeats: usize,
+    /// Forms of the sensitivities to time for `f+g` (default: the
+    /// problem's own).
+    #[serde(default)]
+    pub forms: Vec<SensitivityForm>,
 }
 
 /// Column headers of `eval_bench.csv`.
@@ -108,7 +114,7 @@ pub fn run_eval_bench(
         let at = format!("eval_bench.problems[{k}]");
         let inner = Study::load(base.join(file)).map_err(|e| e.in_file(&study.path, &at))?;
         let t = Instant::now();
-        let problem = SceneProblem::from_study(&inner)?;
+        let mut problem = SceneProblem::from_study(&inner)?;
         let setup = t.elapsed().as_secs_f64();
         let designs = if spec.designs.is_empty() {
             vec![problem.start().to_vec()]
@@ -123,12 +129,22 @@ pub fn run_eval_bench(
                     format!("{} angles [deg]", problem.variables().len()),
                 ));
             }
-            for (mode, gradients) in [("f", false), ("f+g", true)] {
+            let mut modes = vec![("f".to_string(), false, None)];
+            if spec.forms.is_empty() {
+                modes.push(("f+g".into(), true, None));
+            }
+            for form in &spec.forms {
+                modes.push((format!("f+g {}", form.name()), true, Some(*form)));
+            }
+            for (mode, gradients, form) in modes {
+                if let Some(form) = form {
+                    problem.set_sensitivity_form(form);
+                }
                 problem.evaluate_profiled(x, gradients)?;
                 let runs = (0..spec.repeats)
                     .map(|_| Ok(problem.evaluate_profiled(x, gradients)?.1))
                     .collect::<Result<Vec<_>>>()?;
-                let r = row(&inner.name(), x, mode, setup, &runs);
+                let r = row(&inner.name(), x, &mode, setup, &runs);
                 progress(&r);
                 rows.push(r);
             }

@@ -18,7 +18,7 @@
 //! [`headers`]); a failed case is a row with `status = failed: …`.
 
 use crate::error::{Error, Result};
-use crate::integrate::{integrate, integrate_sens, Method, Options, Stats};
+use crate::integrate::{integrate, integrate_sens, Method, Options, SensitivityForm, Stats};
 use crate::mbs::System;
 use crate::mbs::{Force, Param};
 use crate::report::csv::Table;
@@ -171,6 +171,7 @@ pub fn run_events_bench(study: &Study, out: &Path, quiet: bool) -> Result<PathBu
         t0: 0.0,
         times: vec![spec.t_end],
         events,
+        sensitivity: SensitivityForm::Staggered,
     };
     let r = spec.reference_rtol;
     let reference = run(&sys, &y0, &options(Method::Bdf, r, true), joint, &params)?;
