@@ -40,6 +40,15 @@ pub enum SensitivityForm {
 }
 
 impl SensitivityForm {
+    /// The default form for `method`: fused for the explicit method,
+    /// staggered for the implicit ones.
+    pub fn default_for(method: Method) -> SensitivityForm {
+        match method {
+            Method::Tsit45 => SensitivityForm::Fused,
+            Method::Bdf | Method::Esdirk34 => SensitivityForm::Staggered,
+        }
+    }
+
     /// Name as written in study files.
     pub fn name(&self) -> &'static str {
         match self {

@@ -10,7 +10,7 @@ use super::parts::{
 use super::quantity::{Quantity, Response};
 use super::spec::{Effect, ForceSpec, JointSpec, SceneSpec, SegmentSpec};
 use crate::error::{Error, Result};
-use crate::integrate::{Method, Options, SensitivityForm};
+use crate::integrate::{Options, SensitivityForm};
 use crate::mbs::model::{
     axis_angle, frame_from_axis, Body, Drive, Force, Integral, Joint, JointKind, Load, Model,
     Param, PiecewiseLaw, Segment,
@@ -432,10 +432,9 @@ impl SceneSpec {
             t0: 0.0,
             times,
             events: it.events,
-            sensitivity: it.sensitivity_form.unwrap_or(match it.method {
-                Method::Tsit45 => SensitivityForm::Fused,
-                _ => SensitivityForm::Staggered,
-            }),
+            sensitivity: it
+                .sensitivity_form
+                .unwrap_or(SensitivityForm::default_for(it.method)),
         };
         options.validate()?;
         Ok(options)

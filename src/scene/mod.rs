@@ -43,7 +43,8 @@
 //! segments = [{ lower, upper, value, slope, anchor }, ..]  # Eq. 32
 //! type = "spring"; marker_i, marker_j, stiffness, damping, length
 //! type = "load"; body, force, torque       # or table = [[t, fx, fy, fz, tx, ty, tz], ..]
-//! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out, events = true
+//! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out, events = true,
+//!                     sensitivity_form = "fused" | "staggered"   # default: fused with tsit45
 //! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation",
 //!                                "B3.strain_energy", "B3.modal", "<marker>.deflection"]
 //!                  plot = "R3.angle"; plot_file = "theta"   # theta.svg

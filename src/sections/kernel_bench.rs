@@ -4,7 +4,8 @@
 //! ## Method
 //! Every case is a full [`simulate`] of the scene with the method and
 //! relative tolerance replaced (the absolute tolerance is scaled with the
-//! relative one, keeping the scene's ratio `atol/rtol`), repeated
+//! relative one, keeping the scene's ratio `atol/rtol`; sensitivities in
+//! the default form of the method, fused for tsit45), repeated
 //! `repeats` times; the wall time reported is the median of the
 //! integrator's own clock ([`crate::integrate::Stats::wall`]: problem
 //! set-up and stepping, output evaluation excluded). Cases run one after
@@ -26,7 +27,7 @@
 //! case (columns in [`HEADERS`]).
 
 use crate::error::{Error, Result};
-use crate::integrate::Method;
+use crate::integrate::{Method, SensitivityForm};
 use crate::mbs::{System, Workspace};
 use crate::report::csv::Table;
 use crate::scene::{load_scene, Scene};
@@ -370,6 +371,7 @@ pub fn run_bench(
             for &rtol in &spec.rtols {
                 for set in &sens_sets {
                     scene.options.method = method;
+                    scene.options.sensitivity = SensitivityForm::default_for(method);
                     scene.options.rtol = rtol;
                     scene.options.atol = rtol * ratio;
                     scene.params = set.clone();
