@@ -319,7 +319,7 @@ impl Invariants {
     }
 
     /// The flat layout of every entry that can depend on the design, in
-    /// the order of [`Invariants::from_flat`] (for lifting into dual
+    /// the order of `Invariants::from_flat` (for lifting into dual
     /// numbers), without Λ.
     pub fn len_flat(n: usize) -> usize {
         1 + 3 + 9 + 3 * n + 3 * n + 9 * n + 9 * n * n + 3 * n * n + 9 + 3 * n + n * n

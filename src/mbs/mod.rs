@@ -28,9 +28,16 @@
 //! multistep histories. Initial conditions are projected onto the
 //! constraints ([`analysis`]). Forward sensitivities (stiffness, damping,
 //! mass, Eq. 32 breakpoints, ply angles of flexible bodies through
-//! `dΛ/dθ` and `dX/dθ`: [`Param`]) come from
-//! `crate::integrate::integrate_sens`, with exact products from
-//! dual-number evaluations of the same right-hand side.
+//! `dΛ/dθ` and `dX/dθ`, one angle shared by several bodies as a tied
+//! lane: [`Param`]) come from [`crate::integrate::integrate_sens`], with
+//! exact products from dual-number evaluations of the same right-hand
+//! side; the system is an [`crate::integrate::OdeModel`] ([`ode`]) and its
+//! Eq. 32 segment changes are the model's events ([`segments`]).
+//!
+//! Where things go: a new joint type is a [`JointKind`] variant with its
+//! equation count in [`model`] and its constraint rows in [`rows`]
+//! (assembled in [`dynamics`]); a new force element is a [`Force`] variant
+//! applied in [`dynamics`]; the scene names both ([`crate::scene`]).
 //!
 //! ## Limitations
 //! - Linear elasticity in a floating frame: no geometric stiffening, so a

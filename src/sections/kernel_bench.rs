@@ -304,7 +304,7 @@ pub const PIECES: [&str; 7] = [
     "solve: G M^-1 G^T, Cholesky, accelerations",
 ];
 
-/// Cost (µs, [`fastest_us`]) of the pieces of one right-hand side of
+/// Cost (µs, `fastest_us`) of the pieces of one right-hand side of
 /// `sys` at `(t, y)`, in the order of [`PIECES`], evaluated in the scalar
 /// type of `y` (`f64` for a plain call, `Dual64` for a Jacobian-vector
 /// product). Each piece runs on a workspace prepared by the pieces before
