@@ -137,6 +137,11 @@ pub struct RunConfig {
     pub quiet: bool,
 }
 
+/// The largest thread count accepted for a machine with `cores` cores.
+pub fn max_threads(cores: usize) -> usize {
+    (4 * cores).max(64)
+}
+
 impl RunConfig {
     /// Resolve a study path (or the built-in default) and common options.
     pub fn resolve(study: Option<&PathBuf>, common: &Common) -> Result<RunConfig> {
@@ -144,10 +149,22 @@ impl RunConfig {
             Some(p) => Study::load(p)?,
             None => Study::parse(DEFAULT_STUDY_NAME, DEFAULT_STUDY)?,
         };
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let limit = max_threads(cores);
         let threads = match common.threads.or(study.meta.threads) {
             Some(0) => return Err(Error::input("--threads", 0, "a thread count >= 1")),
+            Some(n) if n > limit => {
+                return Err(Error::input(
+                    "--threads",
+                    n,
+                    format!(
+                        "at most {limit} threads (4 per core on this machine's {cores} cores, \
+                         at least 64): evaluations are CPU-bound, more threads only share the cores"
+                    ),
+                ))
+            }
             Some(n) => n,
-            None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            None => cores,
         };
         Ok(RunConfig {
             study,

@@ -164,10 +164,11 @@ impl fmt::Display for Error {
                 value,
                 expected,
             } => {
-                if file.is_empty() {
-                    write!(f, "invalid input: `{key}` = {value}: expected {expected}")
-                } else {
-                    write!(f, "{file}: `{key}` = {value}: expected {expected}")
+                match (file.is_empty(), key.is_empty()) {
+                    (true, _) => write!(f, "invalid input: `{key}` = {value}: expected {expected}"),
+                    // A file-level error (TOML syntax): the place is the value.
+                    (false, true) => write!(f, "{file}: {value}: expected {expected}"),
+                    (false, false) => write!(f, "{file}: `{key}` = {value}: expected {expected}"),
                 }
             }
             Error::Numerical {

@@ -335,4 +335,29 @@ fn bad_study_input_gets_a_clear_error() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("--threads") && e.contains(">= 1"), "{e}");
+    // An absurd thread count is refused with the limit, not run (10000
+    // threads hung the machine).
+    let common = plyscape::cli::Common {
+        threads: Some(10_000),
+        ..common
+    };
+    let e = plyscape::cli::RunConfig::resolve(None, &common)
+        .unwrap_err()
+        .to_string();
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let limit = plyscape::cli::max_threads(cores);
+    assert!(
+        e.contains("--threads") && e.contains("10000") && e.contains(&format!("at most {limit}")),
+        "{e}"
+    );
+    let common = plyscape::cli::Common {
+        threads: Some(limit),
+        ..common
+    };
+    assert_eq!(
+        plyscape::cli::RunConfig::resolve(None, &common)
+            .unwrap()
+            .threads,
+        limit
+    );
 }

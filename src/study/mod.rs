@@ -58,7 +58,7 @@ impl Study {
         let table: toml::Table = toml::from_str(text).map_err(|e| Error::Input {
             file: path.display().to_string(),
             key: String::new(),
-            value: "(file)".into(),
+            value: syntax_place(text, e.span()),
             expected: format!("valid TOML: {}", e.message().trim()),
         })?;
         let mut study = Study {
@@ -160,6 +160,26 @@ fn summarize(v: &toml::Value) -> String {
     }
 }
 
+/// Where a TOML syntax error sits: `line L, column C: <the line>` (1-based,
+/// columns in characters), or `(file)` when the parser gives no place.
+fn syntax_place(text: &str, span: Option<std::ops::Range<usize>>) -> String {
+    let Some(at) = span.map(|s| s.start.min(text.len())) else {
+        return "(file)".into();
+    };
+    let at = (0..=at)
+        .rev()
+        .find(|&k| text.is_char_boundary(k))
+        .unwrap_or(0);
+    let start = text[..at].rfind('\n').map_or(0, |k| k + 1);
+    let end = text[at..].find('\n').map_or(text.len(), |k| at + k);
+    let line = text[..at].matches('\n').count() + 1;
+    let column = text[start..at].chars().count() + 1;
+    format!(
+        "line {line}, column {column}: `{}`",
+        text[start..end].trim_end()
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -200,5 +220,16 @@ mod tests {
     fn bad_toml_names_file() {
         let e = Study::parse("b.toml", "[study\n").unwrap_err().to_string();
         assert!(e.starts_with("b.toml"), "{e}");
+    }
+
+    #[test]
+    fn toml_syntax_errors_give_line_column_and_the_line() {
+        let text = "[study]\nname = \"x\"\n\n[scene]\ngravity = [0.0, 0.0 -9.81]\n";
+        let e = Study::parse("s.toml", text).unwrap_err().to_string();
+        println!("{e}");
+        assert!(
+            e.contains("line 5, column") && e.contains("gravity = [0.0, 0.0 -9.81]"),
+            "{e}"
+        );
     }
 }
