@@ -472,3 +472,19 @@ fn flexible_input_errors_name_the_key() {
         assert!(err.contains("flex.toml"), "file not named: {err}");
     }
 }
+
+#[test]
+fn too_many_panel_modes_name_the_body_key_and_the_largest_allowed() {
+    // The mode count is the body's key (not the panel's), with the value
+    // as written and the largest count the mesh gives: 6 divisions of a
+    // 1 × 0.6 plate clamped at the centre.
+    let text = panel_scene(30.0).replace("modes = 4", "modes = 100000");
+    let err = load_scene(&study(&text)).unwrap_err().to_string();
+    println!("{err}");
+    assert!(
+        err.contains("`scene.bodies[1].flexible.modes` = 100000")
+            && err.contains("expected between 1 and")
+            && err.contains("free DOFs"),
+        "{err}"
+    );
+}

@@ -309,6 +309,10 @@ fn bad_modes_input_names_file_and_key() {
         assert!(e.starts_with("bad.toml") && e.contains(key), "{e}");
     };
     check(
+        &STUDY.replace("n_modes = 6", "n_modes = 100000"),
+        "`modes.n_modes` = 100000: expected between 1 and",
+    );
+    check(
         &STUDY.replace(
             "derivatives = true",
             "derivatives = true\nupdate = \"sometimes\"",

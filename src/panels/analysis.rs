@@ -71,6 +71,17 @@ pub struct PanelAnalysis {
 }
 
 impl PanelAnalysis {
+    /// The largest number of modes this mesh and support give: its free
+    /// DOFs (less the 6 rigid-body modes of a free–free panel).
+    pub fn max_modes(&self) -> usize {
+        let dofs = self.sys.m_diag.len();
+        if self.panel.support == crate::fe::Support::FreeFree {
+            dofs.saturating_sub(6)
+        } else {
+            dofs
+        }
+    }
+
     /// Build everything that does not depend on the ply angles. `want`:
     /// which derivatives later runs compute (none, fixed-mode λ', or
     /// updated-mode λ' and X'); only those matrices are ever assembled.
@@ -100,12 +111,27 @@ impl PanelAnalysis {
     }
 
     /// Modes (and derivatives) for `laminate` (same ply count as the
-    /// panel's; ply angles may differ).
+    /// panel's; ply angles may differ). `n_modes` outside 1..=[`Self::max_modes`]
+    /// is an input error on `n_modes` that names the largest allowed.
     pub fn run(
         &mut self,
         laminate: &crate::laminate::Laminate,
         n_modes: usize,
     ) -> Result<PanelModes> {
+        let max = self.max_modes();
+        if n_modes == 0 || n_modes > max {
+            let dofs = self.sys.m_diag.len();
+            let why = if self.panel.support == crate::fe::Support::FreeFree {
+                format!("{dofs} free DOFs less the 6 rigid-body modes of a free-free panel")
+            } else {
+                format!("{dofs} free DOFs")
+            };
+            return Err(Error::input(
+                "n_modes",
+                n_modes,
+                format!("between 1 and {max} for this mesh ({why})"),
+            ));
+        }
         let t0 = Instant::now();
         self.model
             .assemble_into(laminate, &self.panel.design, &mut self.sys)?;

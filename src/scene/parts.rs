@@ -259,7 +259,13 @@ pub(super) fn flexible_body(
                     "the name of a [[panels]] entry",
                 )
             })?;
-            panels(panel, f.modes, f.derivatives(&fk)?)?
+            panels(panel, f.modes, f.derivatives(&fk)?).map_err(|e| match e {
+                // The mode count is this body's key, not the panel's.
+                Error::Input { key, expected, .. } if key.ends_with("n_modes") => {
+                    Error::input(format!("{fk}.modes"), f.modes, expected)
+                }
+                e => e,
+            })?
         }
     };
     basis.validate(&fk)?;

@@ -142,8 +142,15 @@ pub fn analyse_study(study: &Study, spec: &ModesSpec) -> Result<Vec<PanelModes>>
                 r.seconds = [0.0; 3];
                 r
             }
-            None => analyse_panel(p, spec.n_modes, want)
-                .map_err(|e| in_panel(e, &p.name).in_file(&study.path, &format!("panels[{i}]")))?,
+            None => analyse_panel(p, spec.n_modes, want).map_err(|e| match e {
+                // The mode count is the [modes] section's key, not the panel's.
+                Error::Input { key, expected, .. } if key == "n_modes" => study.error(
+                    "modes.n_modes",
+                    spec.n_modes,
+                    format!("{expected} (panel {})", p.name),
+                ),
+                e => in_panel(e, &p.name).in_file(&study.path, &format!("panels[{i}]")),
+            })?,
         };
         out.push(r);
     }
