@@ -149,6 +149,7 @@ impl RunConfig {
             Some(p) => Study::load(p)?,
             None => Study::parse(DEFAULT_STUDY_NAME, DEFAULT_STUDY)?,
         };
+        check_sections(&study)?;
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         let limit = max_threads(cores);
         let threads = match common.threads.or(study.meta.threads) {
@@ -327,21 +328,53 @@ pub fn run_scene(cfg: &RunConfig) -> Result<()> {
 }
 
 /// `plyscape run`: do every kind of work the study has a section for.
-/// Unknown sections are an error (a typo must not silently do nothing).
-pub fn run_study(cfg: &RunConfig) -> Result<()> {
-    let handlers = handlers();
+/// Refuse a study with a top-level section no part of the tool reads (a
+/// typo must not silently do nothing), naming the known sections and the
+/// closest one. Every subcommand checks this before any work starts.
+pub fn check_sections(study: &Study) -> Result<()> {
     let mut known: Vec<&str> = vec!["study"];
-    known.extend(handlers.iter().map(|(k, _)| *k));
+    known.extend(handlers().iter().map(|(k, _)| *k));
     known.extend(DATA_SECTIONS);
-    for key in cfg.study.table.keys() {
+    for key in study.table.keys() {
         if !known.contains(&key.as_str()) {
-            return Err(cfg.study.error(
+            let closest = known
+                .iter()
+                .min_by_key(|k| edit_distance(k, key))
+                .copied()
+                .unwrap_or("study");
+            return Err(study.error(
                 key.as_str(),
                 "(table)",
-                format!("one of the known sections: {}", known.join(", ")),
+                format!(
+                    "a known section (did you mean [{closest}]?): {}",
+                    known.join(", ")
+                ),
             ));
         }
     }
+    Ok(())
+}
+
+/// Levenshtein distance of two names (insertions, deletions, substitutions).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// Run every section the study asks for, in the order of [`handlers`]
+/// (unknown sections were refused by [`RunConfig::resolve`]).
+pub fn run_study(cfg: &RunConfig) -> Result<()> {
+    let handlers = handlers();
     let mut ran = 0;
     for (key, handler) in &handlers {
         if cfg.study.has(key) {

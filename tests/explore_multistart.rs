@@ -335,6 +335,26 @@ fn bad_study_input_gets_a_clear_error() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("--threads") && e.contains(">= 1"), "{e}");
+    // An unknown section is refused by every subcommand, before any work,
+    // with the closest known section.
+    let typo = plyscape::study::Study::parse(
+        "typo.toml",
+        "[problem]\nname = \"himmelblau\"\n[multistrat]\nstarts = 4\n",
+    )
+    .unwrap();
+    let e = plyscape::cli::check_sections(&typo)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("typo.toml")
+            && e.contains("`multistrat`")
+            && e.contains("did you mean [multistart]?"),
+        "{e}"
+    );
+    let fine =
+        plyscape::study::Study::parse("ok.toml", "[problem]\nname = \"himmelblau\"\n[map]\n")
+            .unwrap();
+    assert!(plyscape::cli::check_sections(&fine).is_ok());
     // An absurd thread count is refused with the limit, not run (10000
     // threads hung the machine).
     let common = plyscape::cli::Common {
