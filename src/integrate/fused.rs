@@ -109,9 +109,5 @@ pub(super) fn integrate_fused<M: OdeModel>(
         problem.t0 = e.t;
         *start_z.borrow_mut() = [e.y, e.s].concat();
     }
-    stats.wall = start.elapsed().as_secs_f64() - observer_time.get();
-    stats.observer_wall = observer_time.get();
-    stats.rhs_calls = rhs_calls.get();
-    stats.jvp_calls = jvps.get();
-    Ok(stats)
+    Ok(stats.finish(start, observer_time.get(), (rhs_calls.get(), jvps.get())))
 }

@@ -163,6 +163,21 @@ pub struct Stats {
 
 impl Stats {
     /// Add the counters of one integration leg.
+    /// Close the counts of a whole integration started at `start`: wall
+    /// time without the observer's `observer` seconds, and the calls.
+    pub(super) fn finish(
+        mut self,
+        start: std::time::Instant,
+        observer: f64,
+        (rhs_calls, jvp_calls): (u64, u64),
+    ) -> Stats {
+        self.wall = start.elapsed().as_secs_f64() - observer;
+        self.observer_wall = observer;
+        self.rhs_calls = rhs_calls;
+        self.jvp_calls = jvp_calls;
+        self
+    }
+
     pub(super) fn absorb(&mut self, leg: &Stats) {
         self.steps += leg.steps;
         self.jacobians += leg.jacobians;

@@ -96,9 +96,5 @@ pub fn integrate<M: OdeModel>(
         problem.t0 = e.t;
         *start_y.borrow_mut() = e.y;
     }
-    stats.wall = start.elapsed().as_secs_f64() - observer_time.get();
-    stats.observer_wall = observer_time.get();
-    stats.rhs_calls = rhs_calls.get();
-    stats.jvp_calls = jvps.get();
-    Ok(stats)
+    Ok(stats.finish(start, observer_time.get(), (rhs_calls.get(), jvps.get())))
 }

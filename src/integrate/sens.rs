@@ -145,9 +145,5 @@ pub fn integrate_sens<M: OdeModel>(
         *start_y.borrow_mut() = e.y;
         *start_s.borrow_mut() = e.s;
     }
-    stats.wall = start.elapsed().as_secs_f64() - observer_time.get();
-    stats.observer_wall = observer_time.get();
-    stats.rhs_calls = rhs_calls.get();
-    stats.jvp_calls = jvps.get();
-    Ok(stats)
+    Ok(stats.finish(start, observer_time.get(), (rhs_calls.get(), jvps.get())))
 }
