@@ -94,11 +94,17 @@ fn crank_rocker_passes_dead_points_conserving_energy() {
     // rank 17, 3 redundant (closed form).
     assert_eq!(sim.equations, 20);
     assert_eq!(sim.redundant, 3);
-    // Full crank turns: count wraps of the crank angle.
+    // The crank's relative angle is written continuous (no jump of 2π
+    // between rows). The crank swings back and forth through more than
+    // half a turn: count its passes through the position opposite its
+    // start (θ = π mod 2π), where the angle used to wrap.
+    let pi = std::f64::consts::PI;
+    assert!(sim.rows.windows(2).all(|w| (w[1][1] - w[0][1]).abs() < pi));
+    let sheet = |th: f64| ((th + pi) / (2.0 * pi)).floor();
     let turns = sim
         .rows
         .windows(2)
-        .filter(|w| (w[1][1] - w[0][1]).abs() > std::f64::consts::PI)
+        .filter(|w| sheet(w[0][1]) != sheet(w[1][1]))
         .count();
     // Rocker dead points: its rate changes sign twice per crank turn.
     let reversals = sim

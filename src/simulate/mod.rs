@@ -52,7 +52,7 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
     let mut ws = Workspace::<f64>::empty();
     let e0 = sys.energy(&y0, &mut ws);
     let conservative = sys.conservative();
-    let mut rows = Vec::new();
+    let mut rows: Vec<Vec<f64>> = Vec::new();
     let mut max_violation = 0.0f64;
     let mut energy_error = 0.0f64;
     let mut y_end = y0.clone();
@@ -60,6 +60,7 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         .outputs
         .iter()
         .any(|(_, q)| matches!(q, Quantity::Reaction(_)));
+    let angle_columns = angle_columns(scene);
     let sens_quantities = sens_quantities(scene);
     let sens_headers = sens_headers(scene, &sens_quantities);
     let mut sens_rows = Vec::new();
@@ -109,7 +110,10 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
             let e = sys.energy(y, &mut ws);
             energy_error = energy_error.max((e - e0).abs() / e0.abs().max(1e-300));
         }
-        let row = output_row(&sys, scene, (t, y), &mut ws, reactions.as_deref(), viol);
+        let mut row = output_row(&sys, scene, (t, y), &mut ws, reactions.as_deref(), viol);
+        if let Some(prev) = rows.last() {
+            unwrap_angles(&mut row, prev, &angle_columns);
+        }
         if let Some(k) = row.iter().position(|v| !v.is_finite()) {
             return Err(Error::numerical_at(
                 "simulate: outputs",
@@ -143,6 +147,31 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         responses,
     };
     Ok((sys, sim))
+}
+
+/// Columns of `history.csv` that hold joint angles (column 0 is time).
+fn angle_columns(scene: &Scene) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut col = 1;
+    for (label, q) in &scene.outputs {
+        if matches!(q, Quantity::Angle(_)) {
+            out.push(col);
+        }
+        col += q.headers(label).len();
+    }
+    out
+}
+
+/// Make the joint angles of `row` continuous with the previous row: a
+/// relative angle is measured in (−π, π] (module doc of `crate::mbs`), so
+/// a joint turning past ±π would jump by 2π between rows; the multiple of
+/// 2π nearest to the previous value is added instead. Outputs are sampled
+/// finely enough that a joint turns less than π between two rows.
+fn unwrap_angles(row: &mut [f64], prev: &[f64], columns: &[usize]) {
+    let turn = 2.0 * std::f64::consts::PI;
+    for &c in columns {
+        row[c] += turn * ((prev[c] - row[c]) / turn).round();
+    }
 }
 
 /// The output columns that have sensitivities (angles, rates, positions,
