@@ -145,7 +145,15 @@ impl PanelAnalysis {
         let mut modes = self.solver.solve(&opts)?;
         let t2 = Instant::now();
         let sys = &self.sys;
-        let mut derivatives = match self.want {
+        if free {
+            // The rigid-body modes go before the derivatives: they do not
+            // depend on the ply angles, and their 6-fold cluster at λ = 0
+            // would cost six factorizations and the adjacent-eigenvector
+            // method for nothing. Each elastic mode's derivative is its own
+            // solve, so the elastic derivatives are the same.
+            remove_rigid_modes(&mut modes, &mut [], sys)?;
+        }
+        let derivatives = match self.want {
             None => Vec::new(),
             Some(update) => {
                 let vars: Vec<DesignDerivative<'_>> = (0..sys.dk.len())
@@ -161,9 +169,6 @@ impl PanelAnalysis {
                 self.solver.derivatives(&modes, &vars, &opts)?
             }
         };
-        if free {
-            remove_rigid_modes(&mut modes, &mut derivatives, sys)?;
-        }
         let t3 = Instant::now();
         let labels = (0..modes.lambda.len())
             .map(|j| label_mode(sys, &self.mirrors, &modes, j))
