@@ -113,12 +113,17 @@ pub struct DriveArgs {
     /// Run only every n-th start, beginning at i (0-based): `--shard i/n`.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<String>,
+    /// Without --resume: discard an earlier runs.csv instead of keeping it
+    /// as runs-<UTC time>.csv.
+    #[arg(long, conflicts_with = "resume")]
+    pub force: bool,
 }
 
 impl DriveArgs {
     fn resolve(&self) -> Result<crate::explore::DriveFlags> {
         let mut f = crate::explore::DriveFlags {
             resume: self.resume,
+            force: self.force,
             ..Default::default()
         };
         if let Some(s) = &self.shard {
@@ -176,19 +181,24 @@ impl RunConfig {
     }
 }
 
-/// Execute a parsed command line.
+/// Execute a parsed command line. Every command that writes into a
+/// results directory holds that directory's lock while it works
+/// ([`crate::report::lock::DirLock`]).
 pub fn execute(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Run { study, common } => {
             let cfg = RunConfig::resolve(study.as_ref(), &common)?;
+            let _lock = lock(&cfg, "run", None)?;
             run_study(&cfg)
         }
         Command::Modes { study, common } => {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
+            let _lock = lock(&cfg, "modes", None)?;
             run_modes_handler(&cfg)
         }
         Command::Simulate { study, common } => {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
+            let _lock = lock(&cfg, "simulate", None)?;
             run_scene(&cfg)
         }
         Command::Multistart {
@@ -197,10 +207,13 @@ pub fn execute(cli: Cli) -> Result<()> {
             drive,
         } => {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
-            crate::explore::run_multistart(&explore_context(&cfg, drive.resolve()?)).map(|_| ())
+            let ctx = explore_context(&cfg, drive.resolve()?);
+            let _lock = lock(&cfg, "multistart", Some(&ctx))?;
+            crate::explore::run_multistart(&ctx).map(|_| ())
         }
         Command::Evolve { study, common } => {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
+            let _lock = lock(&cfg, "evolve", None)?;
             crate::explore::run_evolve(&explore_context(&cfg, Default::default()), None).map(|_| ())
         }
         Command::Compare {
@@ -209,16 +222,34 @@ pub fn execute(cli: Cli) -> Result<()> {
             drive,
         } => {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
-            crate::explore::run_compare(&explore_context(&cfg, drive.resolve()?)).map(|_| ())
+            let ctx = explore_context(&cfg, drive.resolve()?);
+            let _lock = lock(&cfg, "compare", Some(&ctx))?;
+            crate::explore::run_compare(&ctx).map(|_| ())
         }
         Command::Map { study, common } => {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
+            let _lock = lock(&cfg, "map", None)?;
             crate::explore::run_map(&explore_context(&cfg, Default::default())).map(|_| ())
         }
         Command::Merge { dirs, out, quiet } => {
             crate::explore::merge(&dirs, &out, quiet).map(|_| ())
         }
     }
+}
+
+/// The lock of the directory `command` writes into: the study's results
+/// directory, or the shard's own directory for a sharded driver (shards of
+/// one study run side by side).
+fn lock(
+    cfg: &RunConfig,
+    command: &str,
+    ctx: Option<&crate::explore::Context>,
+) -> Result<crate::report::lock::DirLock> {
+    let dir = match ctx {
+        Some(c) => c.dir()?,
+        None => cfg.study.output_dir(&cfg.out)?,
+    };
+    crate::report::lock::DirLock::acquire(&dir, command)
 }
 
 /// The exploration drivers' view of a resolved run.

@@ -88,3 +88,88 @@ fn killed_multistart_resumes_to_the_same_tables() {
     assert_eq!(m["study_text"], STUDY);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A second command on a results directory that a running one holds is
+/// refused with who holds it (exit code 4), and nothing of the holder's is
+/// touched; another results root is free.
+#[test]
+fn a_held_results_directory_is_refused_with_its_holder() {
+    let dir = temp_dir("lock");
+    let study = dir.join("k.toml");
+    std::fs::write(&study, STUDY).unwrap();
+    let out = dir.join("out");
+    let held = plyscape::report::lock::DirLock::acquire(&out.join("k"), "compare").unwrap();
+    let r = plyscape(&[
+        "multistart",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "-q",
+    ])
+    .output()
+    .unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(4), "{err}");
+    assert!(err.contains("in use by plyscape compare"), "{err}");
+    assert!(
+        err.contains(&format!("process {}", std::process::id())),
+        "{err}"
+    );
+    assert!(!out.join("k/runs.csv").exists());
+    drop(held);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The Slurm scripts in `scripts/` (shown verbatim in the README) run as a
+/// job array would: one shard per task id, then the merge script; the
+/// merged tables equal an unsharded run's.
+#[test]
+fn the_documented_slurm_array_runs_and_merges() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let dir = temp_dir("slurm");
+    let study = dir.join("k.toml");
+    std::fs::write(&study, STUDY).unwrap();
+    let bin = env!("CARGO_BIN_EXE_plyscape");
+    let script = |name: &str| {
+        let path = root.join("scripts").join(name);
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            readme.contains(&text),
+            "README does not show {name} verbatim"
+        );
+        let mut c = Command::new("bash");
+        c.arg(path)
+            .current_dir(&dir)
+            .env("STUDY", &study)
+            .env("NAME", "k")
+            .env("SHARDS", "3")
+            .env("PLYSCAPE", bin);
+        c
+    };
+    for task in 0..3 {
+        let r = script("slurm_multistart.sh")
+            .env("SLURM_ARRAY_TASK_ID", task.to_string())
+            .env("SLURM_CPUS_PER_TASK", "1")
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    }
+    let r = script("slurm_merge.sh").output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let st = plyscape(&["multistart", study.to_str().unwrap(), "--out"])
+        .arg(dir.join("full"))
+        .arg("-q")
+        .status()
+        .unwrap();
+    assert!(st.success());
+    for f in ["runs.csv", "optima.csv"] {
+        assert_eq!(
+            table_without(&dir.join("full/k").join(f), &["wall_seconds"]),
+            table_without(&dir.join("results/k").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    assert!(dir.join("results/k/comparison.csv").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -198,6 +198,7 @@ fn merged_shards_equal_the_unsharded_run() {
         let flags = DriveFlags {
             resume: false,
             shard: Shard { index: i, count: 3 },
+            force: false,
         };
         let r = explore::run_multistart(&ctx(&s, &sharded, 1, flags)).unwrap();
         assert_eq!(r.runs.len(), [6, 6, 5][i]);
@@ -211,6 +212,7 @@ fn merged_shards_equal_the_unsharded_run() {
     let shard = DriveFlags {
         resume: false,
         shard: Shard { index: 0, count: 3 },
+        force: false,
     };
     let e = explore::run_compare(&ctx(&s, &sharded, 1, shard)).unwrap_err();
     assert!(e.to_string().contains("--shard"), "{e}");
@@ -380,4 +382,87 @@ fn bad_study_input_gets_a_clear_error() {
             .threads,
         limit
     );
+}
+
+/// Forgetting `--resume` keeps the earlier table under a timestamped name;
+/// `--force` discards it.
+#[test]
+fn rerun_without_resume_keeps_the_earlier_table_unless_forced() {
+    let dir = temp_dir("ms-keep");
+    let s = study("h", &himmelblau(5, ""));
+    explore::run_multistart(&ctx(&s, &dir, 1, DriveFlags::default())).unwrap();
+    let first = std::fs::read_to_string(dir.join("h/runs.csv")).unwrap();
+    explore::run_multistart(&ctx(&s, &dir, 1, DriveFlags::default())).unwrap();
+    let kept: Vec<_> = std::fs::read_dir(dir.join("h"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.starts_with("runs-") && n.ends_with("Z.csv"))
+        .collect();
+    assert_eq!(kept.len(), 1, "{kept:?}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("h").join(&kept[0])).unwrap(),
+        first
+    );
+    let force = DriveFlags {
+        force: true,
+        ..Default::default()
+    };
+    explore::run_multistart(&ctx(&s, &dir, 1, force)).unwrap();
+    let runs = std::fs::read_dir(dir.join("h"))
+        .unwrap()
+        .filter(|e| {
+            let n = e.as_ref().unwrap().file_name().into_string().unwrap();
+            n.starts_with("runs")
+        })
+        .count();
+    assert_eq!(runs, 2, "--force kept nothing more");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `merge` never modifies a shard, refuses a shard that lacks rows (naming
+/// the starts) and refuses a directory that is not a shard.
+#[test]
+fn merge_is_strict_and_read_only() {
+    let dir = temp_dir("ms-merge-strict");
+    let s = study("h", &himmelblau(7, ""));
+    let mut dirs = Vec::new();
+    for i in 0..2 {
+        let flags = DriveFlags {
+            shard: Shard { index: i, count: 2 },
+            ..Default::default()
+        };
+        explore::run_multistart(&ctx(&s, &dir, 1, flags)).unwrap();
+        dirs.push(dir.join(format!("h/shard-{i}-of-2")));
+    }
+    let runs = dirs[1].join("runs.csv");
+    let intact = std::fs::read(&runs).unwrap();
+    // A torn last line: refused, the file left byte for byte.
+    let mut torn = intact.clone();
+    torn.extend_from_slice(b"5,0.1");
+    std::fs::write(&runs, &torn).unwrap();
+    let e = explore::merge(&dirs, &dir, true).unwrap_err().to_string();
+    assert!(e.contains("torn last line"), "{e}");
+    assert_eq!(std::fs::read(&runs).unwrap(), torn);
+    // A missing row: refused, naming the start (shard 1 owns 1, 3, 5).
+    let text = String::from_utf8(intact.clone()).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let without_3: String = lines
+        .iter()
+        .filter(|l| !l.starts_with("3,"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_eq!(without_3.lines().count(), lines.len() - 1);
+    std::fs::write(&runs, &without_3).unwrap();
+    let e = explore::merge(&dirs, &dir, true).unwrap_err().to_string();
+    assert!(e.contains("lacks the rows of starts [3]"), "{e}");
+    std::fs::write(&runs, &intact).unwrap();
+    // An unsharded run's directory is not a shard.
+    let whole = dir.join("whole");
+    explore::run_multistart(&ctx(&s, &whole, 1, DriveFlags::default())).unwrap();
+    let e = explore::merge(&[whole.join("h")], &dir, true)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unsharded"), "{e}");
+    explore::merge(&dirs, &dir, true).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -158,6 +158,9 @@ pub struct DriveFlags {
     pub resume: bool,
     /// Which starts to run.
     pub shard: Shard,
+    /// Without `resume`: discard an earlier `runs.csv` instead of keeping
+    /// it under a timestamped name.
+    pub force: bool,
 }
 
 impl Default for DriveFlags {
@@ -165,6 +168,7 @@ impl Default for DriveFlags {
         DriveFlags {
             resume: false,
             shard: Shard { index: 0, count: 1 },
+            force: false,
         }
     }
 }
@@ -329,6 +333,9 @@ fn multistart_with(
     plan: &MultistartPlan,
 ) -> Result<multistart::Report> {
     let dir = ctx.dir()?;
+    if !ctx.flags.resume {
+        keep_earlier_runs(&dir, ctx.flags.force, ctx.quiet)?;
+    }
     ctx.manifest(&dir, "multistart", json!({"complete": false}))?;
     let solver = solvers::local(&plan.section.method, &plan.section.mmfd)?;
     let settings = multistart::Settings {
@@ -366,6 +373,45 @@ fn multistart_with(
         print_optima(problem, &report);
     }
     Ok(report)
+}
+
+/// A run without `--resume` starts a new `runs.csv`. An earlier one with
+/// rows is kept as `runs-<UTC time>.csv` (and said so on stderr) unless
+/// `force` is given, so that forgetting `--resume` never loses finished
+/// runs. Returns the kept file, if any.
+pub fn keep_earlier_runs(dir: &Path, force: bool, quiet: bool) -> Result<Option<PathBuf>> {
+    let path = dir.join("runs.csv");
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(Error::io(&path, e)),
+    };
+    let rows = text.lines().count().saturating_sub(1);
+    if rows == 0 || force {
+        std::fs::remove_file(&path).map_err(|e| Error::io(&path, e))?;
+        if rows > 0 && !quiet {
+            eprintln!(
+                "note: --force: discarded {rows} earlier row(s) of {}",
+                path.display()
+            );
+        }
+        return Ok(None);
+    }
+    let stamp = crate::report::clock::compact_utc(std::time::SystemTime::now());
+    let mut kept = dir.join(format!("runs-{stamp}.csv"));
+    let mut k = 1;
+    while kept.exists() {
+        kept = dir.join(format!("runs-{stamp}-{k}.csv"));
+        k += 1;
+    }
+    std::fs::rename(&path, &kept).map_err(|e| Error::io(&path, e))?;
+    eprintln!(
+        "note: {} held {rows} earlier run(s); kept as {} (use --resume to continue \
+         them, --force to discard them)",
+        path.display(),
+        kept.display()
+    );
+    Ok(Some(kept))
 }
 
 fn print_optima(problem: &dyn Problem, r: &multistart::Report) {
@@ -708,6 +754,12 @@ fn read_points(
 
 /// `plyscape merge`: combine the shard directories of one multistart into
 /// the tables an unsharded run gives, in `out/<study>/`.
+///
+/// Strict by design: shards are only read, never modified (a torn last
+/// line is refused, not repaired: finish that shard with `--resume`); a
+/// directory of an unsharded run is not a shard; every start a shard owns
+/// must have its row unless the study's `max_evaluations` budget stopped
+/// the shard early (the missing starts are named).
 pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<multistart::Report> {
     if dirs.is_empty() {
         return Err(Error::input(
@@ -716,85 +768,19 @@ pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<multistart::Re
             "at least one shard directory",
         ));
     }
-    let mut text = None;
-    let mut seen = Vec::new();
-    for d in dirs {
-        let m = crate::report::read_manifest(d)?;
-        let t = m["study_text"].as_str().unwrap_or_default().to_string();
-        let shard = (m["shard"]["index"].as_u64(), m["shard"]["count"].as_u64());
-        let (Some(i), Some(n)) = shard else {
-            return Err(Error::input(
-                d.display().to_string(),
-                "manifest.json",
-                "a shard manifest",
-            ));
-        };
-        if m["commands"]["multistart"]["complete"].as_bool() != Some(true) {
-            return Err(Error::input(
-                d.display().to_string(),
-                format!("shard {i}/{n} (incomplete)"),
-                "a finished shard (finish it with --resume first)",
-            ));
-        }
-        match &text {
-            None => {
-                text = Some((
-                    t,
-                    m["study_file"].as_str().unwrap_or("study").to_string(),
-                    n,
-                ))
-            }
-            Some((t0, _, n0)) if *t0 == t && *n0 == n => {}
-            Some(_) => {
-                return Err(Error::input(
-                    d.display().to_string(),
-                    format!("shard {i}/{n}"),
-                    "shards of the same study text and shard count",
-                ))
-            }
-        }
-        seen.push(i);
-    }
-    let (text, file, n) = text.expect("dirs is not empty");
-    let mut sorted = seen.clone();
-    sorted.sort_unstable();
-    if sorted != (0..n).collect::<Vec<_>>() {
-        return Err(Error::input(
-            "dirs",
-            format!("shards {seen:?}"),
-            format!("each of the shards 0..{n} exactly once"),
-        ));
-    }
+    let (text, file, n, indices) = shard_manifests(dirs)?;
     let study = Study::parse(&file, &text)?;
     let problem = problem(&study)?;
     let plan = multistart_plan(&study, problem.as_ref())?;
     let vars = problem.variables();
     let m = problem.n_constraints();
     let mut rows = Vec::new();
-    for d in dirs {
-        let r = tables::read_runs(&d.join("runs.csv"), vars, m)?;
-        if r.repaired_bytes > 0 {
-            return Err(Error::csv(
-                d.join("runs.csv"),
-                "torn last line in a finished shard",
-            ));
-        }
-        for row in &r.rows {
-            let ok = plan.starts.points.get(row.start).is_some_and(|x0| {
-                x0.iter()
-                    .zip(&row.x0)
-                    .all(|(a, b)| a.to_bits() == b.to_bits())
-            });
-            if !ok {
-                return Err(Error::csv(
-                    d.join("runs.csv"),
-                    format!("row for start {} does not match the study", row.start),
-                ));
-            }
-        }
-        rows.extend(r.rows);
+    for (d, &index) in dirs.iter().zip(&indices) {
+        let shard = Shard { index, count: n };
+        rows.extend(shard_rows(d, shard, &plan, vars, m)?);
     }
     let dir = study.output_dir(out)?;
+    let _lock = crate::report::lock::DirLock::acquire(&dir, "merge")?;
     let wall = dirs
         .iter()
         .filter_map(|d| {
@@ -828,4 +814,121 @@ pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<multistart::Re
         print_optima(problem.as_ref(), &report);
     }
     Ok(report)
+}
+
+/// The study text, study file name and shard count shared by the shard
+/// directories `dirs`, and their shard indices; refuses a directory that
+/// is not a finished shard, shards of different studies, and a set that
+/// does not hold each shard exactly once.
+fn shard_manifests(dirs: &[PathBuf]) -> Result<(String, String, usize, Vec<usize>)> {
+    let mut first: Option<(String, String, usize)> = None;
+    let mut seen = Vec::new();
+    for d in dirs {
+        let m = crate::report::read_manifest(d)?;
+        let t = m["study_text"].as_str().unwrap_or_default().to_string();
+        let shard = (m["shard"]["index"].as_u64(), m["shard"]["count"].as_u64());
+        let (Some(i), Some(n)) = shard else {
+            return Err(Error::input(
+                d.display().to_string(),
+                "manifest.json",
+                "a shard manifest",
+            ));
+        };
+        if n < 2 {
+            return Err(Error::input(
+                d.display().to_string(),
+                "an unsharded run (shard 0/1)",
+                "a shard directory written by `plyscape multistart --shard I/N` with N >= 2",
+            ));
+        }
+        if m["commands"]["multistart"]["complete"].as_bool() != Some(true) {
+            return Err(Error::input(
+                d.display().to_string(),
+                format!("shard {i}/{n} (incomplete)"),
+                "a finished shard (finish it with --resume first)",
+            ));
+        }
+        match &first {
+            None => {
+                let file = m["study_file"].as_str().unwrap_or("study").to_string();
+                first = Some((t, file, n as usize));
+            }
+            Some((t0, _, n0)) if *t0 == t && *n0 == n as usize => {}
+            Some(_) => {
+                return Err(Error::input(
+                    d.display().to_string(),
+                    format!("shard {i}/{n}"),
+                    "shards of the same study text and shard count",
+                ))
+            }
+        }
+        seen.push(i as usize);
+    }
+    let (text, file, n) = first.expect("dirs is not empty");
+    let mut sorted = seen.clone();
+    sorted.sort_unstable();
+    if sorted != (0..n).collect::<Vec<_>>() {
+        return Err(Error::input(
+            "dirs",
+            format!("shards {seen:?}"),
+            format!("each of the shards 0..{n} exactly once"),
+        ));
+    }
+    Ok((text, file, n, seen))
+}
+
+/// The rows of one shard's `runs.csv`, read without modifying it: each row
+/// must be a start of the study that this shard owns, and every start it
+/// owns must be there unless the study's function-call budget stopped it.
+fn shard_rows(
+    d: &Path,
+    shard: Shard,
+    plan: &MultistartPlan,
+    vars: &[crate::optimize::Variable],
+    m: usize,
+) -> Result<Vec<tables::RunRecord>> {
+    let path = d.join("runs.csv");
+    let (read, _) = tables::scan_runs(&path, vars, m)?;
+    if read.repaired_bytes > 0 {
+        return Err(Error::csv(
+            &path,
+            format!(
+                "torn last line ({} bytes) in a finished shard; the shard is left as it is: \
+                 run it again with --resume to finish it, then merge",
+                read.repaired_bytes
+            ),
+        ));
+    }
+    let starts = &plan.starts.points;
+    for row in &read.rows {
+        let ok = shard.owns(row.start)
+            && starts.get(row.start).is_some_and(|x0| {
+                x0.iter()
+                    .zip(&row.x0)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            });
+        if !ok {
+            return Err(Error::csv(
+                &path,
+                format!(
+                    "row for start {} does not match the study or is not shard {}/{}'s",
+                    row.start, shard.index, shard.count
+                ),
+            ));
+        }
+    }
+    let have: std::collections::BTreeSet<usize> = read.rows.iter().map(|r| r.start).collect();
+    let missing: Vec<usize> = (0..starts.len())
+        .filter(|&k| shard.owns(k) && !have.contains(&k))
+        .collect();
+    if !missing.is_empty() && plan.section.max_evaluations.is_none() {
+        return Err(Error::csv(
+            &path,
+            format!(
+                "shard {}/{} lacks the rows of starts {missing:?}; run it again with --resume",
+                shard.index, shard.count
+            ),
+        ));
+    }
+    Ok(read.rows)
 }

@@ -172,13 +172,37 @@ pub struct ReadRuns {
 /// Read `runs.csv`, repairing a torn last line in place. A missing file is
 /// an empty table; a wrong header or a bad row before the last is an error.
 pub fn read_runs(path: &Path, vars: &[Variable], m: usize) -> Result<ReadRuns> {
+    let (read, keep) = scan_runs(path, vars, m)?;
+    if read.repaired_bytes > 0 {
+        let f = std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .map_err(|e| Error::io(path, e))?;
+        f.set_len(keep as u64).map_err(|e| Error::io(path, e))?;
+        f.sync_all().map_err(|e| Error::io(path, e))?;
+        eprintln!(
+            "warning: {}: removed a torn last line ({} bytes) left by an interrupted run; that start will run again",
+            path.display(),
+            read.repaired_bytes
+        );
+    }
+    Ok(read)
+}
+
+/// Read `runs.csv` without touching it: the rows, the size of a torn last
+/// line (`repaired_bytes`, what [`read_runs`] would cut) and the length of
+/// the intact part.
+pub fn scan_runs(path: &Path, vars: &[Variable], m: usize) -> Result<(ReadRuns, usize)> {
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Ok(ReadRuns {
-                rows: vec![],
-                repaired_bytes: 0,
-            })
+            return Ok((
+                ReadRuns {
+                    rows: vec![],
+                    repaired_bytes: 0,
+                },
+                0,
+            ))
         }
         Err(e) => return Err(Error::io(path, e)),
     };
@@ -225,23 +249,13 @@ pub fn read_runs(path: &Path, vars: &[Variable], m: usize) -> Result<ReadRuns> {
             }
         }
     }
-    let repaired = bytes.len() - keep;
-    if repaired > 0 {
-        let f = std::fs::OpenOptions::new()
-            .write(true)
-            .open(path)
-            .map_err(|e| Error::io(path, e))?;
-        f.set_len(keep as u64).map_err(|e| Error::io(path, e))?;
-        f.sync_all().map_err(|e| Error::io(path, e))?;
-        eprintln!(
-            "warning: {}: removed a torn last line ({repaired} bytes) left by an interrupted run; that start will run again",
-            path.display()
-        );
-    }
-    Ok(ReadRuns {
-        rows,
-        repaired_bytes: repaired,
-    })
+    Ok((
+        ReadRuns {
+            rows,
+            repaired_bytes: bytes.len() - keep,
+        },
+        keep,
+    ))
 }
 
 /// Appends complete lines to `runs.csv`, flushing after each.

@@ -5,7 +5,9 @@
 //! and `--quiet` was not given. SVG plots use plotters' SVG backend (text is
 //! laid out by the browser, so no font files are needed).
 
+pub mod clock;
 pub mod csv;
+pub mod lock;
 
 use crate::error::{Error, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
