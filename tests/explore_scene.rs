@@ -181,7 +181,7 @@ fn design_as_numbers_matches_the_text_road() {
 
 #[test]
 fn ply_angles_repeat_every_180_degrees() {
-    // A ply at θ and θ ± 180° is the same laminate (NUMERICS.md): the
+    // A ply at θ and θ ± 180° is the same laminate (docs/numerics.md): the
     // whole evaluation repeats to rounding.
     let p = build(&coarse()).unwrap();
     let a = p.evaluate(&[37.3, -61.7], false).unwrap();

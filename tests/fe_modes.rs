@@ -72,7 +72,7 @@ fn simply_supported_plate_frequencies_match_closed_form() {
 }
 
 fn sar_laminate(angles_deg: [f64; 4]) -> Laminate {
-    // IM6/SC1081, 4 plies of 0.5 mm (paper §6, SAR_MODEL.md).
+    // IM6/SC1081, 4 plies of 0.5 mm (paper §6.2, docs/sar_reconstruction.md §6).
     let m = Orthotropic::im6_sc1081();
     Laminate::new(
         angles_deg

@@ -5,8 +5,9 @@ use plyscape::fe::{Derivatives, PanelSpec, Support};
 use plyscape::study::Study;
 use plyscape::Error;
 
-/// Panel 2 of the SAR antenna (SAR_MODEL.md): 1.994 m × 1.3 m, support
-/// points S1/S2 (0.153, ∓0.55), S3 (0.853, 0), S4–S6 (−0.697, −0.55/0/0.55);
+/// Panel 2 of the SAR antenna (docs/sar_reconstruction.md §4; the support
+/// positions are reconstructed): 1.994 m × 1.3 m, support points S1/S2
+/// (0.153, ∓0.55), S3 (0.853, 0), S4–S6 (−0.697, −0.55/0/0.55);
 /// IM6/SC1081, [0/90/90/0] of 0.5 mm plies, design [θ1/θ2/θ2/θ1].
 const PANEL2: &str = r#"
 [[panels]]

@@ -1,5 +1,5 @@
-//! Rigid SAR antenna, phase 1 (studies/sar_phase1_rigid.toml, geometry
-//! from /work/shared/design/sar_geometry.json, a reconstruction).
+//! Rigid SAR antenna, phase 1 (studies/sar_phase1_rigid.toml; the geometry
+//! is a reconstruction, see docs/sar_reconstruction.md).
 use plyscape::integrate::Method;
 use plyscape::mbs::Workspace;
 use plyscape::scene::load_scene;
@@ -19,7 +19,8 @@ fn sar() -> plyscape::scene::Scene {
 fn sar_phase1_rank_deployment_and_reaction() {
     let scene = sar();
     let (sys, sim) = simulate(&scene).unwrap();
-    // SAR_MODEL.md: 65 equations, rank 59 (6 redundant) when folded.
+    // docs/sar_reconstruction.md §4: 65 equations, rank 59 (6 redundant)
+    // when folded; mobility 7 (θ_R3 and the spins of six bars).
     assert_eq!(sim.equations, 65);
     assert_eq!(sim.redundant, 6);
     let h = &sim.headers;

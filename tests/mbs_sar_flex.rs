@@ -1,6 +1,6 @@
 //! Flexible SAR antenna, phase 1 (studies/sar_phase1_flexible.toml: panels
-//! 2 and 3 as floating-frame composite bodies, geometry from
-//! /work/shared/design/sar_geometry.json, a reconstruction), on a coarse
+//! 2 and 3 as floating-frame composite bodies; geometry reconstructed, see
+//! docs/sar_reconstruction.md), on a coarse
 //! version of the study made by text replacement (8 mesh divisions, 6
 //! modes, 0–0.5 s, tight tolerances) so that each simulation takes well
 //! under a second: it runs, the constraints hold, the work–energy balance
@@ -102,8 +102,9 @@ fn flexible_sar_runs_balances_energy_and_stays_near_rigid() {
         "flexible: {} equations, {} redundant, max violation {:e}, {:?}",
         flex.equations, flex.redundant, flex.max_violation, flex.stats
     );
-    // 65 equations as in the rigid scene (SAR_MODEL.md); the rigid scene
-    // has 6 redundant ones, the elastic mounts remove some of them.
+    // 65 equations as in the rigid scene (docs/sar_reconstruction.md §4:
+    // 2 locks × 6 + R3 × 5 + 16 spherical × 3); the rigid scene has 6
+    // redundant ones, the elastic mounts remove some of them.
     assert_eq!(flex.equations, 65);
     assert_eq!(rigid.redundant, 6);
     assert!(flex.redundant < 6, "redundant {}", flex.redundant);
@@ -115,7 +116,7 @@ fn flexible_sar_runs_balances_energy_and_stays_near_rigid() {
 
     // Work–energy balance. No gravity and no modal damping (ζ = 0), so
     // the only non-conservative force is the R3 actuator, torque
-    // τ = −M(θ, θ̇) = −m(θ) − c θ̇ (SAR_MODEL.md), and
+    // τ = −M(θ, θ̇) = −m(θ) − c θ̇ (docs/sar_reconstruction.md §5), and
     //   E(t) − E(0) = −∫_{θ0}^{θ(t)} m dθ − c ∫ θ̇² dt,
     // E = kinetic + strain energy (the `energy` output). The first term is
     // exact (law_integral); the second is composite Simpson on the 5 ms

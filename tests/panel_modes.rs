@@ -125,8 +125,8 @@ fn cross_ply_plate_matches_fsdt_navier_at_a_over_h_10_and_1000() {
 }
 
 fn sar_panel3(divisions: usize) -> Panel {
-    // SAR panel 3 with its four support points (SAR_MODEL.md), lay-up 2 of
-    // Table 1, the paper's centre clamp.
+    // SAR panel 3 with its four support points (docs/sar_reconstruction.md
+    // §4), lay-up 2 of Table 1, the paper's centre clamp.
     let toml = format!(
         r#"
 name = "panel3"
@@ -144,7 +144,7 @@ plies = [{{ angle = 0.0, thickness = 0.5e-3 }}, {{ angle = 90.0, thickness = 0.5
     spec.resolve().unwrap()
 }
 
-/// Mesh convergence (NUMERICS.md: the symmetric and twisting modes of the
+/// Mesh convergence (docs/numerics.md: the symmetric and twisting modes of the
 /// point-clamped panel converge): the first SS and AA flexural modes at
 /// 16, 32 and 64 divisions converge monotonically at about second order
 /// (error ratio 5 expected for e(h) ∝ h² measured against the 64 mesh;

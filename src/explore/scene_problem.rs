@@ -57,7 +57,7 @@
 //! columns of `[scene.outputs]` are dropped (responses need none). The
 //! plan's builders are pooled, so drivers may evaluate in parallel.
 //!
-//! Ply angles repeat every 180° (NUMERICS.md): a periodic variable is
+//! Ply angles repeat every 180° (docs/numerics.md): a periodic variable is
 //! written as given, and `x` and `x + 180°` give the same laminate up to
 //! the rounding of the rotation's sines and cosines.
 

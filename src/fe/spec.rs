@@ -31,7 +31,7 @@ use serde::Deserialize;
 /// at 64 divisions (≈16 000 DOF) the 14 lowest flexural modes are within
 /// about 0.5 % of the 160-division values (≈1 % at 40, ≈0.2 % at 80;
 /// second-order convergence). The two near-rigid rocking modes and the
-/// drilling mode of the point clamp do not converge (NUMERICS.md).
+/// drilling mode of the point clamp do not converge (docs/numerics.md).
 pub const DEFAULT_DIVISIONS: usize = 64;
 
 fn default_divisions() -> usize {

@@ -19,7 +19,7 @@ use nalgebra::{Matrix3, RealField, Vector3};
 /// constraint-space matrix and the dense mass of a flexible body) go
 /// through this trait so that a dual-number evaluation differentiates them
 /// analytically, reusing one real factorization, instead of running the
-/// factorization in dual arithmetic (NUMERICS.md): for `A x = b`,
+/// factorization in dual arithmetic (docs/numerics.md): for `A x = b`,
 /// `x' = A⁻¹(b' − A' x)` with the factor of the real part of `A`.
 pub trait Scalar: RealField + Copy {
     fn is_exact_zero(&self) -> bool;

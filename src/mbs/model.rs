@@ -472,7 +472,8 @@ pub struct Model {
     /// scene's `quadratic_velocity` effect.
     pub quadratic_velocity: bool,
     /// Time integrals carried as extra states (after the velocities), so
-    /// that their sensitivities come with the integration (NUMERICS.md).
+    /// that their sensitivities come with the integration
+    /// (docs/numerics.md, "Responses and optimization").
     pub integrals: Vec<Integral>,
     /// Groups of `(body, design variable)` that [`Param::Tied`] lanes move
     /// together.

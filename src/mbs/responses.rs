@@ -5,7 +5,7 @@
 //!
 //! - **Integrals** are extra states of the integration
 //!   ([`crate::mbs::model::Integral`]): value and sensitivities come with
-//!   the motion under the same error control (NUMERICS.md).
+//!   the motion under the same error control (docs/numerics.md).
 //! - **Peaks** use the critical time point: a raw maximum over time is not
 //!   differentiable where the time of the peak jumps, but at an interior
 //!   maximum `t*` (where `U̇ = 0`) the envelope theorem gives

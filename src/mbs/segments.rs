@@ -346,8 +346,9 @@ mod tests {
 
     #[test]
     fn breakpoints_of_eq32_layout() {
-        // The interval layout of Eq. 32 (SAR_MODEL.md): the outer bound
-        // 3.12 of the top segment is not a breakpoint (the line extends).
+        // The interval layout of Eq. 32 (docs/sar_reconstruction.md §5):
+        // the outer bound 3.12 of the top segment is not a breakpoint (the
+        // line extends).
         let law = PiecewiseLaw::new(
             "law",
             vec![

@@ -1,6 +1,6 @@
 //! CMA-ES (covariance matrix adaptation evolution strategy) with IPOP
 //! restarts, as an argmin [`Solver`]: the global comparison method of the
-//! exploration (NUMERICS.md, "Responses and optimization").
+//! exploration (docs/numerics.md, "Responses and optimization").
 //!
 //! Method: N. Hansen, *The CMA Evolution Strategy: A Tutorial*
 //! (arXiv:1604.00772, 2016), with the default parameters of its Table 1
