@@ -185,6 +185,7 @@ impl RunConfig {
 /// results directory holds that directory's lock while it works
 /// ([`crate::report::lock::DirLock`]).
 pub fn execute(cli: Cli) -> Result<()> {
+    crate::report::mark_start();
     match cli.command {
         Command::Run { study, common } => {
             let cfg = RunConfig::resolve(study.as_ref(), &common)?;
@@ -336,19 +337,36 @@ fn run_kernel_bench_handler(cfg: &RunConfig) -> Result<()> {
     crate::sections::kernel_bench::run_kernel_bench(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
 }
 
-/// The `[modes]` section: panel modal analysis.
+/// The `[modes]` section: panel modal analysis (and its manifest entry).
 fn run_modes_handler(cfg: &RunConfig) -> Result<()> {
-    crate::sections::modes::run_modes(&cfg.study, &cfg.out, cfg.quiet)
+    let t0 = std::time::Instant::now();
+    crate::sections::modes::run_modes(&cfg.study, &cfg.out, cfg.quiet)?;
+    let dir = cfg.study.output_dir(&cfg.out)?;
+    let mut entry = serde_json::Map::new();
+    entry.insert("wall_seconds".into(), t0.elapsed().as_secs_f64().into());
+    crate::report::record_command(&dir, &cfg.study, 1, "modes", entry, Default::default())
 }
 
 /// The `[scene]` handler: simulate the multibody scene and write
 /// `history.csv`, `stats.csv` (and an SVG) into the study's output folder.
 pub fn run_scene(cfg: &RunConfig) -> Result<()> {
     use crate::simulate;
+    let t0 = std::time::Instant::now();
     let scene = crate::scene::load_scene(&cfg.study)?;
     let (_, sim) = simulate::simulate(&scene).map_err(cfg.study.locate("scene"))?;
     let dir = cfg.study.output_dir(&cfg.out)?;
     let files = simulate::write_results(&scene, &sim, &dir)?;
+    let mut entry = serde_json::Map::new();
+    entry.insert("wall_seconds".into(), t0.elapsed().as_secs_f64().into());
+    entry.insert(
+        "files".into(),
+        files
+            .iter()
+            .filter_map(|f| f.file_name()?.to_str().map(String::from))
+            .collect::<Vec<_>>()
+            .into(),
+    );
+    crate::report::record_command(&dir, &cfg.study, 1, "simulate", entry, Default::default())?;
     if !cfg.quiet {
         println!("{}", simulate::summary(&sim));
         for f in files {

@@ -86,6 +86,13 @@ fn killed_multistart_resumes_to_the_same_tables() {
     assert_eq!(ms["complete"], true);
     assert!(ms["runs_this_invocation"].as_u64().unwrap() <= 24 - 3);
     assert_eq!(m["study_text"], STUDY);
+    // Built from a git checkout: a 40-hex commit (maybe `-dirty`).
+    let commit = m["git_commit"].as_str().unwrap();
+    assert!(
+        commit == "unknown" || commit[..40].chars().all(|c| c.is_ascii_hexdigit()),
+        "{commit}"
+    );
+    assert!(ms["started"].as_str().unwrap() <= ms["ended"].as_str().unwrap());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

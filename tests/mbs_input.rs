@@ -191,6 +191,21 @@ fn simulate_command_writes_history_stats_and_svg() {
     let stats = std::fs::read_to_string(res.join("stats.csv")).unwrap();
     assert!(stats.contains("redundant_equations,0"), "{stats}");
     assert!(res.join("pin.angle.svg").exists());
+    // The manifest: the build's commit, the study text, start and end (UTC).
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(res.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(m["last_command"], "simulate");
+    assert_eq!(m["git_commit"], plyscape::report::GIT_COMMIT);
+    let sim = &m["commands"]["simulate"];
+    for key in ["started", "ended"] {
+        let t = sim[key].as_str().unwrap();
+        assert!(
+            t.len() == 20 && t.ends_with('Z') && t.as_bytes()[10] == b'T',
+            "{t}"
+        );
+    }
+    assert!(sim["started"].as_str() <= sim["ended"].as_str());
+    assert!(sim["files"].to_string().contains("history.csv"));
     // A bad file gives exit code 2 (input error) and names the key.
     std::fs::write(&study, BASE.replace("mass = 1.0", "mass = 0.0")).unwrap();
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_plyscape"))

@@ -201,30 +201,21 @@ impl Context<'_> {
         Ok(dir)
     }
 
-    /// Update `manifest.json`: common fields at the top, one entry per
-    /// command under `commands` (entries of earlier commands on the same
-    /// study text are kept, so `plyscape run` records every step).
+    /// Update `manifest.json` ([`crate::report::record_command`]) with the
+    /// shard, the threads, the resume flag and `extra`.
     fn manifest(&self, dir: &Path, command: &str, extra: serde_json::Value) -> Result<()> {
-        let mut commands = crate::report::read_manifest(dir)
-            .ok()
-            .filter(|m| m["study_text"].as_str() == Some(self.study.text.as_str()))
-            .and_then(|m| m["commands"].as_object().cloned())
-            .unwrap_or_default();
         let mut entry = serde_json::Map::new();
         entry.insert("threads".into(), json!(self.threads));
         entry.insert("resume".into(), json!(self.flags.resume));
         if let serde_json::Value::Object(e) = extra {
             entry.extend(e);
         }
-        commands.insert(command.into(), serde_json::Value::Object(entry));
-        let mut m = serde_json::Map::new();
-        m.insert(
+        let mut top = serde_json::Map::new();
+        top.insert(
             "shard".into(),
             json!({"index": self.flags.shard.index, "count": self.flags.shard.count}),
         );
-        m.insert("last_command".into(), json!(command));
-        m.insert("commands".into(), serde_json::Value::Object(commands));
-        crate::report::write_manifest(dir, self.study, self.threads, m)
+        crate::report::record_command(dir, self.study, self.threads, command, entry, top)
     }
 }
 

@@ -101,27 +101,64 @@ pub fn crate_versions() -> Vec<(String, String)> {
     out
 }
 
-/// Write `manifest.json` into `dir`: everything needed to reproduce the
-/// tables next to it. `extra` adds command-specific fields.
-pub fn write_manifest(
+/// The git commit this binary was built from (`-dirty` when tracked files
+/// differed from it; `unknown` without git), recorded by `build.rs`.
+pub const GIT_COMMIT: &str = env!("PLYSCAPE_GIT_COMMIT");
+
+/// When this process started its work (set by [`mark_start`], else at the
+/// first manifest written).
+static STARTED: std::sync::OnceLock<std::time::SystemTime> = std::sync::OnceLock::new();
+
+/// Record now as the start of this process's work (the command line calls
+/// it first thing; later calls keep the first time).
+pub fn mark_start() {
+    STARTED.get_or_init(std::time::SystemTime::now);
+}
+
+/// Update `manifest.json` in `dir`: everything needed to reproduce the
+/// tables next to it. Common fields at the top (version, git commit, study,
+/// seed, threads, crate versions, the study text, `top`), and one entry per
+/// command under `commands`: the entries of earlier commands on the same
+/// study text are kept, so `plyscape run` records every step. Each entry
+/// gets `started` (when this process began) and `ended` (now) as UTC
+/// timestamps.
+pub fn record_command(
     dir: &Path,
     study: &crate::study::Study,
     threads: usize,
-    extra: serde_json::Map<String, serde_json::Value>,
+    command: &str,
+    mut entry: serde_json::Map<String, serde_json::Value>,
+    top: serde_json::Map<String, serde_json::Value>,
 ) -> Result<()> {
     use serde_json::json;
+    mark_start();
+    let started = *STARTED.get().expect("set just above");
+    entry.insert("started".into(), json!(clock::iso_utc(started)));
+    entry.insert(
+        "ended".into(),
+        json!(clock::iso_utc(std::time::SystemTime::now())),
+    );
+    let mut commands = read_manifest(dir)
+        .ok()
+        .filter(|m| m["study_text"].as_str() == Some(study.text.as_str()))
+        .and_then(|m| m["commands"].as_object().cloned())
+        .unwrap_or_default();
+    commands.insert(command.into(), serde_json::Value::Object(entry));
     let crates: serde_json::Map<String, serde_json::Value> = crate_versions()
         .into_iter()
         .map(|(n, v)| (n, json!(v)))
         .collect();
     let mut m = serde_json::Map::new();
     m.insert("plyscape_version".into(), json!(env!("CARGO_PKG_VERSION")));
+    m.insert("git_commit".into(), json!(GIT_COMMIT));
     m.insert("study_file".into(), json!(study.path.display().to_string()));
     m.insert("study_name".into(), json!(study.name()));
     m.insert("seed".into(), json!(study.meta.seed));
     m.insert("threads".into(), json!(threads));
     m.insert("crates".into(), serde_json::Value::Object(crates));
-    m.extend(extra);
+    m.extend(top);
+    m.insert("last_command".into(), json!(command));
+    m.insert("commands".into(), serde_json::Value::Object(commands));
     m.insert("study_text".into(), json!(study.text));
     let text = serde_json::to_string_pretty(&serde_json::Value::Object(m))
         .map_err(|e| Error::csv(dir.join("manifest.json"), e))?;
