@@ -162,3 +162,72 @@ fn more_than_two_variables_get_slices_through_the_base_design() {
     assert!(e.to_string().contains("map.pairs[0]"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn bipop_is_chosen_in_the_study_and_reported() {
+    let dir = temp_dir("cmp-bipop");
+    // `[evolve] restarts = "bipop"`: the comparison names the method, the
+    // manifest records the schedule and every run's regime, λ, σ0 and
+    // evaluations, which add up to the evolution's function calls. (A
+    // budget of its own, so that there are restarts.)
+    let s = study(
+        "b",
+        &text(
+            "b",
+            "himmelblau",
+            "[evolve]\nrestarts = \"bipop\"\nmax_evaluations = 3000\n",
+        ),
+    );
+    let rows = explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    assert_eq!(rows[1].method, "cmaes-bipop");
+    assert!(rows[1].best_f.abs() < 1e-6, "{:?}", rows[1]);
+    let t = table_without(&dir.join("b/comparison.csv"), &[]);
+    assert_eq!(column(&t, "method"), ["multistart-mmfd", "cmaes-bipop"]);
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("b/manifest.json")).unwrap())
+            .unwrap();
+    let ev = &m["commands"]["evolve"];
+    assert_eq!(ev["restarts"], "bipop");
+    assert_eq!(ev["solver"], "BIPOP-CMA-ES");
+    let runs = ev["runs"].as_array().unwrap();
+    let small = runs.iter().filter(|r| r["regime"] == "small").count();
+    assert_eq!(ev["small_runs"].as_u64(), Some(small as u64));
+    assert_eq!(ev["large_runs"].as_u64(), Some((runs.len() - small) as u64));
+    assert!(small >= 1, "{runs:?}");
+    let spent: u64 = runs
+        .iter()
+        .map(|r| r["evaluations"].as_u64().unwrap())
+        .sum();
+    assert_eq!(spent as usize, rows[1].function_calls);
+    let svg = std::fs::read_to_string(dir.join("b/convergence.svg")).unwrap();
+    assert!(svg.contains("BIPOP-CMA-ES (best so far)"));
+    // The default stays IPOP, under the method name it always had.
+    let s = study(
+        "i",
+        &text("i", "himmelblau", "[evolve]\nrestarts = \"ipop\"\n"),
+    );
+    let rows = explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    assert_eq!(rows[1].method, "cmaes");
+    // A bad value names the file, the key, the value and the choices, and
+    // is refused before the multistart runs.
+    let bad = study(
+        "x",
+        &text("x", "himmelblau", "[evolve]\nrestarts = \"lpop\"\n"),
+    );
+    let e = explore::run_compare(&ctx(&bad, &dir, 1, DriveFlags::default()))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("x.toml")
+            && e.contains("evolve.restarts")
+            && e.contains("\"lpop\"")
+            && e.contains("one of ipop, bipop"),
+        "{e}"
+    );
+    assert!(!dir.join("x/runs.csv").exists());
+    let e = explore::run_evolve(&ctx(&bad, &dir, 1, DriveFlags::default()), None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("evolve.restarts"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -14,6 +14,7 @@
 
 use super::tables::{num, write_atomic};
 use crate::error::{Error, Result};
+use crate::optimize::cmaes::Restarts;
 use crate::optimize::{
     Counted, Evaluation, GlobalOutcome, IterRecord, Observer, Problem, Variable,
 };
@@ -29,6 +30,8 @@ pub struct Request {
     pub seed: u64,
     /// Function-evaluation budget.
     pub max_evaluations: usize,
+    /// CMA-ES restart schedule (IPOP or BIPOP).
+    pub restarts: Restarts,
 }
 
 /// An evolutionary solver: CMA-ES in the binary, anything in tests.
@@ -67,6 +70,8 @@ pub struct Report {
     pub gradient_calls: usize,
     /// Wall time \[s\].
     pub wall_seconds: f64,
+    /// The restart schedule the solver was asked for.
+    pub restarts: Restarts,
 }
 
 /// Records every objective value requested, in request order.
@@ -173,6 +178,7 @@ pub fn run(
         generations: std::mem::take(&mut obs.rows),
         outcome,
         wall_seconds: t0.elapsed().as_secs_f64(),
+        restarts: request.restarts,
     };
     write_atomic(
         &dir.join("evolution.csv"),

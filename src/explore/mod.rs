@@ -54,6 +54,7 @@ pub mod solvers;
 pub mod tables;
 
 use crate::error::{Error, Result};
+use crate::optimize::cmaes::{Regime, Restarts};
 use crate::optimize::Problem;
 use crate::study::Study;
 use cluster::Tolerances;
@@ -128,6 +129,23 @@ pub struct EvolveSection {
     /// Evaluation budget. Default: under `compare`, the function calls the
     /// multistart used; alone, 100 per start of `[multistart]`, else 10 000.
     pub max_evaluations: Option<usize>,
+    /// CMA-ES restart schedule: `ipop` (default) or `bipop`
+    /// ([`crate::optimize::cmaes::Restarts`]).
+    pub restarts: Option<String>,
+}
+
+/// Read and check `[evolve]` (absent: defaults): the section and its
+/// restart schedule. Errors name the file and `evolve.<key>`.
+pub fn evolve_plan(study: &Study) -> Result<(EvolveSection, Restarts)> {
+    let sec: EvolveSection = study.section("evolve")?.unwrap_or_default();
+    if sec.max_evaluations == Some(0) {
+        return Err(study.error("evolve.max_evaluations", 0, "a budget >= 1"));
+    }
+    let restarts = match &sec.restarts {
+        Some(name) => Restarts::parse(name).map_err(study.locate("evolve"))?,
+        None => Restarts::default(),
+    };
+    Ok((sec, restarts))
 }
 
 /// The `[compare]` section (no keys).
@@ -427,12 +445,7 @@ fn print_optima(problem: &dyn Problem, r: &multistart::Report) {
 /// the study's.
 pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<evolve::Report> {
     let problem = problem(ctx.study)?;
-    let sec: EvolveSection = ctx.study.section("evolve")?.unwrap_or_default();
-    if sec.max_evaluations == Some(0) {
-        return Err(ctx
-            .study
-            .error("evolve.max_evaluations", 0, "a budget >= 1"));
-    }
+    let (sec, restarts) = evolve_plan(ctx.study)?;
     let starts = ctx
         .study
         .section::<MultistartSection>("multistart")?
@@ -446,6 +459,7 @@ pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<evolve::Report
     let request = evolve::Request {
         seed: ctx.study.meta.seed,
         max_evaluations,
+        restarts,
     };
     let solver = solvers::global();
     let report = evolve::run(
@@ -456,26 +470,45 @@ pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<evolve::Report
         ctx.quiet,
         &dir,
     )?;
+    let o = &report.outcome;
+    let (large, small) = regime_counts(o);
+    let runs: Vec<serde_json::Value> = o
+        .runs
+        .iter()
+        .map(|r| {
+            json!({"regime": r.regime.name(), "lambda": r.lambda, "sigma0": r.sigma0,
+                   "evaluations": r.evaluations, "generations": r.generations})
+        })
+        .collect();
     ctx.manifest(
         &dir,
         "evolve",
-        json!({"max_evaluations": max_evaluations, "wall_seconds": report.wall_seconds}),
+        json!({"max_evaluations": max_evaluations, "wall_seconds": report.wall_seconds,
+               "solver": restarts.solver_name(), "restarts": restarts.name(),
+               "large_runs": large, "small_runs": small, "runs": runs}),
     )?;
     convergence_plot(problem.as_ref(), &dir, None, Some(&report))?;
     if !ctx.quiet {
-        let o = &report.outcome;
         println!(
-            "evolution on {}: best f = {:.8e} at x = {:?} (feasible = {}), {} evaluations, {} generations, {} restarts, {}",
-            problem.name(), o.f, o.x, o.feasible, report.function_calls, o.generations, o.restarts, o.termination
+            "evolution ({}) on {}: best f = {:.8e} at x = {:?} (feasible = {}), {} evaluations, {} generations, {} restarts ({} large-population runs, {} small), {}",
+            restarts.solver_name(), problem.name(), o.f, o.x, o.feasible, report.function_calls,
+            o.generations, o.restarts, large, small, o.termination
         );
     }
     Ok(report)
 }
 
+/// Runs of the (large, small) regimes in a CMA-ES outcome.
+pub fn regime_counts(o: &crate::optimize::GlobalOutcome) -> (usize, usize) {
+    let large = o.runs.iter().filter(|r| r.regime == Regime::Large).count();
+    (large, o.runs.len() - large)
+}
+
 /// One row of the comparison table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ComparisonRow {
-    /// `multistart-<method>` or `cmaes`.
+    /// `multistart-<method>`, or the evolutionary method:
+    /// [`solvers::global_method`] (`cmaes` for IPOP, `cmaes-bipop`).
     pub method: String,
     /// Best objective.
     pub best_f: f64,
@@ -513,6 +546,8 @@ pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
     }
     let problem = problem(ctx.study)?;
     let plan = multistart_plan(ctx.study, problem.as_ref())?;
+    // Check [evolve] before the (possibly long) multistart.
+    let (_, restarts) = evolve_plan(ctx.study)?;
     let ms = multistart_with(ctx, problem.as_ref(), &plan)?;
     let budget = ms.function_calls + plan.starts.filter_evaluations;
     let ev = run_evolve(ctx, Some(budget))?;
@@ -533,7 +568,7 @@ pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
     }
     let o = &ev.outcome;
     rows.push(ComparisonRow {
-        method: "cmaes".into(),
+        method: solvers::global_method(restarts).into(),
         best_f: o.f,
         best_x: o.x.clone(),
         feasible: o.g.iter().all(|&g| g <= plan.tolerances.feasibility),
@@ -623,8 +658,12 @@ fn convergence_plot(
         });
     }
     if let Some(ev) = ev {
+        let label = match ev.restarts {
+            Restarts::Ipop => "CMA-ES (best so far)",
+            Restarts::Bipop => "BIPOP-CMA-ES (best so far)",
+        };
         curves.push(crate::report::Curve {
-            label: "CMA-ES (best so far)".into(),
+            label: label.into(),
             points: ev
                 .generations
                 .iter()

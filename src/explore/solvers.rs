@@ -11,11 +11,13 @@
 //!   coordinate, when `|Δf| <= 1e-14 max(1, |f|)`, or after 10 000
 //!   iterations. `P` wraps periodic variables and clamps the others.
 //!
-//! The evolutionary solver is `optimize::cmaes`.
+//! The evolutionary solver is `optimize::cmaes`, with IPOP (default) or
+//! BIPOP restarts (`[evolve] restarts`).
 
 use super::evolve::{GlobalSolver, Request};
 use super::multistart::LocalSolver;
 use crate::error::{Error, Result};
+use crate::optimize::cmaes::Restarts;
 use crate::optimize::{Counted, LocalOutcome, NoObserver, Problem, Termination};
 
 /// Local methods by name.
@@ -99,18 +101,28 @@ pub fn local(method: &str, mmfd: &MmfdSettings) -> Result<Box<LocalSolver<'stati
     })
 }
 
-/// CMA-ES with restarts, seeded and budgeted by the request.
+/// CMA-ES with the request's restart schedule, seeded and budgeted by it.
 pub fn global() -> Box<GlobalSolver<'static>> {
     Box::new(
         |p: &dyn Problem, r: &Request, obs: &mut dyn crate::optimize::Observer| {
             let options = crate::optimize::cmaes::CmaesOptions {
                 seed: r.seed,
                 max_evaluations: r.max_evaluations,
+                restarts: r.restarts,
                 ..Default::default()
             };
             crate::optimize::cmaes::minimize(p, &options, obs)
         },
     )
+}
+
+/// The evolutionary method's name in `comparison.csv`: `cmaes` (IPOP, the
+/// name it had before BIPOP existed) or `cmaes-bipop`.
+pub fn global_method(restarts: Restarts) -> &'static str {
+    match restarts {
+        Restarts::Ipop => "cmaes",
+        Restarts::Bipop => "cmaes-bipop",
+    }
 }
 
 /// Projected steepest descent (see the module doc).

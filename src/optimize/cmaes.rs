@@ -1,13 +1,38 @@
-//! CMA-ES (covariance matrix adaptation evolution strategy) with IPOP
-//! restarts, as an argmin [`Solver`]: the global comparison method of the
-//! exploration (docs/numerics.md, "Responses and optimization").
+//! CMA-ES (covariance matrix adaptation evolution strategy) with IPOP or
+//! BIPOP restarts, as an argmin [`Solver`]: the global comparison method of
+//! the exploration (docs/numerics.md, "Responses and optimization").
 //!
 //! Method: N. Hansen, *The CMA Evolution Strategy: A Tutorial*
 //! (arXiv:1604.00772, 2016), with the default parameters of its Table 1
 //! (weights `ln((λ+1)/2) − ln i` on the best μ = ⌊λ/2⌋, cumulation `c_σ`,
 //! `c_c`, rank-one `c_1`, rank-μ `c_μ`, damping `d_σ`) and the `h_σ` stall
-//! of the evolution path; restarts with doubled population (IPOP-CMA-ES,
-//! Auger & Hansen, CEC 2005) from a uniformly random mean in the box.
+//! of the evolution path. Restarts ([`Restarts`]) start from a uniformly
+//! random mean in the box:
+//! - IPOP (default; A. Auger, N. Hansen, "A restart CMA evolution strategy
+//!   with increasing population size", CEC 2005): restart `i` has the
+//!   population `λ_i = round(λ_def · F^i)` (F = `popsize_factor` = 2) and
+//!   the initial step σ0.
+//! - BIPOP (N. Hansen, "Benchmarking a BI-population CMA-ES on the
+//!   BBOB-2009 function testbed", GECCO 2009 companion, BBOB workshop): after
+//!   the first run (λ_def, σ0) two interlaced regimes share the budget. The
+//!   large regime is IPOP: its i-th restart has
+//!   `λ_large = round(λ_def · F^i)` and σ0. A small-regime run has
+//!   `λ_s = ⌊λ_def · (½ λ_large / λ_def)^(U₁²)⌋` and
+//!   `σ_s = σ0 · 10^(−2 U₂)`, with `U₁, U₂` uniform on [0, 1) and
+//!   `λ_large = λ_def · F^i` the population of the *next* large restart
+//!   (i large runs so far, the first run included), so that with F = 2
+//!   `λ_def <= λ_s <= λ_large / 2` (the last large population) and
+//!   `σ0 / 100 < σ_s <= σ0`. Before each restart the regime that has spent
+//!   fewer evaluations so far runs: small while `E_small < E_large`, large
+//!   otherwise; the first run is charged to the large regime (it is IPOP's
+//!   run 0). `max_restarts` counts the large restarts only; the search ends
+//!   when the large regime is due and has used them all (or at the budget).
+//!   (Hansen's BBOB default σ0 = 2 on [−5, 5]ⁿ gives the paper's
+//!   `σ_s = 2 · 10^(−2U)`.) Implementations differ in where the first
+//!   run's evaluations go; charging them to the large regime makes the
+//!   first restart a small one with `λ_s = λ_def`. Units: λ and the
+//!   evaluation counts are numbers of designs, σ is a fraction of each
+//!   variable's range.
 //!
 //! Search space: range-scaled `y = (x − lower)/range ∈ [0, 1]ⁿ`, so σ is a
 //! fraction of each variable's range (σ0 = 0.3 by default) and every
@@ -53,7 +78,10 @@ pub struct CmaesOptions {
     pub sigma0: f64,
     /// Population of the first run; `None`: `4 + ⌊3 ln n⌋` (Hansen, Table 1).
     pub popsize: Option<usize>,
-    /// IPOP restarts after the first run (each doubles the population): 9.
+    /// Restart schedule: IPOP (default) or BIPOP (module doc).
+    pub restarts: Restarts,
+    /// Restarts with increased population after the first run: 9. Under
+    /// BIPOP the large-regime restarts; small-regime runs do not count.
     pub max_restarts: usize,
     /// Population growth factor per restart: 2 (IPOP).
     pub popsize_factor: f64,
@@ -70,6 +98,110 @@ pub struct CmaesOptions {
     pub target: Option<f64>,
 }
 
+/// Restart schedule of [`Cmaes`] (module doc for the formulas).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Restarts {
+    /// Every restart multiplies the population by `popsize_factor`.
+    #[default]
+    Ipop,
+    /// Large (IPOP) and small-population restarts on equal budgets.
+    Bipop,
+}
+
+impl Restarts {
+    /// Names as written in study files.
+    pub const NAMES: &'static str = "ipop, bipop";
+
+    /// Parse a study-file name; the error names the key `restarts`.
+    pub fn parse(name: &str) -> Result<Restarts> {
+        match name {
+            "ipop" => Ok(Restarts::Ipop),
+            "bipop" => Ok(Restarts::Bipop),
+            other => Err(Error::input(
+                "restarts",
+                format!("\"{other}\""),
+                format!("one of {}", Restarts::NAMES),
+            )),
+        }
+    }
+
+    /// Name as written in study files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Restarts::Ipop => "ipop",
+            Restarts::Bipop => "bipop",
+        }
+    }
+
+    /// The solver's name: `IPOP-CMA-ES` or `BIPOP-CMA-ES`.
+    pub fn solver_name(&self) -> &'static str {
+        match self {
+            Restarts::Ipop => "IPOP-CMA-ES",
+            Restarts::Bipop => "BIPOP-CMA-ES",
+        }
+    }
+}
+
+/// The regime a run belongs to. Under IPOP every run is large.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Regime {
+    /// The first run and the IPOP restarts: `λ_def · F^i`, σ0.
+    Large,
+    /// BIPOP's small-population restarts: `λ_s`, `σ_s` (module doc).
+    Small,
+}
+
+impl Regime {
+    /// `large` or `small`, as reports write it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Regime::Large => "large",
+            Regime::Small => "small",
+        }
+    }
+}
+
+/// One CMA-ES run between restarts, in the order the runs were made.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunRecord {
+    /// Which regime scheduled the run.
+    pub regime: Regime,
+    /// Population size λ.
+    pub lambda: usize,
+    /// Initial step size, as a fraction of each variable's range.
+    pub sigma0: f64,
+    /// Function evaluations the run spent (λ per generation); 0 for a
+    /// restart the remaining budget could not afford a generation of.
+    pub evaluations: usize,
+    /// Generations the run made.
+    pub generations: usize,
+}
+
+/// Evaluations spent so far by the (large, small) regimes.
+pub fn regime_evaluations(runs: &[RunRecord]) -> (usize, usize) {
+    runs.iter().fold((0, 0), |(l, s), r| match r.regime {
+        Regime::Large => (l + r.evaluations, s),
+        Regime::Small => (l, s + r.evaluations),
+    })
+}
+
+/// BIPOP's small-regime run (module doc): `λ_s = ⌊λ_def (½ λ_large /
+/// λ_def)^(u₁²)⌋` (at least 2) and `σ_s = σ0 · 10^(−2 u₂)`, where
+/// `λ_large / λ_def = F^i` after `large_runs = i` large runs; `u₁, u₂` in
+/// [0, 1].
+pub fn small_run(
+    lambda_def: usize,
+    factor: f64,
+    large_runs: usize,
+    sigma0: f64,
+    u1: f64,
+    u2: f64,
+) -> (usize, f64) {
+    let ratio = 0.5 * factor.powi(large_runs as i32);
+    let lambda = ((lambda_def as f64) * ratio.powf(u1 * u1)).floor() as usize;
+    (lambda.max(2), sigma0 * 10f64.powf(-2.0 * u2))
+}
+
 impl Default for CmaesOptions {
     fn default() -> Self {
         CmaesOptions {
@@ -77,6 +209,7 @@ impl Default for CmaesOptions {
             max_evaluations: 10_000,
             sigma0: 0.3,
             popsize: None,
+            restarts: Restarts::Ipop,
             max_restarts: 9,
             popsize_factor: 2.0,
             x0: None,
@@ -238,6 +371,10 @@ pub struct Cmaes {
     run: Option<Run>,
     lambda0: usize,
     restarts: usize,
+    /// One record per run started, the current one last.
+    runs: Vec<RunRecord>,
+    /// The regime of the next run to start.
+    next_regime: Regime,
     generations: usize,
     best: Option<Sample>,
     termination: Option<Termination>,
@@ -269,6 +406,8 @@ impl Cmaes {
             run: None,
             lambda0,
             restarts: 0,
+            runs: Vec::new(),
+            next_regime: Regime::Large,
             generations: 0,
             best: None,
             termination: None,
@@ -280,18 +419,70 @@ impl Cmaes {
         self.lower.len()
     }
 
+    /// Start the next run in `next_regime`: population and step size from
+    /// the schedule (small regime: `u₁`, `u₂` drawn first), then the mean
+    /// (`x0` for the first run if given, else uniform in the box).
     fn start_run(&mut self) {
         let n = self.n();
-        let lambda = ((self.lambda0 as f64)
-            * self.options.popsize_factor.powi(self.restarts as i32))
-        .round() as usize;
-        let mean: Vec<f64> = match (&self.options.x0, self.run.is_none() && self.restarts == 0) {
+        let large_runs = self
+            .runs
+            .iter()
+            .filter(|r| r.regime == Regime::Large)
+            .count();
+        let (lambda, sigma0) = match self.next_regime {
+            Regime::Large => {
+                let lambda = ((self.lambda0 as f64)
+                    * self.options.popsize_factor.powi(large_runs as i32))
+                .round() as usize;
+                (lambda.max(2), self.options.sigma0)
+            }
+            Regime::Small => {
+                let u1: f64 = self.rng.random();
+                let u2: f64 = self.rng.random();
+                let o = &self.options;
+                small_run(self.lambda0, o.popsize_factor, large_runs, o.sigma0, u1, u2)
+            }
+        };
+        let mean: Vec<f64> = match (&self.options.x0, self.runs.is_empty()) {
             (Some(x0), true) => (0..n)
                 .map(|i| (x0[i] - self.lower[i]) / self.range[i])
                 .collect(),
             _ => (0..n).map(|_| self.rng.random::<f64>()).collect(),
         };
-        self.run = Some(Run::new(n, lambda.max(2), mean, self.options.sigma0));
+        self.runs.push(RunRecord {
+            regime: self.next_regime,
+            lambda,
+            sigma0,
+            evaluations: 0,
+            generations: 0,
+        });
+        self.run = Some(Run::new(n, lambda, mean, sigma0));
+    }
+
+    /// The regime of the run after the current one, or `None` when the
+    /// restarts are used up. IPOP: large while `restarts < max_restarts`.
+    /// BIPOP: small while the small regime has spent fewer evaluations than
+    /// the large one, else large while the large restarts (runs after the
+    /// first) are fewer than `max_restarts`.
+    fn following_regime(&self) -> Option<Regime> {
+        let large_restarts = self
+            .runs
+            .iter()
+            .filter(|r| r.regime == Regime::Large)
+            .count()
+            .saturating_sub(1);
+        let large = (large_restarts < self.options.max_restarts).then_some(Regime::Large);
+        match self.options.restarts {
+            Restarts::Ipop => large,
+            Restarts::Bipop => {
+                let (spent_large, spent_small) = regime_evaluations(&self.runs);
+                if spent_small < spent_large {
+                    Some(Regime::Small)
+                } else {
+                    large
+                }
+            }
+        }
     }
 
     /// Map a scaled sample to the design evaluated and its box violation.
@@ -319,9 +510,9 @@ impl Cmaes {
         (x, viol)
     }
 
-    /// One generation: sample, evaluate as a batch, rank, update.
+    /// One generation: sample, evaluate as a batch, rank, update; then the
+    /// target test and, when the run stops, the restart (or the end).
     fn generation(&mut self, problem: &mut ArgminProblem<Counted<'_>>) -> Result<()> {
-        let n = self.n();
         if self.run.is_none() {
             self.start_run();
         }
@@ -335,16 +526,68 @@ impl Cmaes {
             self.termination = Some(Termination::MaxEvaluations);
             return Ok(());
         }
-        // Sample (sequential, seeded).
-        let mut zs = Vec::with_capacity(lambda);
+        let samples = self.evaluate_population(problem, lambda)?;
+        let mut order: Vec<usize> = (0..lambda).collect();
+        order.sort_by(|&a, &b| better(&samples[a], &samples[b]).then(a.cmp(&b)));
+        let top = &samples[order[0]];
+        if self.best.as_ref().is_none_or(|b| better(top, b).is_lt()) {
+            self.best = Some(top.clone());
+        }
+        self.update(&samples, &order);
+        self.generations += 1;
+        if let Some(r) = self.runs.last_mut() {
+            r.evaluations += lambda;
+            r.generations += 1;
+        }
+        let best = self.best.as_ref().expect("a best sample");
+        let (fc, gc) = problem
+            .problem
+            .as_ref()
+            .map(|c| (c.function_calls(), c.gradient_calls()))
+            .unwrap_or((0, 0));
+        let sigma = self.run.as_ref().map(|r| r.sigma).unwrap_or(0.0);
+        self.record = Some(IterRecord {
+            iteration: self.generations - 1,
+            x: best.x.clone(),
+            f: best.f,
+            max_g: best.g.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            step: sigma,
+            function_calls: fc,
+            gradient_calls: gc,
+        });
+        if let Some(t) = self.options.target {
+            if best.violation <= 0.0 && best.f <= t {
+                self.termination = Some(Termination::TargetReached);
+                return Ok(());
+            }
+        }
+        if let Some(stop) = self.run_should_stop(&samples) {
+            match self.following_regime() {
+                None => self.termination = Some(stop),
+                Some(regime) => {
+                    self.next_regime = regime;
+                    self.restarts += 1;
+                    self.run = None;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Sample λ points of the current run (sequential, seeded), evaluate
+    /// them as one batch and compute their violations.
+    fn evaluate_population(
+        &mut self,
+        problem: &mut ArgminProblem<Counted<'_>>,
+        lambda: usize,
+    ) -> Result<Vec<Sample>> {
+        let n = self.n();
         let mut ys = Vec::with_capacity(lambda);
         {
             let run = self.run.as_ref().expect("run started");
             for _ in 0..lambda {
                 let z = DVector::from_fn(n, |_, _| normal(&mut self.rng));
-                let y = &run.mean + run.sigma * (&run.b * run.d.component_mul(&z));
-                zs.push(z);
-                ys.push(y);
+                ys.push(&run.mean + run.sigma * (&run.b * run.d.component_mul(&z)));
             }
         }
         let designs: Vec<(Vec<f64>, f64)> =
@@ -372,45 +615,7 @@ impl Cmaes {
                 violation,
             });
         }
-        let mut order: Vec<usize> = (0..lambda).collect();
-        order.sort_by(|&a, &b| better(&samples[a], &samples[b]).then(a.cmp(&b)));
-        let top = &samples[order[0]];
-        if self.best.as_ref().is_none_or(|b| better(top, b).is_lt()) {
-            self.best = Some(top.clone());
-        }
-        self.update(&samples, &order);
-        self.generations += 1;
-        let best = self.best.as_ref().expect("a best sample");
-        let (fc, gc) = problem
-            .problem
-            .as_ref()
-            .map(|c| (c.function_calls(), c.gradient_calls()))
-            .unwrap_or((0, 0));
-        let sigma = self.run.as_ref().map(|r| r.sigma).unwrap_or(0.0);
-        self.record = Some(IterRecord {
-            iteration: self.generations - 1,
-            x: best.x.clone(),
-            f: best.f,
-            max_g: best.g.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            step: sigma,
-            function_calls: fc,
-            gradient_calls: gc,
-        });
-        if let Some(t) = self.options.target {
-            if best.violation <= 0.0 && best.f <= t {
-                self.termination = Some(Termination::TargetReached);
-                return Ok(());
-            }
-        }
-        if let Some(stop) = self.run_should_stop(&samples) {
-            if self.restarts >= self.options.max_restarts {
-                self.termination = Some(stop);
-            } else {
-                self.restarts += 1;
-                self.run = None;
-            }
-        }
-        Ok(())
+        Ok(samples)
     }
 
     /// Hansen's update of mean, paths, covariance and step size.
@@ -514,7 +719,7 @@ impl Recorded for Cmaes {
 
 impl<'a> Solver<Counted<'a>, OptState> for Cmaes {
     fn name(&self) -> &str {
-        "IPOP-CMA-ES"
+        self.options.restarts.solver_name()
     }
 
     fn next_iter(
@@ -539,9 +744,10 @@ impl<'a> Solver<Counted<'a>, OptState> for Cmaes {
     }
 }
 
-/// Minimize `problem` with IPOP-CMA-ES within `options.max_evaluations`;
-/// one record per generation (best-so-far design, σ in `step`) goes to
-/// `observer`.
+/// Minimize `problem` with IPOP- or BIPOP-CMA-ES (`options.restarts`)
+/// within `options.max_evaluations`; one record per generation
+/// (best-so-far design, σ in `step`) goes to `observer`, one record per
+/// run is in the outcome's `runs`.
 pub fn minimize(
     problem: &dyn Problem,
     options: &CmaesOptions,
@@ -567,6 +773,7 @@ pub fn minimize(
         generations: solver.generations,
         restarts: solver.restarts,
         termination: solver.termination.unwrap_or(Termination::MaxEvaluations),
+        runs: solver.runs,
     })
 }
 

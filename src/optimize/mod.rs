@@ -310,6 +310,8 @@ pub struct GlobalOutcome {
     pub restarts: usize,
     /// Why it stopped.
     pub termination: Termination,
+    /// One record per run (`restarts + 1`): regime, λ, σ0, evaluations.
+    pub runs: Vec<cmaes::RunRecord>,
 }
 
 #[cfg(test)]
