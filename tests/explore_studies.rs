@@ -53,6 +53,14 @@ fn analytic_studies_run_and_find_their_known_optima() {
             assert!((f - f_star).abs() <= tol, "{file} {m}: f = {f}");
         }
         assert_eq!(column(&t, "feasible"), ["true", "true"], "{file}");
+        // One feasibility tolerance for both methods, stated in the table,
+        // and every best design within it.
+        let tols = column(&t, "feasibility_tolerance");
+        assert_eq!(tols[0], tols[1], "{file}");
+        let tol_g: f64 = tols[0].parse().unwrap();
+        for g in column(&t, "max_g").iter().filter(|g| !g.is_empty()) {
+            assert!(g.parse::<f64>().unwrap() <= tol_g, "{file}: max_g = {g}");
+        }
         // The manifest keeps every step `plyscape run` did.
         let m: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(d.join("manifest.json")).unwrap())

@@ -24,7 +24,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 /// What the evolutionary solver is given.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Request {
     /// Seed of every random choice of the solver.
     pub seed: u64,
@@ -32,6 +32,9 @@ pub struct Request {
     pub max_evaluations: usize,
     /// CMA-ES restart schedule (IPOP or BIPOP).
     pub restarts: Restarts,
+    /// A constraint is met when `g <= feasibility_tolerance` (the
+    /// multistart's tolerance, so both methods search the same set).
+    pub feasibility_tolerance: f64,
 }
 
 /// An evolutionary solver: CMA-ES in the binary, anything in tests.

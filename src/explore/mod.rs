@@ -446,10 +446,10 @@ fn print_optima(problem: &dyn Problem, r: &multistart::Report) {
 pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<evolve::Report> {
     let problem = problem(ctx.study)?;
     let (sec, restarts) = evolve_plan(ctx.study)?;
-    let starts = ctx
-        .study
-        .section::<MultistartSection>("multistart")?
-        .map(|m| m.starts + m.points.len());
+    let ms = ctx.study.section::<MultistartSection>("multistart")?;
+    let starts = ms.as_ref().map(|m| m.starts + m.points.len());
+    // One feasibility tolerance for both methods: the multistart's.
+    let feasibility_tolerance = ms.as_ref().map_or(0.0, |m| m.feasibility_tolerance);
     let max_evaluations = sec
         .max_evaluations
         .or(budget)
@@ -460,6 +460,7 @@ pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<evolve::Report
         seed: ctx.study.meta.seed,
         max_evaluations,
         restarts,
+        feasibility_tolerance,
     };
     let solver = solvers::global();
     let report = evolve::run(
@@ -514,8 +515,14 @@ pub struct ComparisonRow {
     pub best_f: f64,
     /// Best design.
     pub best_x: Vec<f64>,
-    /// Feasible within the tolerance.
+    /// Largest constraint value at the best design (`None`: no
+    /// constraints).
+    pub max_g: Option<f64>,
+    /// Feasible: `max_g <= feasibility_tolerance`, the same for every row.
     pub feasible: bool,
+    /// The tolerance of `feasible` (the multistart's, which the
+    /// evolutionary search also used).
+    pub feasibility_tolerance: f64,
     /// Function calls.
     pub function_calls: usize,
     /// Gradient calls.
@@ -558,7 +565,9 @@ pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
             method: format!("multistart-{}", plan.section.method),
             best_f: best.f,
             best_x: best.x.clone(),
+            max_g: best.g.iter().copied().reduce(f64::max),
             feasible: best.feasible,
+            feasibility_tolerance: plan.tolerances.feasibility,
             function_calls: budget,
             gradient_calls: ms.gradient_calls,
             wall_seconds: ms.wall_seconds,
@@ -571,7 +580,9 @@ pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
         method: solvers::global_method(restarts).into(),
         best_f: o.f,
         best_x: o.x.clone(),
+        max_g: o.g.iter().copied().reduce(f64::max),
         feasible: o.g.iter().all(|&g| g <= plan.tolerances.feasibility),
+        feasibility_tolerance: plan.tolerances.feasibility,
         function_calls: ev.function_calls,
         gradient_calls: ev.gradient_calls,
         wall_seconds: ev.wall_seconds,
@@ -593,7 +604,9 @@ pub fn comparison_table(problem: &dyn Problem, rows: &[ComparisonRow]) -> Vec<Ve
     h.extend(problem.variables().iter().map(|v| format!("x_{}", v.name)));
     h.extend(
         [
+            "max_g",
             "feasible",
+            "feasibility_tolerance",
             "function_calls",
             "gradient_calls",
             "wall_seconds",
@@ -606,7 +619,9 @@ pub fn comparison_table(problem: &dyn Problem, rows: &[ComparisonRow]) -> Vec<Ve
     for r in rows {
         let mut v = vec![r.method.clone(), tables::num(r.best_f)];
         v.extend(r.best_x.iter().map(|&x| tables::num(x)));
+        v.push(tables::field(r.max_g));
         v.push(r.feasible.to_string());
+        v.push(tables::num(r.feasibility_tolerance));
         v.push(r.function_calls.to_string());
         v.push(r.gradient_calls.to_string());
         v.push(format!("{:.3}", r.wall_seconds));

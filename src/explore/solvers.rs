@@ -109,6 +109,7 @@ pub fn global() -> Box<GlobalSolver<'static>> {
                 seed: r.seed,
                 max_evaluations: r.max_evaluations,
                 restarts: r.restarts,
+                feasibility_tolerance: r.feasibility_tolerance,
                 ..Default::default()
             };
             crate::optimize::cmaes::minimize(p, &options, obs)

@@ -96,6 +96,11 @@ pub struct CmaesOptions {
     pub tol_x: f64,
     /// Stop when a feasible design reaches this objective (`None`: never).
     pub target: Option<f64>,
+    /// A constraint counts as met when `g_j <= feasibility_tolerance`: the
+    /// violation of Deb's rules is `Σ_j max(0, g_j − tol)` (default 0;
+    /// the exploration passes the multistart's tolerance so that both
+    /// methods search the same feasible set).
+    pub feasibility_tolerance: f64,
 }
 
 /// Restart schedule of [`Cmaes`] (module doc for the formulas).
@@ -216,6 +221,7 @@ impl Default for CmaesOptions {
             tol_fun: 1e-12,
             tol_x: 1e-12,
             target: None,
+            feasibility_tolerance: 0.0,
         }
     }
 }
@@ -241,7 +247,11 @@ impl CmaesOptions {
         if self.max_evaluations == 0 {
             return bad("max_evaluations", "0".into(), "at least one evaluation");
         }
-        for (k, v) in [("tol_fun", self.tol_fun), ("tol_x", self.tol_x)] {
+        for (k, v) in [
+            ("tol_fun", self.tol_fun),
+            ("tol_x", self.tol_x),
+            ("feasibility_tolerance", self.feasibility_tolerance),
+        ] {
             if !(v >= 0.0 && v.is_finite()) {
                 return bad(k, v.to_string(), "a finite value >= 0");
             }
@@ -606,7 +616,8 @@ impl Cmaes {
         let mut samples: Vec<Sample> = Vec::with_capacity(lambda);
         for (k, ev) in evals.into_iter().enumerate() {
             driver::check_evaluation(&ev, &xs[k], m, false, "optimize::cmaes")?;
-            let violation = designs[k].1 + ev.g.iter().map(|g| g.max(0.0)).sum::<f64>();
+            let tol = self.options.feasibility_tolerance;
+            let violation = designs[k].1 + ev.g.iter().map(|g| (g - tol).max(0.0)).sum::<f64>();
             samples.push(Sample {
                 y: ys[k].as_slice().to_vec(),
                 x: xs[k].clone(),
