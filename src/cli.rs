@@ -31,6 +31,10 @@ pub struct Common {
     /// No progress bars or summaries beyond errors.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Discard an earlier runs.csv instead of keeping it as
+    /// runs-<UTC time>.csv (multistart without --resume).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Subcommands.
@@ -113,17 +117,12 @@ pub struct DriveArgs {
     /// Run only every n-th start, beginning at i (0-based): `--shard i/n`.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<String>,
-    /// Without --resume: discard an earlier runs.csv instead of keeping it
-    /// as runs-<UTC time>.csv.
-    #[arg(long, conflicts_with = "resume")]
-    pub force: bool,
 }
 
 impl DriveArgs {
     fn resolve(&self) -> Result<crate::explore::DriveFlags> {
         let mut f = crate::explore::DriveFlags {
             resume: self.resume,
-            force: self.force,
             ..Default::default()
         };
         if let Some(s) = &self.shard {
@@ -140,6 +139,8 @@ pub struct RunConfig {
     pub out: PathBuf,
     pub threads: usize,
     pub quiet: bool,
+    /// `--force`: see [`Common::force`].
+    pub force: bool,
 }
 
 /// The largest thread count accepted for a machine with `cores` cores.
@@ -177,6 +178,7 @@ impl RunConfig {
             out: common.out.clone(),
             threads,
             quiet: common.quiet,
+            force: common.force,
         })
     }
 }
@@ -256,8 +258,9 @@ fn lock(
 /// The exploration drivers' view of a resolved run.
 fn explore_context(
     cfg: &RunConfig,
-    flags: crate::explore::DriveFlags,
+    mut flags: crate::explore::DriveFlags,
 ) -> crate::explore::Context<'_> {
+    flags.force = cfg.force;
     crate::explore::Context {
         study: &cfg.study,
         out: &cfg.out,

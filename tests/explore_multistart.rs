@@ -332,6 +332,7 @@ fn bad_study_input_gets_a_clear_error() {
         out: "results".into(),
         threads: Some(0),
         quiet: true,
+        force: false,
     };
     let e = plyscape::cli::RunConfig::resolve(None, &common)
         .unwrap_err()

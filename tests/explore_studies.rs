@@ -13,6 +13,7 @@ fn run(file: &str, out: &std::path::Path) -> Study {
         out: out.to_path_buf(),
         threads: 2,
         quiet: true,
+        force: false,
     };
     run_study(&cfg).unwrap_or_else(|e| panic!("{file}: {e}"));
     study

@@ -153,6 +153,7 @@ pub fn run(
             &HeatMap {
                 title: &title,
                 names: (na, nb),
+                value_label: &problem.objective_label(),
                 xs: &slice.xs,
                 ys: &slice.ys,
                 values: &values,

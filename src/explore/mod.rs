@@ -687,12 +687,32 @@ fn convergence_plot(
                 .collect(),
         });
     }
+    // Log–log: the gap of each best-so-far to the lowest f either method
+    // found, with a floor so that the final point of the winner shows.
+    let lowest = curves
+        .iter()
+        .flat_map(|c| c.points.iter().map(|p| p.1))
+        .fold(f64::INFINITY, f64::min);
+    let floor = 1e-12 * lowest.abs().max(1.0);
+    for c in &mut curves {
+        for p in &mut c.points {
+            p.1 = p.1 - lowest + floor;
+        }
+    }
+    let y = format!(
+        "best f − lowest f found ({lowest:.6e}) + {floor:.0e}, {}",
+        problem.objective_label()
+    );
     crate::report::line_plot(
         &dir.join("convergence.svg"),
         &crate::report::Axes {
-            title: &format!("{}: best objective vs function calls", problem.name()),
-            x: "function calls",
-            y: "best f",
+            title: &format!(
+                "{}: best objective vs function calls (log–log)",
+                problem.name()
+            ),
+            x: "function calls [-]",
+            y: &y,
+            scale: crate::report::Scale::LogLog,
         },
         &curves,
     )

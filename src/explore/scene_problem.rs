@@ -681,6 +681,14 @@ impl Problem for SceneProblem {
     fn name(&self) -> &str {
         "scene"
     }
+    fn objective_label(&self) -> String {
+        let (response, divisor) = &self.objective;
+        if *divisor == 1.0 {
+            format!("f = {response} [SI unit of the response]")
+        } else {
+            format!("f = {response} / {divisor:.4e} [-]")
+        }
+    }
 }
 
 #[cfg(test)]

@@ -137,6 +137,11 @@ pub trait Problem: Sync {
     fn name(&self) -> &str {
         "problem"
     }
+    /// What `f` is, with its unit, for plot axes (default: a dimensionless
+    /// test function).
+    fn objective_label(&self) -> String {
+        "f [-]".into()
+    }
 }
 
 /// Counts every evaluation of the wrapped problem. A call with gradients

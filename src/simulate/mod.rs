@@ -458,9 +458,10 @@ pub fn plot_column(path: &Path, label: &str, rows: &[Vec<f64>], col: usize) -> R
     line_plot(
         path,
         &Axes {
-            title: label,
+            title: &format!("{label} against time"),
             x: "t [s]",
             y: label,
+            scale: crate::report::Scale::Linear,
         },
         &[Curve {
             label: label.to_string(),

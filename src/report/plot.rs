@@ -1,0 +1,317 @@
+//! SVG plots (plotters' SVG backend: text is laid out by the browser, so no
+//! font files are needed). Every plot has a title and axis labels with
+//! units; logarithmic axes are drawn on the base-10 logarithm of the data
+//! with tick labels in the data's own values.
+
+use crate::error::{Error, Result};
+use plotters::prelude::*;
+use std::path::Path;
+
+fn plot_err(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::csv(path, format!("SVG drawing failed: {e}"))
+}
+
+/// A named curve for [`line_plot`].
+pub struct Curve {
+    /// Legend label.
+    pub label: String,
+    /// Points `(x, y)`, finite.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// How the axes of a line plot map data to the page.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Scale {
+    /// Both axes linear.
+    #[default]
+    Linear,
+    /// Logarithmic y (points with y <= 0 are left out).
+    LogY,
+    /// Both axes logarithmic (points with x <= 0 or y <= 0 left out).
+    LogLog,
+}
+
+impl Scale {
+    fn log_x(self) -> bool {
+        self == Scale::LogLog
+    }
+    fn log_y(self) -> bool {
+        self != Scale::Linear
+    }
+}
+
+/// Axis labels (with units) and title of a line plot.
+pub struct Axes<'a> {
+    /// Title.
+    pub title: &'a str,
+    /// x label, with its unit.
+    pub x: &'a str,
+    /// y label, with its unit.
+    pub y: &'a str,
+    /// Linear or logarithmic axes.
+    pub scale: Scale,
+}
+
+/// `v` on a logarithmic axis: its base-10 logarithm (positive finite
+/// values only).
+fn log_of(v: f64) -> Option<f64> {
+    (v > 0.0 && v.is_finite()).then(|| v.log10())
+}
+
+/// Tick label of a value drawn at `v` on a log axis: `10^v`.
+fn log_tick(v: &f64) -> String {
+    format!("{:.0e}", 10f64.powf(*v))
+}
+
+/// The curves' points as drawn: logarithms where the axis is logarithmic,
+/// non-finite and non-positive-on-log points left out.
+fn drawn_points(curves: &[Curve], scale: Scale) -> Vec<Vec<(f64, f64)>> {
+    let map = |v: f64, log: bool| {
+        if log {
+            log_of(v)
+        } else {
+            v.is_finite().then_some(v)
+        }
+    };
+    curves
+        .iter()
+        .map(|c| {
+            c.points
+                .iter()
+                .filter_map(|&(x, y)| Some((map(x, scale.log_x())?, map(y, scale.log_y())?)))
+                .collect()
+        })
+        .collect()
+}
+
+/// Draw curves into an SVG (legend; linear or logarithmic axes).
+pub fn line_plot(path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()> {
+    let drawn = drawn_points(curves, axes.scale);
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y) in drawn.iter().flatten() {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    if !(x0.is_finite() && y0.is_finite()) {
+        return Ok(());
+    }
+    let pad = |a: f64, b: f64| {
+        if b > a {
+            0.05 * (b - a)
+        } else {
+            0.5 * a.abs().max(1.0)
+        }
+    };
+    let (px, py) = (pad(x0, x1), pad(y0, y1));
+    let root = SVGBackend::new(path, (800, 500)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(axes.title, ("sans-serif", 20))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0 - px..x1 + px, y0 - py..y1 + py)
+        .map_err(|e| plot_err(path, e))?;
+    let plain = |v: &f64| format!("{v}");
+    let fx: &dyn Fn(&f64) -> String = if axes.scale.log_x() {
+        &log_tick
+    } else {
+        &plain
+    };
+    let fy: &dyn Fn(&f64) -> String = if axes.scale.log_y() {
+        &log_tick
+    } else {
+        &plain
+    };
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(axes.x).y_desc(axes.y);
+    if axes.scale.log_x() {
+        mesh.x_label_formatter(fx);
+    }
+    if axes.scale.log_y() {
+        mesh.y_label_formatter(fy);
+    }
+    mesh.draw().map_err(|e| plot_err(path, e))?;
+    for (i, (c, pts)) in curves.iter().zip(drawn).enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        chart
+            .draw_series(LineSeries::new(pts, color.stroke_width(2)))
+            .map_err(|e| plot_err(path, e))?
+            .label(c.label.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| plot_err(path, e))?;
+    root.present().map_err(|e| plot_err(path, e))
+}
+
+/// A heat map: a regular grid of values, cells that violate constraints,
+/// and marked points.
+pub struct HeatMap<'a> {
+    /// Title.
+    pub title: &'a str,
+    /// Axis names (with units).
+    pub names: (&'a str, &'a str),
+    /// What the colours show (with its unit), written on the colour scale.
+    pub value_label: &'a str,
+    /// Grid coordinates along x (`nx`) and y (`ny`), increasing.
+    pub xs: &'a [f64],
+    /// Grid coordinates along y.
+    pub ys: &'a [f64],
+    /// Values, `values[i * ny + j]` at `(xs[i], ys[j])`.
+    pub values: &'a [f64],
+    /// Infeasible cells (same indexing), drawn greyed.
+    pub infeasible: &'a [bool],
+    /// Marked points: label, points, colour index.
+    pub marks: Vec<(String, Vec<(f64, f64)>)>,
+}
+
+/// The colour scale of a heat map in `area`: the ramp from `t = 0` (bottom)
+/// to `t = 1` (top), labelled with the values `value_at(t)` and `label`.
+fn colour_bar<DB: DrawingBackend>(
+    path: &Path,
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    label: &str,
+    value_at: &dyn Fn(f64) -> f64,
+) -> Result<()> {
+    let mut bar = ChartBuilder::on(area)
+        .margin_top(40)
+        .margin_bottom(50)
+        .margin_right(5)
+        .y_label_area_size(95)
+        .build_cartesian_2d(0.0..1.0, 0.0..1.0)
+        .map_err(|e| plot_err(path, e))?;
+    let fmt = |t: &f64| format!("{:.3e}", value_at(*t));
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc(label)
+        .y_label_style(("sans-serif", 12))
+        .axis_desc_style(("sans-serif", 14))
+        .y_label_formatter(&fmt)
+        .y_labels(8)
+        .draw()
+        .map_err(|e| plot_err(path, e))?;
+    const STEPS: usize = 200;
+    bar.draw_series((0..STEPS).map(|k| {
+        let (a, b) = (k as f64 / STEPS as f64, (k + 1) as f64 / STEPS as f64);
+        Rectangle::new([(0.0, a), (1.0, b)], ramp(0.5 * (a + b)).filled())
+    }))
+    .map_err(|e| plot_err(path, e))?;
+    Ok(())
+}
+
+/// Colour for `t` in `[0, 1]` (a viridis-like ramp: dark blue, teal, yellow).
+fn ramp(t: f64) -> RGBColor {
+    const STOPS: [(f64, f64, f64); 5] = [
+        (68.0, 1.0, 84.0),
+        (59.0, 82.0, 139.0),
+        (33.0, 145.0, 140.0),
+        (94.0, 201.0, 98.0),
+        (253.0, 231.0, 37.0),
+    ];
+    let s = t.clamp(0.0, 1.0) * 4.0;
+    let i = (s.floor() as usize).min(3);
+    let w = s - i as f64;
+    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    let mix = |p: f64, q: f64| (p + w * (q - p)).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// Draw a heat map SVG. Colours follow `log(1 + (v - min) / s)` with
+/// `s = (max - min) / 1000`, so the basins stay visible next to tall peaks.
+pub fn heat_map(path: &Path, map: &HeatMap) -> Result<()> {
+    let (nx, ny) = (map.xs.len(), map.ys.len());
+    if nx < 2 || ny < 2 || map.values.len() != nx * ny {
+        return Err(plot_err(path, "grid needs at least 2 x 2 values"));
+    }
+    let vmin = map.values.iter().copied().fold(f64::INFINITY, f64::min);
+    let vmax = map.values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let s = ((vmax - vmin) / 1000.0).max(1e-300);
+    let top = (1.0 + (vmax - vmin) / s).ln().max(1e-300);
+    let half = |c: &[f64], i: usize| {
+        let lo = if i == 0 {
+            c[0]
+        } else {
+            0.5 * (c[i - 1] + c[i])
+        };
+        let hi = if i + 1 == c.len() {
+            c[i]
+        } else {
+            0.5 * (c[i] + c[i + 1])
+        };
+        (lo, hi)
+    };
+    let root = SVGBackend::new(path, (900, 700)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+    let (root, bar) = root.split_horizontally(760);
+    let value_at = |t: f64| vmin + s * ((t * top).exp() - 1.0);
+    colour_bar(path, &bar, map.value_label, &value_at)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(map.title, ("sans-serif", 20))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(map.xs[0]..map.xs[nx - 1], map.ys[0]..map.ys[ny - 1])
+        .map_err(|e| plot_err(path, e))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(map.names.0)
+        .y_desc(map.names.1)
+        .draw()
+        .map_err(|e| plot_err(path, e))?;
+    let mut cells = Vec::with_capacity(nx * ny);
+    for i in 0..nx {
+        for j in 0..ny {
+            let v = map.values[i * ny + j];
+            let mut c = ramp((1.0 + (v - vmin) / s).ln() / top);
+            if map.infeasible.get(i * ny + j).copied().unwrap_or(false) {
+                let grey = |u: u8| ((u as f64 + 2.0 * 200.0) / 3.0) as u8;
+                c = RGBColor(grey(c.0), grey(c.1), grey(c.2));
+            }
+            let ((x0, x1), (y0, y1)) = (half(map.xs, i), half(map.ys, j));
+            cells.push(Rectangle::new([(x0, y0), (x1, y1)], c.filled()));
+        }
+    }
+    chart.draw_series(cells).map_err(|e| plot_err(path, e))?;
+    let colors = [RED, WHITE, MAGENTA, CYAN];
+    for (k, (label, pts)) in map.marks.iter().enumerate() {
+        let color = colors[k % colors.len()];
+        chart
+            .draw_series(pts.iter().map(|&p| Cross::new(p, 7, color.stroke_width(3))))
+            .map_err(|e| plot_err(path, e))?
+            .label(label.clone())
+            .legend(move |(x, y)| Cross::new((x + 8, y), 5, color.stroke_width(3)));
+    }
+    if !map.marks.is_empty() {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| plot_err(path, e))?;
+    }
+    root.present().map_err(|e| plot_err(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ramp_ends() {
+        assert_eq!(ramp(0.0), RGBColor(68, 1, 84));
+        assert_eq!(ramp(1.0), RGBColor(253, 231, 37));
+    }
+}
