@@ -407,6 +407,31 @@ pub fn check_sections(study: &Study) -> Result<()> {
     Ok(())
 }
 
+/// Check every section the study has before any of them runs, so that a
+/// bad late section is found before earlier ones write results: each
+/// section is read into its typed form (unknown keys, wrong types and bad
+/// values refused) and checked as far as that needs no computation.
+pub fn check_study(study: &Study) -> Result<()> {
+    use crate::sections;
+    const EXPLORE: &[&str] = &["multistart", "evolve", "compare", "map", "scaling"];
+    for key in study.table.keys() {
+        match key.as_str() {
+            "modes" => sections::modes::check(study).map(|_| ())?,
+            "scene" => crate::scene::ScenePlan::new(study).map(|_| ())?,
+            "kernel_bench" => sections::kernel_bench::check(study).map(|_| ())?,
+            "events_bench" => sections::events_bench::check(study).map(|_| ())?,
+            "eval_bench" => sections::eval_bench::check(study).map(|_| ())?,
+            "scene_convergence" => sections::scene_convergence::check(study).map(|_| ())?,
+            k if EXPLORE.contains(&k) => {
+                crate::explore::check(study, "problem")?;
+                crate::explore::check(study, k)?;
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// Levenshtein distance of two names (insertions, deletions, substitutions).
 fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
@@ -426,6 +451,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
 /// Run every section the study asks for, in the order of [`handlers`]
 /// (unknown sections were refused by [`RunConfig::resolve`]).
 pub fn run_study(cfg: &RunConfig) -> Result<()> {
+    check_study(&cfg.study)?;
     let handlers = handlers();
     let mut ran = 0;
     for (key, handler) in &handlers {

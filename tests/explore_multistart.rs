@@ -467,3 +467,29 @@ fn merge_is_strict_and_read_only() {
     explore::merge(&dirs, &dir, true).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `plyscape run` checks every section before any runs: a bad late section
+/// (here `[map]` and `[evolve]`, which run after the multistart) is refused
+/// with its key and nothing is written.
+#[test]
+fn a_bad_late_section_is_refused_before_any_work() {
+    let dir = temp_dir("ms-late");
+    for (late, key) in [
+        ("[map]\nresolution = 1\n", "map.resolution"),
+        ("[evolve]\nrestarts = \"bopop\"\n", "evolve.restarts"),
+        ("[map]\nresolutoin = 11\n", "resolutoin"),
+    ] {
+        let s = study("late", &format!("{}{late}", himmelblau(6, "")));
+        let cfg = plyscape::cli::RunConfig {
+            study: s,
+            out: dir.clone(),
+            threads: 1,
+            quiet: true,
+            force: false,
+        };
+        let e = plyscape::cli::run_study(&cfg).unwrap_err().to_string();
+        assert!(e.starts_with("late.toml") && e.contains(key), "{e}");
+        assert!(!dir.join("late/runs.csv").exists(), "{late}: work was done");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

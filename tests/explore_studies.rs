@@ -82,3 +82,21 @@ fn analytic_studies_run_and_find_their_known_optima() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Every study in `studies/` passes the whole-study check `plyscape run`
+/// does before any work (so the check refuses only what is wrong).
+#[test]
+fn every_shipped_study_passes_the_upfront_check() {
+    let mut n = 0;
+    for e in std::fs::read_dir("studies").unwrap() {
+        let path = e.unwrap().path();
+        if path.extension().and_then(|x| x.to_str()) != Some("toml") {
+            continue;
+        }
+        let s = Study::load(&path).unwrap();
+        plyscape::cli::check_sections(&s).unwrap();
+        plyscape::cli::check_study(&s).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        n += 1;
+    }
+    assert!(n >= 20, "{n} studies");
+}

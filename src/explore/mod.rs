@@ -265,8 +265,8 @@ pub struct MultistartPlan {
     pub tolerances: Tolerances,
 }
 
-/// Read and check `[multistart]`, generate the starts.
-pub fn multistart_plan(study: &Study, problem: &dyn Problem) -> Result<MultistartPlan> {
+/// Read and check `[multistart]` (keys and values; no start generated).
+pub fn multistart_section(study: &Study) -> Result<MultistartSection> {
     let s: MultistartSection =
         study.require_section("multistart", "starts = ..., sampler = ...")?;
     let loc = study.locate("multistart");
@@ -295,6 +295,13 @@ pub fn multistart_plan(study: &Study, problem: &dyn Problem) -> Result<Multistar
             "a budget >= 1 (or no key)",
         )));
     }
+    Ok(s)
+}
+
+/// Read and check `[multistart]`, generate the starts.
+pub fn multistart_plan(study: &Study, problem: &dyn Problem) -> Result<MultistartPlan> {
+    let s = multistart_section(study)?;
+    let loc = study.locate("multistart");
     let spec = sampling::StartsSpec {
         sampler: s.sampler.clone(),
         count: s.starts,
@@ -723,18 +730,8 @@ fn convergence_plot(
 /// output directory.
 pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
     let problem = problem(ctx.study)?;
-    let sec: MapSection = ctx.study.section("map")?.unwrap_or(MapSection {
-        resolution: default_resolution(),
-        pairs: None,
-    });
+    let sec = map_section(ctx.study)?;
     let loc = ctx.study.locate("map");
-    if !(2..=2001).contains(&sec.resolution) {
-        return Err(loc(Error::input(
-            "resolution",
-            sec.resolution,
-            "2 <= resolution <= 2001",
-        )));
-    }
     let vars = problem.variables();
     let n = vars.len();
     let pairs: Vec<(usize, usize)> = match &sec.pairs {
@@ -784,6 +781,43 @@ pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
         );
     }
     Ok(slices)
+}
+
+/// Read and check `[map]` (default: 61 points per axis, consecutive pairs).
+pub fn map_section(study: &Study) -> Result<MapSection> {
+    let sec: MapSection = study.section("map")?.unwrap_or(MapSection {
+        resolution: default_resolution(),
+        pairs: None,
+    });
+    if !(2..=2001).contains(&sec.resolution) {
+        return Err(study.error("map.resolution", sec.resolution, "2 <= resolution <= 2001"));
+    }
+    Ok(sec)
+}
+
+/// Check the exploration section `key` of `study` without doing any work
+/// (`plyscape run` checks every section before the first one runs). A
+/// `scene` problem is only parsed here: building it evaluates a design.
+pub fn check(study: &Study, key: &str) -> Result<()> {
+    match key {
+        "problem" => {
+            let spec: problems::ProblemSpec =
+                study.require_section("problem", "the problem to explore (name = ...)")?;
+            if spec.name == "scene" {
+                scene_problem::SceneProblem::check(study)
+            } else {
+                problem(study).map(|_| ())
+            }
+        }
+        "multistart" => multistart_section(study).map(|_| ()),
+        "evolve" => evolve_plan(study).map(|_| ()),
+        "compare" => study.section::<CompareSection>("compare").map(|_| ()),
+        "map" => map_section(study).map(|_| ()),
+        "scaling" => study
+            .require_section::<scaling::ScalingSection>("scaling", "threads = [1, 2]")
+            .map(|_| ()),
+        _ => Ok(()),
+    }
 }
 
 /// Designs from the `<prefix><name>` columns of a CSV, if the file exists.

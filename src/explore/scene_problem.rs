@@ -196,13 +196,7 @@ impl SceneProblem {
     /// `[scene_problem]`; evaluates the start design (and the
     /// normalization design) once. Errors name the file and key.
     pub fn from_study(study: &Study) -> Result<SceneProblem> {
-        let spec: SceneProblemSpec = study.require_section(
-            "scene_problem",
-            "the scene problem (variables, start, objective)",
-        )?;
-        let plan = ScenePlan::new(study)?;
-        let ties = Ties::resolve(study, &spec, &plan)?;
-        check_objective_and_constraints(study, &spec, &plan, &ties.vars)?;
+        let (spec, plan, ties) = Self::checked(study)?;
         let mut problem = SceneProblem {
             vars: ties.vars,
             plan,
@@ -215,6 +209,24 @@ impl SceneProblem {
         };
         problem.set_references(study, &spec)?;
         Ok(problem)
+    }
+
+    /// Check `[scene_problem]` against `[scene]` and `[[panels]]` without
+    /// evaluating any design.
+    pub fn check(study: &Study) -> Result<()> {
+        Self::checked(study).map(|_| ())
+    }
+
+    /// The parsed and checked spec, the scene plan and the ties.
+    fn checked(study: &Study) -> Result<(SceneProblemSpec, ScenePlan, Ties)> {
+        let spec: SceneProblemSpec = study.require_section(
+            "scene_problem",
+            "the scene problem (variables, start, objective)",
+        )?;
+        let plan = ScenePlan::new(study)?;
+        let ties = Ties::resolve(study, &spec, &plan)?;
+        check_objective_and_constraints(study, &spec, &plan, &ties.vars)?;
+        Ok((spec, plan, ties))
     }
 
     /// The constraint bounds and the objective's divisor from the start

@@ -153,10 +153,14 @@ pub fn run_eval_bench(
     Ok(rows)
 }
 
+/// Read `[eval_bench]` without running anything.
+pub fn check(study: &Study) -> Result<EvalBenchSpec> {
+    study.require_section("eval_bench", "the design-evaluation benchmark")
+}
+
 /// The `[eval_bench]` handler: run the section and write the CSV.
 pub fn run_eval_bench_section(study: &Study, out: &Path, quiet: bool) -> Result<PathBuf> {
-    let spec: EvalBenchSpec =
-        study.require_section("eval_bench", "the design-evaluation benchmark")?;
+    let spec = check(study)?;
     let rows = run_eval_bench(study, &spec, |r| {
         if !quiet {
             println!("{}", r.join(", "));

@@ -133,10 +133,16 @@ pub fn headers(param_names: &[String]) -> Vec<String> {
     h
 }
 
-/// The `[events_bench]` handler: run all cases, write `events.csv`.
-pub fn run_events_bench(study: &Study, out: &Path, quiet: bool) -> Result<PathBuf> {
+/// Read and check `[events_bench]` without running anything.
+pub fn check(study: &Study) -> Result<EventsSpec> {
     let spec: EventsSpec = study.require_section("events_bench", "the events benchmark")?;
     validate(study, &spec)?;
+    Ok(spec)
+}
+
+/// The `[events_bench]` handler: run all cases, write `events.csv`.
+pub fn run_events_bench(study: &Study, out: &Path, quiet: bool) -> Result<PathBuf> {
+    let spec = check(study)?;
     let base = study.path.parent().unwrap_or(Path::new("."));
     let path = base.join(&spec.scene);
     let scene_study =

@@ -439,9 +439,16 @@ pub fn write_csv(rows: &[BenchRow], dir: &Path) -> Result<PathBuf> {
     Ok(path)
 }
 
+/// Read and check `[kernel_bench]` without running anything.
+pub fn check(study: &Study) -> Result<BenchSpec> {
+    let spec: BenchSpec = study.require_section("kernel_bench", "the kernel benchmark")?;
+    validate(study, &spec)?;
+    Ok(spec)
+}
+
 /// The `[kernel_bench]` handler: run the section and write the CSV.
 pub fn run_kernel_bench(study: &Study, out: &Path, quiet: bool) -> Result<PathBuf> {
-    let spec: BenchSpec = study.require_section("kernel_bench", "the kernel benchmark")?;
+    let spec = check(study)?;
     let rows = run_bench(study, &spec, |r| {
         if !quiet {
             println!("{}", r.line());

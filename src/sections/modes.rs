@@ -105,9 +105,21 @@ impl ModesSpec {
     }
 }
 
-/// Run the modal analysis of every panel of the study, sharing analyses of
-/// identical panels. Returns one result per panel, in file order.
-pub fn analyse_study(study: &Study, spec: &ModesSpec) -> Result<Vec<PanelModes>> {
+/// Read and check `[modes]`, `[[panels]]` and `[convergence]` without
+/// analysing anything.
+pub fn check(study: &Study) -> Result<ModesSpec> {
+    let spec: ModesSpec = study.require_section("modes", "what modal analysis to run")?;
+    checked_panels(study, &spec)?;
+    study.section::<ConvergenceSpec>("convergence")?;
+    Ok(spec)
+}
+
+/// The study's panels and the derivatives `spec` asks for, checked: at
+/// least one panel, a known derivative kind, reference names that exist.
+fn checked_panels(
+    study: &Study,
+    spec: &ModesSpec,
+) -> Result<(Vec<crate::fe::Panel>, Option<ModeUpdate>)> {
     let panels = crate::fe::panels_from_study(study)?;
     if panels.is_empty() {
         return Err(study.error("panels", "(missing)", "at least one [[panels]] entry"));
@@ -126,6 +138,13 @@ pub fn analyse_study(study: &Study, spec: &ModesSpec) -> Result<Vec<PanelModes>>
             ));
         }
     }
+    Ok((panels, want))
+}
+
+/// Run the modal analysis of every panel of the study, sharing analyses of
+/// identical panels. Returns one result per panel, in file order.
+pub fn analyse_study(study: &Study, spec: &ModesSpec) -> Result<Vec<PanelModes>> {
+    let (panels, want) = checked_panels(study, spec)?;
     let mut out: Vec<PanelModes> = Vec::with_capacity(panels.len());
     for (i, p) in panels.iter().enumerate() {
         // Same mesh, lay-up, design map and support: reuse (compute once).
@@ -449,7 +468,7 @@ pub fn write_convergence(dir: &Path, rows: &[ConvergenceRow]) -> Result<PathBuf>
 
 /// `plyscape modes` / the `[modes]` handler of `plyscape run`.
 pub fn run_modes(study: &Study, out_root: &Path, quiet: bool) -> Result<()> {
-    let spec: ModesSpec = study.require_section("modes", "what modal analysis to run")?;
+    let spec = check(study)?;
     let results = analyse_study(study, &spec)?;
     let dir = study.output_dir(out_root)?;
     let mut files = write_results(&dir, &results, &spec)?;

@@ -210,10 +210,14 @@ pub fn write_csv(rows: &[Variant], dir: &Path) -> Result<PathBuf> {
     Ok(path)
 }
 
+/// Read `[scene_convergence]` without running anything.
+pub fn check(study: &Study) -> Result<ConvergenceSpec> {
+    study.require_section("scene_convergence", "the flexible-scene accuracy/cost grid")
+}
+
 /// The `[scene_convergence]` handler.
 pub fn run_scene_convergence(study: &Study, out: &Path, quiet: bool) -> Result<PathBuf> {
-    let spec: ConvergenceSpec =
-        study.require_section("scene_convergence", "the flexible-scene accuracy/cost grid")?;
+    let spec = check(study)?;
     let rows = run_grid(study, &spec, |v| {
         if !quiet {
             let r: Vec<String> = v
