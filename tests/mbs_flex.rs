@@ -488,3 +488,19 @@ fn too_many_panel_modes_name_the_body_key_and_the_largest_allowed() {
         "{err}"
     );
 }
+
+/// A size that cannot fit is refused before anything is allocated, with
+/// the key, the estimate and the machine's available memory (100 000 beam
+/// modes per plane: about 24 TB by the measured scaling in
+/// `study::memory`, more than any machine this runs on).
+#[test]
+fn a_size_that_cannot_fit_is_refused_with_the_estimate() {
+    let s = study(&FREE_BEAM.replace("modes = 4,", "modes = 100000,"));
+    let e = load_scene(&s).unwrap_err().to_string();
+    assert!(
+        e.contains("`scene.bodies[0].flexible.modes` = 100000")
+            && e.contains("fits in memory")
+            && e.contains("GiB available"),
+        "{e}"
+    );
+}

@@ -85,6 +85,14 @@ impl Mesh {
         let xs = grid_lines(hx, p.points.iter().map(|q| q[0]), h, tol);
         let ys = grid_lines(hy, p.points.iter().map(|q| q[1]), h, tol);
         let (nx, ny) = (xs.len(), ys.len());
+        use crate::study::memory;
+        memory::require_fits(
+            "divisions",
+            p.divisions,
+            &format!("the panel analysis of {nx} x {ny} nodes (12 KB per DOF, measured)"),
+            memory::PANEL_BYTES_PER_DOF * (6 * nx * ny) as f64,
+            memory::available_bytes(),
+        )?;
         let mut nodes = Vec::with_capacity(nx * ny);
         for &y in &ys {
             for &x in &xs {

@@ -320,6 +320,14 @@ fn beam_basis(fk: &str, f: &FlexSpec) -> Result<ModalBasis> {
         rho_a: get("rho_a", f.rho_a)?,
     };
     beam.validate(fk)?;
+    use crate::study::memory;
+    memory::require_fits(
+        &format!("{fk}.modes"),
+        f.modes,
+        &format!("a closed-form beam with {} modes per plane", f.modes),
+        memory::beam_bytes(f.modes),
+        memory::available_bytes(),
+    )?;
     let rho_ip = f.rho_ip.unwrap_or(0.0);
     if !(rho_ip.is_finite() && rho_ip > 0.0) {
         return Err(Error::input(

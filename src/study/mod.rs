@@ -9,6 +9,8 @@
 //!
 //! Every error names the file, the key, the value and what was expected.
 
+pub mod memory;
+
 use crate::error::{Error, Result};
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
