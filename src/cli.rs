@@ -316,6 +316,7 @@ fn handlers() -> Vec<(&'static str, Handler)> {
         ("events_bench", run_events_bench_handler),
         ("scene_convergence", run_scene_convergence_handler),
         ("eval_bench", run_eval_bench_handler),
+        ("gradient_check", run_gradient_check_handler),
     ]
 }
 
@@ -328,6 +329,11 @@ fn run_scene_convergence_handler(cfg: &RunConfig) -> Result<()> {
 /// The `[eval_bench]` section: cost of one design evaluation, by stage.
 fn run_eval_bench_handler(cfg: &RunConfig) -> Result<()> {
     crate::sections::eval_bench::run_eval_bench_section(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
+}
+
+/// The `[gradient_check]` section: fixed- against updated-mode gradients.
+fn run_gradient_check_handler(cfg: &RunConfig) -> Result<()> {
+    crate::sections::gradient_check::run_gradient_check(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
 }
 
 /// The `[events_bench]` section: Eq. 32 segment changes as events or not.
@@ -421,6 +427,7 @@ pub fn check_study(study: &Study) -> Result<()> {
             "kernel_bench" => sections::kernel_bench::check(study).map(|_| ())?,
             "events_bench" => sections::events_bench::check(study).map(|_| ())?,
             "eval_bench" => sections::eval_bench::check(study).map(|_| ())?,
+            "gradient_check" => sections::gradient_check::check(study).map(|_| ())?,
             "scene_convergence" => sections::scene_convergence::check(study).map(|_| ())?,
             k if EXPLORE.contains(&k) => {
                 crate::explore::check(study, "problem")?;

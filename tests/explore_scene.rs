@@ -415,3 +415,40 @@ fn fused_sensitivities_give_the_staggered_gradient() {
         }
     }
 }
+
+/// `[gradient_check]` on the coarse problem: the updated-mode gradient
+/// agrees with the section's central differences (tight tolerances here),
+/// the fixed-mode one is the approximation it is (its error is larger than
+/// the updated one's), and both tables are written with every row.
+#[test]
+fn gradient_check_section_compares_fixed_and_updated_modes() {
+    let dir = std::env::temp_dir().join(format!("plyscape-gradcheck-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("coarse.toml"), coarse()).unwrap();
+    let text = "[study]\nname = \"gc\"\n[gradient_check]\nproblems = [\"coarse.toml\"]\n\
+                step_deg = 1e-3\nrepeats = 1\n";
+    std::fs::write(dir.join("gc.toml"), text).unwrap();
+    let s = Study::load(dir.join("gc.toml")).unwrap();
+    plyscape::sections::gradient_check::run_gradient_check(&s, &dir, true).unwrap();
+    let csv = std::fs::read_to_string(dir.join("gc/gradient_check.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    // 3 kinds (central, updated, fixed) × 2 functions × 2 variables.
+    assert_eq!(rows.len(), 12, "{csv}");
+    let max_rel = |kind: &str| {
+        rows.iter()
+            .filter(|r| r[2] == kind)
+            .map(|r| r[8].parse::<f64>().unwrap())
+            .fold(0.0f64, f64::max)
+    };
+    let (updated, fixed) = (max_rel("updated"), max_rel("fixed"));
+    assert!(
+        updated < 1e-4,
+        "updated-mode gradient vs central: {updated}"
+    );
+    assert!(fixed > 10.0 * updated, "fixed {fixed} vs updated {updated}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -280,6 +280,12 @@ impl SceneProblem {
         self.plan.set_sensitivity_form(form);
     }
 
+    /// Compute the panels' mode derivatives by `update` from now on
+    /// (fixed: Eq. 19, eigenvalue derivatives only; updated: Eq. 18).
+    pub fn set_mode_update(&mut self, update: crate::modal::ModeUpdate) {
+        self.plan.set_mode_update(update);
+    }
+
     /// The start design \[deg\].
     pub fn start(&self) -> &[f64] {
         &self.start

@@ -94,6 +94,16 @@ impl ScenePlan {
         self.spec.integrator.sensitivity_form = Some(form);
     }
 
+    /// Compute the mode derivatives of every panel body that has them by
+    /// `update` from now on (overrides each body's `derivatives`).
+    pub fn set_mode_update(&mut self, update: ModeUpdate) {
+        for b in &mut self.spec.bodies {
+            if let Some(f) = b.flexible.as_mut().filter(|f| f.derivatives_name.is_some()) {
+                f.derivatives_name = Some(update.name().to_string());
+            }
+        }
+    }
+
     /// The `[[panels]]` entries, in file order, with the study's lay-ups.
     pub fn panels(&self) -> &[Panel] {
         &self.panels

@@ -2,7 +2,8 @@
 //! `[convergence]`), the kernel benchmark
 //! (`[kernel_bench]`), the Eq. 32 events benchmark (`[events_bench]`) and
 //! the flexible-scene convergence grid (`[scene_convergence]`) and the
-//! cost of one design evaluation (`[eval_bench]`). Each
+//! cost of one design evaluation (`[eval_bench]`), and the fixed- against
+//! updated-mode gradients (`[gradient_check]`). Each
 //! reads its section, runs scenes through [`crate::scene`] and
 //! [`crate::simulate`], and writes its table through [`crate::report`].
 //!
@@ -11,6 +12,7 @@
 
 pub mod eval_bench;
 pub mod events_bench;
+pub mod gradient_check;
 pub mod kernel_bench;
 pub mod modes;
 pub mod scene_convergence;
