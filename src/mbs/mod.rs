@@ -37,7 +37,7 @@
 //! Where things go: a new joint type is a [`JointKind`] variant with its
 //! equation count in [`model`] and its constraint rows in [`rows`]
 //! (assembled in [`dynamics`]); a new force element is a [`Force`] variant
-//! applied in [`dynamics`]; the scene names both ([`crate::scene`]).
+//! applied in [`forces`]; the scene names both ([`crate::scene`]).
 //!
 //! ## Limitations
 //! - Linear elasticity in a floating frame: no geometric stiffening, so a
@@ -60,6 +60,7 @@ pub mod beam;
 pub mod dynamics;
 pub mod flex;
 pub mod flexdyn;
+pub mod forces;
 pub mod linalg;
 pub mod model;
 pub mod ode;
