@@ -2,7 +2,7 @@
 //! per-state outputs: joint angles and rates, reactions, energy and
 //! constraint violation.
 
-use super::dynamics::{angle_of, BodyKin, System, Workspace, RANK_REG, RANK_TOL};
+use super::dynamics::{angle_of, slide_of, BodyKin, System, Workspace, RANK_REG, RANK_TOL};
 use super::linalg::Scalar;
 use super::model::{Force, JointKind};
 use crate::error::{Error, Result};
@@ -167,7 +167,7 @@ impl System {
     }
 
     /// Mechanical energy: kinetic + strain (`½ wᵀΛw`) + gravity potential
-    /// + linear springs (J).
+    /// + linear springs between markers and along joints (J).
     pub fn energy(&self, y: &[f64], ws: &mut Workspace<f64>) -> f64 {
         self.kinematics(y, ws);
         self.mass_factors(ws);
@@ -212,6 +212,16 @@ impl System {
                 } => {
                     let l = (ws.mk[*j].x - ws.mk[*i].x).norm();
                     e += 0.5 * stiffness * (l - length).powi(2);
+                }
+                Force::JointSpring {
+                    joint,
+                    stiffness,
+                    length,
+                    ..
+                } => {
+                    let jt = &self.model.joints[*joint];
+                    let (s, _) = slide_of(&ws.mk[jt.i], &ws.mk[jt.j]);
+                    e += 0.5 * stiffness * (s - length).powi(2);
                 }
                 _ => {}
             }
@@ -298,6 +308,7 @@ impl System {
         let forces_ok = self.model.forces.iter().all(|f| match f {
             Force::Gravity { .. } => true,
             Force::SpringDamper { damping, .. } => *damping == 0.0,
+            Force::JointSpring { damping, force, .. } => *damping == 0.0 && *force == 0.0,
             _ => false,
         });
         let modal_ok = self
@@ -346,6 +357,14 @@ impl System {
         self.kinematics(y, ws);
         let j = &self.model.joints[joint];
         angle_of(&ws.mk[j.i], &ws.mk[j.j])
+    }
+
+    /// Displacement (m) and rate (m/s) of a prismatic or cylindrical
+    /// joint along its axis.
+    pub fn slide(&self, y: &[f64], joint: usize, ws: &mut Workspace<f64>) -> (f64, f64) {
+        self.kinematics(y, ws);
+        let j = &self.model.joints[joint];
+        slide_of(&ws.mk[j.i], &ws.mk[j.j])
     }
 
     /// Reactions of every joint at `(t, y)` (one right-hand-side solve).

@@ -40,9 +40,9 @@
 
 use super::flexdyn::{flex_terms, FlexEffects, FlexState, InvT};
 use super::linalg::{cst, euler_rate, rotation, rotation_tangent, rotation_vector, Scalar};
-use super::model::{JointKind, Model, Param};
-pub use super::rows::angle_of;
-use super::rows::{angle_row, dot_row, point_row};
+use super::model::{Model, Param};
+use super::rows::joint_rows;
+pub use super::rows::{angle_of, slide_of};
 pub use super::workspace::{
     BodyKin, Counters, MarkerKin, NodeShapes, Row, Workspace, RANK_REG, RANK_TOL, RIGID,
 };
@@ -401,6 +401,15 @@ impl System {
         angle_of(&mi, &mj)
     }
 
+    /// Displacement `s` (m) of prismatic or cylindrical joint `jt` along
+    /// its axis and its rate `ṡ` (m/s) ([`slide_of`]).
+    pub fn joint_slide<T: Scalar>(&self, kin: &[BodyKin<T>], jt: usize) -> (T, T) {
+        let joint = &self.model.joints[jt];
+        let mi = self.marker_kin(kin, joint.i);
+        let mj = self.marker_kin(kin, joint.j);
+        slide_of(&mi, &mj)
+    }
+
     /// Assemble all constraint rows at time `t` into `ws.rows` (marker
     /// kinematics from `ws.mk`).
     pub fn constraints<T: Scalar>(&self, t: f64, ws: &mut Workspace<T>) {
@@ -408,32 +417,9 @@ impl System {
         ws.mjac.clear();
         let alpha = self.model.baumgarte;
         for joint in &self.model.joints {
-            let mi = &ws.mk[joint.i];
-            let mj = &ws.mk[joint.j];
             let first = ws.rows.len();
-            for k in 0..3 {
-                ws.rows.push(point_row(mi, mj, k));
-            }
-            let (xi, yi) = (mi.frame.column(0).into(), mi.frame.column(1).into());
-            let (yj, zj) = (mj.frame.column(1).into(), mj.frame.column(2).into());
-            match &joint.kind {
-                JointKind::Spherical => {}
-                JointKind::Revolute => {
-                    ws.rows.push(dot_row(mi, mj, &xi, &zj));
-                    ws.rows.push(dot_row(mi, mj, &yi, &zj));
-                }
-                JointKind::Fixed => {
-                    ws.rows.push(dot_row(mi, mj, &xi, &zj));
-                    ws.rows.push(dot_row(mi, mj, &yi, &zj));
-                    ws.rows.push(dot_row(mi, mj, &xi, &yj));
-                }
-                JointKind::Driven(drive) => {
-                    ws.rows.push(dot_row(mi, mj, &xi, &zj));
-                    ws.rows.push(dot_row(mi, mj, &yi, &zj));
-                    let (f, df, ddf) = drive.eval(t);
-                    ws.rows.push(angle_row(mi, mj, (f, df, ddf)));
-                }
-            }
+            let markers = (&ws.mk[joint.i], &ws.mk[joint.j]);
+            joint_rows(&joint.kind, markers, t, &mut ws.rows);
             for row in &mut ws.rows[first..] {
                 row.markers = [joint.i, joint.j];
             }

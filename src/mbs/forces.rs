@@ -2,7 +2,8 @@
 //! rigid bodies, the inertia, elastic and damping forces of flexible
 //! bodies ([`super::flexdyn`]), and the force elements of
 //! [`Model::forces`](super::model::Model) (gravity, loads, the Eq. 32
-//! actuator, spring-dampers), one function per element. Forces are
+//! actuator, spring-dampers between markers and along joints), one
+//! function per element. Forces are
 //! accumulated in the velocity layout of the state (`[ṙ, ω', ẇ]` per
 //! body: force in global axes (N), torque in body axes (N·m), modal
 //! forces), at a marker through [`System::apply_force`] and
@@ -12,9 +13,9 @@
 //! Every value a sensitivity parameter can replace is read through
 //! [`pval`], so a dual-number evaluation differentiates it exactly.
 
-use super::dynamics::{angle_of, bump, pval, System, Workspace};
+use super::dynamics::{angle_of, bump, pval, slide_of, System, Workspace};
 use super::linalg::{cst, Scalar};
-use super::model::{Force, Load, Param, PiecewiseLaw};
+use super::model::{Force, Load, LoadFrame, Param, PiecewiseLaw};
 use nalgebra::Vector3;
 
 impl System {
@@ -31,7 +32,14 @@ impl System {
         for (fi, force) in self.model.forces.iter().enumerate() {
             match force {
                 Force::Gravity { g } => self.gravity(ws, g),
-                Force::BodyLoad { body, load } => self.body_load(t, ws, *body, load),
+                Force::BodyLoad { body, load, frame } => {
+                    self.body_load(t, ws, *body, (load, *frame))
+                }
+                Force::MarkerLoad {
+                    marker,
+                    load,
+                    frame,
+                } => self.marker_load(t, ws, *marker, (load, *frame)),
                 Force::Rotational {
                     joint,
                     law,
@@ -44,6 +52,13 @@ impl System {
                     damping,
                     length,
                 } => self.spring_damper(ws, fi, [*i, *j], [*stiffness, *damping, *length]),
+                Force::JointSpring {
+                    joint,
+                    stiffness,
+                    damping,
+                    length,
+                    force,
+                } => self.joint_spring(ws, fi, *joint, [*stiffness, *damping, *length, *force]),
             }
         }
     }
@@ -99,15 +114,38 @@ impl System {
         }
     }
 
-    /// A global force (N) at the centre of mass and a global torque (N·m)
-    /// on `body`. On a flexible body the force is distributed in
-    /// proportion to mass (modal forces `i3ᵀ Aᵀf / m`, torque of the
+    /// The load `(f, τ)` at time `t` in global axes: as given, or turned
+    /// from the axes of slot `s` (`A f`, `A τ`).
+    fn load_global<T: Scalar>(
+        &self,
+        t: f64,
+        ws: &Workspace<T>,
+        s: usize,
+        (load, frame): (&Load, LoadFrame),
+    ) -> (Vector3<T>, Vector3<T>) {
+        let (f, tau) = load.eval(t);
+        let (f, tau) = (f.map(cst::<T>), tau.map(cst::<T>));
+        match frame {
+            LoadFrame::Global => (f, tau),
+            LoadFrame::Body => (ws.kin[s].a * f, ws.kin[s].a * tau),
+        }
+    }
+
+    /// A force (N) at the centre of mass and a torque (N·m) on `body`
+    /// ([`Force::BodyLoad`]). On a flexible body the force is distributed
+    /// in proportion to mass (modal forces `i3ᵀ Aᵀf / m`, torque of the
     /// centre of mass's offset from the frame origin).
-    fn body_load<T: Scalar>(&self, t: f64, ws: &mut Workspace<T>, body: usize, load: &Load) {
+    fn body_load<T: Scalar>(
+        &self,
+        t: f64,
+        ws: &mut Workspace<T>,
+        body: usize,
+        load: (&Load, LoadFrame),
+    ) {
         bump(&self.counters.loads);
         let Some(s) = self.slot[body] else { return };
-        let (force, torque) = load.eval(t);
-        let tb = ws.kin[s].a.transpose() * torque.map(cst::<T>);
+        let (force, torque) = self.load_global(t, ws, s, load);
+        let tb = ws.kin[s].a.transpose() * torque;
         let o = self.vel_local(s);
         // A flexible body's frame origin is not its centre of mass: the
         // force acts at the centre of mass.
@@ -115,10 +153,10 @@ impl System {
             Some(inv) if self.modes[s] > 0 => Some(inv.first_moment(&ws.kin[s].q) / inv.mass),
             _ => None,
         };
-        let fb = ws.kin[s].a.transpose() * force.map(cst::<T>);
+        let fb = ws.kin[s].a.transpose() * force;
         let extra = arm.map_or(Vector3::zeros(), |c| c.cross(&fb));
         for c in 0..3 {
-            ws.q[o + c] += cst::<T>(force[c]);
+            ws.q[o + c] += force[c];
             ws.q[o + 3 + c] += tb[c] + extra[c];
         }
         if let Some(inv) = ws.inv.get(s).and_then(|i| i.as_ref()) {
@@ -130,6 +168,23 @@ impl System {
                 }
             }
         }
+    }
+
+    /// A force (N) at the point of `marker` and a torque (N·m) on its body
+    /// ([`Force::MarkerLoad`]): [`System::apply_force`] adds the moment
+    /// of the marker's offset and the modal forces of a flexible node.
+    fn marker_load<T: Scalar>(
+        &self,
+        t: f64,
+        ws: &mut Workspace<T>,
+        marker: usize,
+        load: (&Load, LoadFrame),
+    ) {
+        bump(&self.counters.loads);
+        let Some(s) = ws.mk[marker].slot else { return };
+        let (force, torque) = self.load_global(t, ws, s, load);
+        self.apply_force(ws, marker, &force);
+        self.apply_torque(ws, marker, &torque);
     }
 
     /// The Eq. 32 spring-damper-actuator `forces[fi]` on revolute joint
@@ -186,6 +241,33 @@ impl System {
         let f = u * tension; // on i, towards j
         self.apply_force(ws, i, &f);
         self.apply_force(ws, j, &(-f));
+    }
+
+    /// Spring-damper-actuator `forces[fi]` along the axis of prismatic or
+    /// cylindrical joint `joint` ([`Force::JointSpring`]): tension
+    /// `T = k(s − s0) − f + c·ṡ` (N); `−T z_i` at marker j, `+T z_i` at
+    /// marker i, torque `−T z_i×d` on marker i (`d = x_j − x_i`), so that
+    /// the generalized force is exactly `−T ∂s/∂q`.
+    fn joint_spring<T: Scalar>(
+        &self,
+        ws: &mut Workspace<T>,
+        fi: usize,
+        joint: usize,
+        [stiffness, damping, length, force]: [f64; 4],
+    ) {
+        bump(&self.counters.springs);
+        let jt = &self.model.joints[joint];
+        let (mi, mj) = (ws.mk[jt.i], ws.mk[jt.j]);
+        let (s, sdot) = slide_of(&mi, &mj);
+        let k = pval(&ws.params, Param::Stiffness(fi), stiffness);
+        let c = pval(&ws.params, Param::Damping(fi), damping);
+        let tension = k * (s - cst::<T>(length)) - cst::<T>(force) + c * sdot;
+        let zi: Vector3<T> = mi.frame.column(2).into();
+        let f = zi * tension;
+        self.apply_force(ws, jt.i, &f);
+        self.apply_force(ws, jt.j, &(-f));
+        let d = mj.x - mi.x;
+        self.apply_torque(ws, jt.i, &(-zi.cross(&d) * tension));
     }
 
     /// Add a global torque on the carrier of marker `m` (and on the modes

@@ -74,5 +74,6 @@ pub use analysis::{Projection, Reaction};
 pub use dynamics::{System, Workspace};
 pub use flex::{BasisDerivative, Invariants, ModalBasis};
 pub use model::{
-    Body, Drive, Force, Joint, JointKind, Marker, Model, Param, PiecewiseLaw, Segment,
+    Body, Drive, Force, Joint, JointKind, Load, LoadFrame, Marker, Model, Param, PiecewiseLaw,
+    Segment,
 };

@@ -93,6 +93,7 @@
 //! ```
 
 pub mod build;
+pub mod forces;
 pub mod load;
 pub mod parts;
 pub mod quantity;

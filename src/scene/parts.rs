@@ -42,6 +42,18 @@ pub(super) fn parse_param(
         let b = model.body(body)?;
         return model.bodies[b].flex.is_none().then_some(Param::Mass(b));
     }
+    for (suffix, which) in [
+        (".stiffness", Param::Stiffness as fn(usize) -> Param),
+        (".damping", Param::Damping),
+    ] {
+        let Some(force) = name.strip_suffix(suffix) else {
+            continue;
+        };
+        if let Some(k) = forces.iter().position(|f| f.name() == Some(force)) {
+            let p = which((*force_index.get(k)?)?);
+            return p.value(model).map(|_| p);
+        }
+    }
     if let Some((body, var)) = name.split_once(".design.") {
         let b = model.body(body)?;
         let flex = model.bodies[b].flex.as_ref()?;
@@ -96,12 +108,27 @@ pub(super) fn parse_quantity(
         Error::input(
             key,
             q,
-            "energy, violation, <joint>.angle|rate|reaction, <body>.position, \
+            "energy, violation, <joint>.angle|rate|reaction, \
+             <prismatic or cylindrical joint>.displacement|velocity, <body>.position, \
              <flexible body>.modal|strain_energy or <marker on a flexible node>.deflection",
         )
     };
     let (name, what) = q.rsplit_once('.').ok_or_else(bad)?;
     match what {
+        "displacement" | "velocity" => {
+            let j = model.joint(name).ok_or_else(bad)?;
+            if !model.joints[j].kind.has_slide() {
+                return Err(Error::input(
+                    key,
+                    q,
+                    "a displacement or velocity of a prismatic or cylindrical joint",
+                ));
+            }
+            Ok(match what {
+                "displacement" => Quantity::Displacement(j),
+                _ => Quantity::Velocity(j),
+            })
+        }
         "angle" | "rate" | "reaction" => {
             let j = model.joint(name).ok_or_else(bad)?;
             if what != "reaction" && !model.joints[j].kind.has_angle() {

@@ -28,6 +28,10 @@ impl Response {
 pub enum Quantity {
     Angle(usize),
     Rate(usize),
+    /// Displacement of a prismatic or cylindrical joint along its axis (m).
+    Displacement(usize),
+    /// Its rate (m/s).
+    Velocity(usize),
     /// Reaction force (3) and torque (3) of a joint.
     Reaction(usize),
     /// Global position of a body's centre of mass (of a flexible body:
@@ -50,6 +54,8 @@ impl Quantity {
         match self {
             Quantity::Angle(_) => vec![format!("{label} [rad]")],
             Quantity::Rate(_) => vec![format!("{label} [rad/s]")],
+            Quantity::Displacement(_) => vec![format!("{label} [m]")],
+            Quantity::Velocity(_) => vec![format!("{label} [m/s]")],
             Quantity::Reaction(_) => {
                 let base = label.trim_end_matches(".reaction");
                 let mut h: Vec<String> = ["x", "y", "z"]

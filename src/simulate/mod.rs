@@ -174,8 +174,9 @@ fn unwrap_angles(row: &mut [f64], prev: &[f64], columns: &[usize]) {
     }
 }
 
-/// The output columns that have sensitivities (angles, rates, positions,
-/// modal coordinates, strain energies, deflections).
+/// The output columns that have sensitivities (angles, rates, joint
+/// displacements and velocities, positions, modal coordinates, strain
+/// energies, deflections).
 fn sens_quantities(scene: &Scene) -> Vec<(String, Quantity)> {
     scene
         .outputs
@@ -185,6 +186,8 @@ fn sens_quantities(scene: &Scene) -> Vec<(String, Quantity)> {
                 q,
                 Quantity::Angle(_)
                     | Quantity::Rate(_)
+                    | Quantity::Displacement(_)
+                    | Quantity::Velocity(_)
                     | Quantity::Position(_)
                     | Quantity::Modal(..)
                     | Quantity::Strain(_)
@@ -227,6 +230,8 @@ fn output_row(
         match q {
             Quantity::Angle(j) => row.push(sys.angle(y, *j, ws).0),
             Quantity::Rate(j) => row.push(sys.angle(y, *j, ws).1),
+            Quantity::Displacement(j) => row.push(sys.slide(y, *j, ws).0),
+            Quantity::Velocity(j) => row.push(sys.slide(y, *j, ws).1),
             Quantity::Reaction(j) => {
                 let r = reactions.map(|r| r[*j]).unwrap_or(Reaction {
                     force: Default::default(),
@@ -324,6 +329,8 @@ fn output_sensitivities(
         match q {
             Quantity::Angle(j) => out.push(sys.joint_angle(&kin, *j).0.eps),
             Quantity::Rate(j) => out.push(sys.joint_angle(&kin, *j).1.eps),
+            Quantity::Displacement(j) => out.push(sys.joint_slide(&kin, *j).0.eps),
+            Quantity::Velocity(j) => out.push(sys.joint_slide(&kin, *j).1.eps),
             Quantity::Position(b) => match sys.slot[*b] {
                 Some(k) => {
                     let p = sys.pos_off(k);
