@@ -38,6 +38,7 @@
 //! Everything is generic over the scalar `T` so that `num_dual::Dual64`
 //! gives exact Jacobian-vector products of the right-hand side.
 
+use super::energy::quadratic_form;
 use super::flexdyn::{flex_terms, FlexEffects, FlexState, InvT};
 use super::linalg::{cst, euler_rate, rotation, rotation_tangent, rotation_vector, Scalar};
 use super::model::{Model, Param};
@@ -481,6 +482,7 @@ impl System {
     /// (added to `ws.q`). `ws.q` must be sized.
     pub(crate) fn flex_bodies<T: Scalar>(&self, ws: &mut Workspace<T>, forces: bool) {
         ws.mfac.resize_with(self.nb(), Vec::new);
+        ws.kinetic.resize(self.nb(), T::zero());
         for s in 0..self.nb() {
             let n = self.modes[s];
             if n == 0 {
@@ -514,6 +516,10 @@ impl System {
                     wd: &k.qd,
                 };
                 flex_terms(inv, &st, eff, &mut mass, &mut fq);
+                let v: Vec<T> = (k.v.iter().chain(k.wb.iter()).chain(&k.qd))
+                    .copied()
+                    .collect();
+                ws.kinetic[s] = quadratic_form(&mass, &v, d);
             }
             // A non-positive pivot leaves a NaN in the factor, which the
             // integrator reports with the time.
@@ -580,12 +586,10 @@ impl System {
         dy[vo..vo + self.nvel].copy_from_slice(&acc);
         let io = self.integral_off();
         for (i, integral) in self.model.integrals.iter().enumerate() {
-            let mut v = T::zero();
-            for &b in &integral.bodies {
-                if let Some(s) = self.slot[b] {
-                    v += self.strain_energy_dual(y, s, &ws.kin[s].design);
-                }
-            }
+            let v = integral
+                .terms
+                .iter()
+                .fold(T::zero(), |acc, e| acc + self.energy_term(*e, y, ws));
             dy[io + i] = v * cst::<T>(integral.scale);
         }
     }

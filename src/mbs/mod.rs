@@ -58,6 +58,7 @@
 pub mod analysis;
 pub mod beam;
 pub mod dynamics;
+pub mod energy;
 pub mod flex;
 pub mod flexdyn;
 pub mod forces;
@@ -72,6 +73,7 @@ pub mod workspace;
 
 pub use analysis::{Projection, Reaction};
 pub use dynamics::{System, Workspace};
+pub use energy::Energy;
 pub use flex::{BasisDerivative, Invariants, ModalBasis};
 pub use model::{
     Body, Drive, Force, Joint, JointKind, Load, LoadFrame, Marker, Model, Param, PiecewiseLaw,

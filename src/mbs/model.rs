@@ -14,6 +14,7 @@
 //!   displacement is `s = z_i·(x_j − x_i)` (m), zero at the start (a
 //!   scene makes both markers at the joint point).
 
+use super::energy::Energy;
 use super::flex::{Invariants, ModalBasis};
 use crate::error::{Error, Result};
 use nalgebra::{Matrix3, Vector3};
@@ -539,12 +540,13 @@ pub struct Model {
     pub ties: Vec<Vec<(usize, usize)>>,
 }
 
-/// `∫ scale · Σ_b U_b dt` over the strain energies `U_b = ½ wᵀΛw` of the
-/// flexible bodies `bodies` (the paper's objective Ψ₀ = ∫ 2U dt, Eq. 33,
-/// is `scale = 2`). Rigid bodies contribute zero.
+/// `∫ scale · Σ terms dt` over energy terms (strain and kinetic energies
+/// of bodies, [`Energy`]): the paper's objective Ψ₀ = ∫ 2U dt (Eq. 33) is
+/// the strain energies of the flexible bodies with `scale = 2`; the
+/// IDAS slider-crank's `G = ∫ T dt` the kinetic energies with 1.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Integral {
-    pub bodies: Vec<usize>,
+    pub terms: Vec<Energy>,
     pub scale: f64,
 }
 

@@ -3,7 +3,9 @@
 //! responses and sensitivity parameters, in that order; each step names
 //! the key below `scene` in its errors.
 
-use super::parts::{finite3, flexible_body, make_marker, parse_param, parse_quantity, PanelBases};
+use super::parts::{
+    finite3, flexible_body, make_marker, parse_energy, parse_param, parse_quantity, PanelBases,
+};
 use super::quantity::{Quantity, Response};
 use super::spec::{Effect, JointSpec, SceneSpec};
 use crate::error::{Error, Result};
@@ -345,49 +347,38 @@ impl SceneSpec {
                     "a finite factor",
                 ));
             }
-            let mut bodies = Vec::new();
+            let mut terms = Vec::new();
             for (i, q) in r.of.iter().enumerate() {
-                let body = q
-                    .strip_suffix(".strain_energy")
-                    .filter(|b| flex_names.contains(b))
-                    .and_then(|b| model.body(b))
-                    .ok_or_else(|| {
-                        Error::input(
-                            format!("{key}.of[{i}]"),
-                            q,
-                            "<body>.strain_energy of a body with a `flexible` table",
-                        )
-                    })?;
-                bodies.push(body);
+                terms.extend(parse_energy(model, flex_names, q).ok_or_else(|| {
+                    Error::input(
+                        format!("{key}.of[{i}]"),
+                        q,
+                        "kinetic_energy (all bodies), <body>.kinetic_energy or \
+                         <body>.strain_energy of a body with a `flexible` table",
+                    )
+                })?);
             }
-            if bodies.is_empty() {
+            if r.of.is_empty() {
                 return Err(Error::input(
                     format!("{key}.of"),
                     "[]",
-                    "at least one strain energy",
+                    "at least one energy",
                 ));
             }
+            let (name, scale) = (r.name.clone(), r.scale);
             out.push(match r.kind.as_str() {
                 "integral" => {
-                    model.integrals.push(Integral {
-                        bodies,
-                        scale: r.scale,
-                    });
-                    Response::Integral {
-                        name: r.name.clone(),
-                        index: model.integrals.len() - 1,
-                    }
+                    model.integrals.push(Integral { terms, scale });
+                    let index = model.integrals.len() - 1;
+                    Response::Integral { name, index }
                 }
-                "peak" => Response::Peak {
-                    name: r.name.clone(),
-                    bodies,
-                    scale: r.scale,
-                },
+                "peak" => Response::Peak { name, terms, scale },
+                "final" => Response::Final { name, terms, scale },
                 other => {
                     return Err(Error::input(
                         format!("{key}.kind"),
                         other,
-                        "integral or peak",
+                        "integral, peak or final",
                     ));
                 }
             });

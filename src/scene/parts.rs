@@ -9,6 +9,7 @@ use crate::mbs::beam::Beam;
 use crate::mbs::flex::ModalBasis;
 use crate::mbs::linalg::euler_from_rotation;
 use crate::mbs::model::{Body, Flex, Force, Marker, Model, Param};
+use crate::mbs::Energy;
 use crate::modal::ModeUpdate;
 use nalgebra::{Matrix3, Vector3};
 
@@ -102,6 +103,7 @@ pub(super) fn parse_quantity(
     match q {
         "energy" => return Ok(Quantity::Energy),
         "violation" => return Ok(Quantity::Violation),
+        "kinetic_energy" => return Ok(Quantity::Kinetic(None)),
         _ => {}
     }
     let bad = || {
@@ -110,7 +112,8 @@ pub(super) fn parse_quantity(
             q,
             "energy, violation, <joint>.angle|rate|reaction, \
              <prismatic or cylindrical joint>.displacement|velocity, <body>.position, \
-             <flexible body>.modal|strain_energy or <marker on a flexible node>.deflection",
+             kinetic_energy, <body>.kinetic_energy, <flexible body>.modal|strain_energy or \
+             <marker on a flexible node>.deflection",
         )
     };
     let (name, what) = q.rsplit_once('.').ok_or_else(bad)?;
@@ -148,6 +151,10 @@ pub(super) fn parse_quantity(
             let b = model.body(name).ok_or_else(bad)?;
             Ok(Quantity::Position(b))
         }
+        "kinetic_energy" => {
+            let b = model.body(name).ok_or_else(bad)?;
+            Ok(Quantity::Kinetic(Some(b)))
+        }
         "modal" | "strain_energy" => {
             let b = model.body(name).ok_or_else(bad)?;
             let n = match &model.bodies[b].flex {
@@ -172,6 +179,22 @@ pub(super) fn parse_quantity(
         }
         _ => Err(bad()),
     }
+}
+
+/// An energy name → its terms: `kinetic_energy` (every moving body),
+/// `<body>.kinetic_energy`, or `<body>.strain_energy` of a body named in
+/// `flex_names` (a `flexible` table; zero when the scene runs it rigid).
+pub(super) fn parse_energy(model: &Model, flex_names: &[&str], q: &str) -> Option<Vec<Energy>> {
+    if q == "kinetic_energy" {
+        return Some(Energy::kinetic_total(model));
+    }
+    if let Some(b) = q.strip_suffix(".kinetic_energy") {
+        return Some(vec![Energy::Kinetic(model.body(b)?)]);
+    }
+    let b = q
+        .strip_suffix(".strain_energy")
+        .filter(|b| flex_names.contains(b))?;
+    Some(vec![Energy::Strain(model.body(b)?)])
 }
 
 /// A marker `(name, body)` at the global point `p` with global frame

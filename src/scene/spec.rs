@@ -132,10 +132,13 @@ pub struct SceneSpec {
     pub responses: Vec<ResponseSpec>,
 }
 
-/// `[[scene.responses]] name = "psi0"; kind = "integral" | "peak";
-/// of = ["B2.strain_energy", ..]; scale = 2.0`: the time integral (as an
-/// extra integrated state) or the largest value over the run (located
-/// from dense output) of `scale · Σ` the listed strain energies.
+/// `[[scene.responses]] name = "psi0"; kind = "integral" | "peak" |
+/// "final"; of = ["B2.strain_energy", "crank.kinetic_energy",
+/// "kinetic_energy", ..]; scale = 2.0`: the time integral (as an extra
+/// integrated state), the largest value over the run (located from dense
+/// output) or the value at the end time of `scale · Σ` the listed
+/// energies (strain energies of flexible bodies, kinetic energies of a
+/// body or of all bodies).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ResponseSpec {
