@@ -268,13 +268,16 @@ impl SceneSpec {
                 | Quantity::Rate(_)
                 | Quantity::Displacement(_)
                 | Quantity::Velocity(_)
+                | Quantity::Strain(_)
+                | Quantity::Kinetic(_)
                 | Quantity::Energy
                 | Quantity::Violation => {}
                 _ => {
                     return Err(Error::input(
                         "outputs.plot",
                         p,
-                        "a scalar output (angle, rate, displacement, velocity, energy, violation)",
+                        "a scalar output (angle, rate, displacement, velocity, strain or \
+                         kinetic energy, energy, violation)",
                     ))
                 }
             }
