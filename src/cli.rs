@@ -281,7 +281,13 @@ fn handlers() -> Vec<(&'static str, Handler)> {
         ("events_bench", run_events_bench_handler),
         ("scene_convergence", run_scene_convergence_handler),
         ("eval_bench", run_eval_bench_handler),
+        ("sens_bench", run_sens_bench_handler),
     ]
+}
+
+/// The `[sens_bench]` section: plain run and both sensitivity forms timed.
+fn run_sens_bench_handler(cfg: &RunConfig) -> Result<()> {
+    crate::sections::sens_bench::run_sens_bench_section(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
 }
 
 /// The `[scene_convergence]` section: responses vs mesh and modes, with cost.

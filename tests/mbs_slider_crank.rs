@@ -188,3 +188,31 @@ fn tolerance_sweep_explains_the_difference_to_idas() {
     assert!(errors[2] < 1e-11, "{errors:?}");
     assert!(idas > 1e-6 && idas < 1e-5 && idas < 2.0 * bdf6, "{idas:e}");
 }
+
+#[test]
+fn sens_bench_times_the_plain_run_and_both_forms() {
+    // The study's [sens_bench] section, cut to one run at one tolerance:
+    // a plain row (ratio 1) and one row per form with the same G and
+    // gradients (fused = staggered).
+    let path = format!("{}/studies/slider_crank.toml", env!("CARGO_MANIFEST_DIR"));
+    let study = Study::load(path).unwrap();
+    let spec = plyscape::sections::sens_bench::SensBenchSpec {
+        repeats: 1,
+        rtols: vec![1e-6],
+        forms: vec![SensitivityForm::Fused, SensitivityForm::Staggered],
+    };
+    let (header, rows) =
+        plyscape::sections::sens_bench::run_sens_bench(&study, &spec, |_| {}).unwrap();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let forms: Vec<&str> = rows.iter().map(|r| r[col("form")].as_str()).collect();
+    assert_eq!(forms, ["plain", "fused", "staggered"]);
+    assert_eq!(rows[0][col("integrate_ratio")], "1.000");
+    let dk = col("d/d(spring.stiffness)");
+    let (a, b): (f64, f64) = (rows[1][dk].parse().unwrap(), rows[2][dk].parse().unwrap());
+    println!("{header:?}\n{rows:?}");
+    assert!(
+        (a - b).abs() < 1e-10 && (a - 0.33345).abs() < 1e-5,
+        "{a} {b}"
+    );
+    assert!(rows[0][dk].is_empty());
+}

@@ -1,8 +1,9 @@
 //! Study sections: the panel modes table (`plyscape modes`: `[modes]`,
 //! `[convergence]`), the kernel benchmark
 //! (`[kernel_bench]`), the Eq. 32 events benchmark (`[events_bench]`) and
-//! the flexible-scene convergence grid (`[scene_convergence]`) and the
-//! cost of one design evaluation (`[eval_bench]`). Each
+//! the flexible-scene convergence grid (`[scene_convergence]`), the
+//! cost of one design evaluation (`[eval_bench]`) and the cost of a
+//! scene's sensitivities in both forms (`[sens_bench]`). Each
 //! reads its section, runs scenes through [`crate::scene`] and
 //! [`crate::simulate`], and writes its table through [`crate::report`].
 //!
@@ -14,4 +15,5 @@ pub mod events_bench;
 pub mod kernel_bench;
 pub mod modes;
 pub mod scene_convergence;
+pub mod sens_bench;
 pub mod stats;
