@@ -11,7 +11,7 @@
 //! - floating-frame flexible body: `T = ½ vᵀ M(w) v` with the mass
 //!   matrix of [`super::flexdyn`] (configuration-dependent through the
 //!   modal coordinates `w`, design-dependent through the lifted
-//!   invariants), taken before it is factored ([`System::flex_bodies`]).
+//!   invariants), taken before it is factored (`System::flex_bodies`).
 //!
 //! Strain energy: `U = ½ wᵀ Λ w` of a flexible body
 //! ([`System::strain_energy_dual`]).

@@ -6,12 +6,12 @@
 //! function per element. Forces are
 //! accumulated in the velocity layout of the state (`[ṙ, ω', ẇ]` per
 //! body: force in global axes (N), torque in body axes (N·m), modal
-//! forces), at a marker through [`System::apply_force`] and
-//! [`System::apply_torque`], which add the moment of the marker's offset
+//! forces), at a marker through `System::apply_force` and
+//! `System::apply_torque`, which add the moment of the marker's offset
 //! and the modal work through the node's mode shapes.
 //!
 //! Every value a sensitivity parameter can replace is read through
-//! [`pval`], so a dual-number evaluation differentiates it exactly.
+//! `pval`, so a dual-number evaluation differentiates it exactly.
 
 use super::dynamics::{angle_of, bump, pval, slide_of, System, Workspace};
 use super::linalg::{cst, Scalar};

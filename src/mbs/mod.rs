@@ -3,11 +3,14 @@
 //! (paper Eqs. 5–6; [`flex`], [`flexdyn`], bases from closed-form beams
 //! [`beam`] or from composite panels `crate::panels::panel_basis`),
 //! markers (on flexible bodies: on mesh nodes, moving and rotating with the
-//! modes), joints (spherical, revolute, driven/locked revolute, fixed),
-//! force elements (gravity, the paper's Eq. 32 spring-damper-actuator,
-//! linear spring-dampers, constant or time-tabulated loads), the equations
+//! modes), joints (spherical, revolute, driven/locked revolute, fixed,
+//! prismatic, cylindrical), force elements ([`forces`]: gravity, the
+//! paper's Eq. 32 spring-damper-actuator, linear spring-dampers between
+//! markers or along a sliding joint, constant or time-tabulated loads at
+//! a centre of mass or a marker, in global or body axes), the equations
 //! of motion with Lagrange multipliers, consistent initial conditions,
-//! and outputs. It knows nothing of files: scenes are built by
+//! energies ([`energy`]: kinetic and strain, as outputs and response
+//! terms) and outputs. It knows nothing of files: scenes are built by
 //! [`crate::scene`], simulated by [`crate::simulate`].
 //!
 //! ## Method

@@ -1,6 +1,6 @@
 //! Constraint rows of the joints: value, Jacobian blocks per body and the
 //! velocity-dependent part `γ` of the constraint accelerations, and the
-//! rows each joint kind is made of ([`joint_rows`]).
+//! rows each joint kind is made of (`joint_rows`).
 //!
 //! Every row's rate is written as `P·v_point + W·ω_marker` of the two
 //! markers (point velocity, marker frame angular velocity), which
