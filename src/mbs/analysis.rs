@@ -173,8 +173,9 @@ impl System {
         let mut terms = Energy::kinetic_total(&self.model);
         terms.extend(self.moving.iter().map(|&b| Energy::Strain(b)));
         // With a flexible body, its kinetic term also builds the invariants
-        // that `mass_centre` reads.
+        // that `mass_centre` reads; the springs need the markers.
         let mut e = self.energy_sum(&terms, y, ws);
+        self.markers_kin(ws);
         for f in &self.model.forces {
             match f {
                 Force::Gravity { g } => {

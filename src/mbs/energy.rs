@@ -81,10 +81,13 @@ impl System {
     }
 
     /// `Σ terms` at state `y` (J), in any scalar: the parameters (and
-    /// design seeds) are those in `ws.params`. Fills the kinematics of
-    /// `ws` and, when a term needs them, the flexible mass matrices.
+    /// design seeds) are those in `ws.params`. Fills the body kinematics
+    /// of `ws` (not the markers': energies need none) and, when a term
+    /// needs them, the flexible mass matrices.
     pub fn energy_sum<T: Scalar>(&self, terms: &[Energy], y: &[T], ws: &mut Workspace<T>) -> T {
-        self.kinematics(y, ws);
+        let mut kin = std::mem::take(&mut ws.kin);
+        self.body_kin(y, &ws.params, &mut kin);
+        ws.kin = kin;
         let flexible_kinetic = terms.iter().any(|t| match t {
             Energy::Kinetic(b) => self.slot[*b].is_some_and(|s| self.modes[s] > 0),
             Energy::Strain(_) => false,
