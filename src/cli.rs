@@ -317,7 +317,13 @@ fn handlers() -> Vec<(&'static str, Handler)> {
         ("scene_convergence", run_scene_convergence_handler),
         ("eval_bench", run_eval_bench_handler),
         ("gradient_check", run_gradient_check_handler),
+        ("sens_bench", run_sens_bench_handler),
     ]
+}
+
+/// The `[sens_bench]` section: plain run and both sensitivity forms timed.
+fn run_sens_bench_handler(cfg: &RunConfig) -> Result<()> {
+    crate::sections::sens_bench::run_sens_bench_section(&cfg.study, &cfg.out, cfg.quiet).map(|_| ())
 }
 
 /// The `[scene_convergence]` section: responses vs mesh and modes, with cost.
@@ -428,6 +434,7 @@ pub fn check_study(study: &Study) -> Result<()> {
             "events_bench" => sections::events_bench::check(study).map(|_| ())?,
             "eval_bench" => sections::eval_bench::check(study).map(|_| ())?,
             "gradient_check" => sections::gradient_check::check(study).map(|_| ())?,
+            "sens_bench" => sections::sens_bench::check(study).map(|_| ())?,
             "scene_convergence" => sections::scene_convergence::check(study).map(|_| ())?,
             k if EXPLORE.contains(&k) => {
                 crate::explore::check(study, "problem")?;

@@ -106,6 +106,104 @@ fn each_bad_input_names_file_key_and_value() {
     }
 }
 
+/// The whole input error of `text`: (file, key, value, expected).
+fn full_error_of(text: &str) -> (String, String, String, String) {
+    let study = Study::parse("bad.toml", text).unwrap();
+    match load_scene(&study) {
+        Err(Error::Input {
+            file,
+            key,
+            value,
+            expected,
+        }) => (file, key, value, expected),
+        other => panic!("expected an input error, got {other:?}"),
+    }
+}
+
+#[test]
+fn force_and_response_errors_name_key_value_and_the_expected_values() {
+    let spring = |body: &str| {
+        BASE.to_string()
+            + "[[scene.forces]]\ntype = \"spring\"\nname = \"s\"\nstiffness = 1.0\n"
+            + body
+    };
+    let load = |body: &str| BASE.to_string() + "[[scene.forces]]\ntype = \"load\"\n" + body;
+    let cases: Vec<(String, &str, &str, &[&str])> = vec![
+        // A spring along an unknown joint, and along a revolute one.
+        (
+            spring("joint = \"slid\"\n"),
+            "scene.forces[0].joint",
+            "slid",
+            &["prismatic or cylindrical joint", "none in this scene"],
+        ),
+        (
+            spring("joint = \"pin\"\n"),
+            "scene.forces[0].joint",
+            "pin",
+            &["type = \"actuator\""],
+        ),
+        (
+            spring("joint = \"pin\"\nmarker_i = \"pin.i\"\nmarker_j = \"pin.j\"\n"),
+            "scene.forces[0].joint",
+            "pin",
+            &["not both"],
+        ),
+        // A load at an unknown marker lists the markers there are.
+        (
+            load("marker = \"nowhere\"\nforce = [1.0, 0.0, 0.0]\n"),
+            "scene.forces[0].marker",
+            "nowhere",
+            &["pin.i, pin.j"],
+        ),
+        (
+            load("marker = \"pin.j\"\nframe = \"bodyy\"\n"),
+            "scene.forces[0].frame",
+            "bodyy",
+            &["\"global\"", "\"body\""],
+        ),
+        (
+            load("force = [1.0, 0.0, 0.0]\n"),
+            "scene.forces[0].body",
+            "(missing)",
+            &["or marker"],
+        ),
+        (
+            BASE.replace("quantities = [\"pin.angle\"]", "quantities = [\"pin.displacement\"]"),
+            "scene.outputs.quantities[0]",
+            "pin.displacement",
+            &["prismatic or cylindrical"],
+        ),
+        (
+            BASE.to_string() + "[[scene.responses]]\nname = \"G\"\nkind = \"integral\"\nof = [\"rod.kinetic\"]\n",
+            "scene.responses[0].of[0]",
+            "rod.kinetic",
+            &["<body>.kinetic_energy"],
+        ),
+        (
+            BASE.to_string() + "[[scene.responses]]\nname = \"G\"\nkind = \"last\"\nof = [\"kinetic_energy\"]\n",
+            "scene.responses[0].kind",
+            "last",
+            &["integral, peak or final"],
+        ),
+    ];
+    for (text, key, value, expected) in cases {
+        let (file, k, v, e) = full_error_of(&text);
+        println!("{file}: {k} = {v}: expected {e}");
+        assert_eq!(file, "bad.toml");
+        assert_eq!(k, key, "value {v}");
+        assert!(
+            v.contains(value),
+            "key {k}: value {v} should contain {value}"
+        );
+        for x in expected {
+            assert!(
+                e.contains(x),
+                "key {k}: expected '{e}' should contain '{x}'"
+            );
+        }
+    }
+}
+
 #[test]
 fn effects_not_listed_are_not_built_or_evaluated() {
     let with = Study::parse("a.toml", BASE).unwrap();

@@ -2,7 +2,8 @@
 //! per-state outputs: joint angles and rates, reactions, energy and
 //! constraint violation.
 
-use super::dynamics::{angle_of, BodyKin, System, Workspace, RANK_REG, RANK_TOL};
+use super::dynamics::{angle_of, slide_of, BodyKin, System, Workspace, RANK_REG, RANK_TOL};
+use super::energy::Energy;
 use super::linalg::Scalar;
 use super::model::{Force, JointKind};
 use crate::error::{Error, Result};
@@ -167,35 +168,14 @@ impl System {
     }
 
     /// Mechanical energy: kinetic + strain (`½ wᵀΛw`) + gravity potential
-    /// + linear springs (J).
+    /// + linear springs between markers and along joints (J).
     pub fn energy(&self, y: &[f64], ws: &mut Workspace<f64>) -> f64 {
-        self.kinematics(y, ws);
-        self.mass_factors(ws);
-        let mut e = 0.0;
-        for (s, &b) in self.moving.iter().enumerate() {
-            let body = &self.model.bodies[b];
-            let k = &ws.kin[s];
-            match ws.inv.get(s).and_then(|i| i.as_ref()) {
-                Some(inv) if self.modes[s] > 0 => {
-                    // ½ vᵀ M v with M = L Lᵀ: ½ |Lᵀ v|².
-                    let d = self.dof(s);
-                    let o = self.vel_off(s);
-                    let v = &y[o..o + d];
-                    let l = &ws.mfac[s];
-                    for c in 0..d {
-                        let ltv: f64 = (c..d).map(|r| l[r * d + c] * v[r]).sum();
-                        e += 0.5 * ltv * ltv;
-                    }
-                    for (j, w) in k.q.iter().enumerate() {
-                        e += 0.5 * inv.lambda[j] * w * w;
-                    }
-                }
-                _ => {
-                    e += 0.5 * body.mass * k.v.norm_squared()
-                        + 0.5 * k.wb.dot(&(body.inertia * k.wb));
-                }
-            }
-        }
+        let mut terms = Energy::kinetic_total(&self.model);
+        terms.extend(self.moving.iter().map(|&b| Energy::Strain(b)));
+        // With a flexible body, its kinetic term also builds the invariants
+        // that `mass_centre` reads; the springs need the markers.
+        let mut e = self.energy_sum(&terms, y, ws);
+        self.markers_kin(ws);
         for f in &self.model.forces {
             match f {
                 Force::Gravity { g } => {
@@ -212,6 +192,16 @@ impl System {
                 } => {
                     let l = (ws.mk[*j].x - ws.mk[*i].x).norm();
                     e += 0.5 * stiffness * (l - length).powi(2);
+                }
+                Force::JointSpring {
+                    joint,
+                    stiffness,
+                    length,
+                    ..
+                } => {
+                    let jt = &self.model.joints[*joint];
+                    let (s, _) = slide_of(&ws.mk[jt.i], &ws.mk[jt.j]);
+                    e += 0.5 * stiffness * (s - length).powi(2);
                 }
                 _ => {}
             }
@@ -298,6 +288,7 @@ impl System {
         let forces_ok = self.model.forces.iter().all(|f| match f {
             Force::Gravity { .. } => true,
             Force::SpringDamper { damping, .. } => *damping == 0.0,
+            Force::JointSpring { damping, force, .. } => *damping == 0.0 && *force == 0.0,
             _ => false,
         });
         let modal_ok = self
@@ -346,6 +337,14 @@ impl System {
         self.kinematics(y, ws);
         let j = &self.model.joints[joint];
         angle_of(&ws.mk[j.i], &ws.mk[j.j])
+    }
+
+    /// Displacement (m) and rate (m/s) of a prismatic or cylindrical
+    /// joint along its axis.
+    pub fn slide(&self, y: &[f64], joint: usize, ws: &mut Workspace<f64>) -> (f64, f64) {
+        self.kinematics(y, ws);
+        let j = &self.model.joints[joint];
+        slide_of(&ws.mk[j.i], &ws.mk[j.j])
     }
 
     /// Reactions of every joint at `(t, y)` (one right-hand-side solve).
@@ -405,6 +404,7 @@ impl<T: Scalar> Workspace<T> {
             mfac: Vec::new(),
             inv: Vec::new(),
             inv_seeded: Vec::new(),
+            kinetic: Vec::new(),
             inv_order: Vec::new(),
             spd: Default::default(),
             q: Vec::new(),

@@ -38,18 +38,19 @@
 //! Everything is generic over the scalar `T` so that `num_dual::Dual64`
 //! gives exact Jacobian-vector products of the right-hand side.
 
+use super::energy::quadratic_form;
 use super::flexdyn::{flex_terms, FlexEffects, FlexState, InvT};
 use super::linalg::{cst, euler_rate, rotation, rotation_tangent, rotation_vector, Scalar};
-use super::model::{Force, JointKind, Model, Param};
-pub use super::rows::angle_of;
-use super::rows::{angle_row, dot_row, point_row};
+use super::model::{Model, Param};
+use super::rows::joint_rows;
+pub use super::rows::{angle_of, slide_of};
 pub use super::workspace::{
     BodyKin, Counters, MarkerKin, NodeShapes, Row, Workspace, RANK_REG, RANK_TOL, RIGID,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::cell::Cell;
 
-fn bump(c: &Cell<u64>) {
+pub(crate) fn bump(c: &Cell<u64>) {
     c.set(c.get() + 1);
 }
 
@@ -401,6 +402,15 @@ impl System {
         angle_of(&mi, &mj)
     }
 
+    /// Displacement `s` (m) of prismatic or cylindrical joint `jt` along
+    /// its axis and its rate `ṡ` (m/s) ([`slide_of`]).
+    pub fn joint_slide<T: Scalar>(&self, kin: &[BodyKin<T>], jt: usize) -> (T, T) {
+        let joint = &self.model.joints[jt];
+        let mi = self.marker_kin(kin, joint.i);
+        let mj = self.marker_kin(kin, joint.j);
+        slide_of(&mi, &mj)
+    }
+
     /// Assemble all constraint rows at time `t` into `ws.rows` (marker
     /// kinematics from `ws.mk`).
     pub fn constraints<T: Scalar>(&self, t: f64, ws: &mut Workspace<T>) {
@@ -408,32 +418,9 @@ impl System {
         ws.mjac.clear();
         let alpha = self.model.baumgarte;
         for joint in &self.model.joints {
-            let mi = &ws.mk[joint.i];
-            let mj = &ws.mk[joint.j];
             let first = ws.rows.len();
-            for k in 0..3 {
-                ws.rows.push(point_row(mi, mj, k));
-            }
-            let (xi, yi) = (mi.frame.column(0).into(), mi.frame.column(1).into());
-            let (yj, zj) = (mj.frame.column(1).into(), mj.frame.column(2).into());
-            match &joint.kind {
-                JointKind::Spherical => {}
-                JointKind::Revolute => {
-                    ws.rows.push(dot_row(mi, mj, &xi, &zj));
-                    ws.rows.push(dot_row(mi, mj, &yi, &zj));
-                }
-                JointKind::Fixed => {
-                    ws.rows.push(dot_row(mi, mj, &xi, &zj));
-                    ws.rows.push(dot_row(mi, mj, &yi, &zj));
-                    ws.rows.push(dot_row(mi, mj, &xi, &yj));
-                }
-                JointKind::Driven(drive) => {
-                    ws.rows.push(dot_row(mi, mj, &xi, &zj));
-                    ws.rows.push(dot_row(mi, mj, &yi, &zj));
-                    let (f, df, ddf) = drive.eval(t);
-                    ws.rows.push(angle_row(mi, mj, (f, df, ddf)));
-                }
-            }
+            let markers = (&ws.mk[joint.i], &ws.mk[joint.j]);
+            joint_rows(&joint.kind, markers, t, &mut ws.rows);
             for row in &mut ws.rows[first..] {
                 row.markers = [joint.i, joint.j];
             }
@@ -493,8 +480,9 @@ impl System {
     /// Mass matrices of the flexible bodies (factored into `ws.mfac`) and,
     /// when `forces` is set, their inertia, elastic and damping forces
     /// (added to `ws.q`). `ws.q` must be sized.
-    fn flex_bodies<T: Scalar>(&self, ws: &mut Workspace<T>, forces: bool) {
+    pub(crate) fn flex_bodies<T: Scalar>(&self, ws: &mut Workspace<T>, forces: bool) {
         ws.mfac.resize_with(self.nb(), Vec::new);
+        ws.kinetic.resize(self.nb(), T::zero());
         for s in 0..self.nb() {
             let n = self.modes[s];
             if n == 0 {
@@ -528,6 +516,10 @@ impl System {
                     wd: &k.qd,
                 };
                 flex_terms(inv, &st, eff, &mut mass, &mut fq);
+                let v: Vec<T> = (k.v.iter().chain(k.wb.iter()).chain(&k.qd))
+                    .copied()
+                    .collect();
+                ws.kinetic[s] = quadratic_form(&mass, &v, d);
             }
             // A non-positive pivot leaves a NaN in the factor, which the
             // integrator reports with the time.
@@ -559,178 +551,6 @@ impl System {
         (0..d)
             .map(|r| (0..=r).map(|c| l[r * d + c] * ltv[c]).sum())
             .collect()
-    }
-
-    /// Applied generalized forces (inertia, elastic, gravity, force
-    /// elements) of every moving body at time `t` (into `ws.q`), and the
-    /// factored mass matrices of flexible bodies.
-    pub(crate) fn applied<T: Scalar>(&self, t: f64, ws: &mut Workspace<T>) {
-        ws.q.clear();
-        ws.q.resize(self.nvel, T::zero());
-        if self.model.quadratic_velocity {
-            for (s, &b) in self.moving.iter().enumerate() {
-                if self.modes[s] > 0 {
-                    continue;
-                }
-                bump(&self.counters.quadratic);
-                let body = &self.model.bodies[b];
-                let k = &ws.kin[s];
-                let jw = body.inertia.map(cst::<T>) * k.wb;
-                let gyro = -k.wb.cross(&jw);
-                let o = self.vel_local(s);
-                for c in 0..3 {
-                    ws.q[o + 3 + c] += gyro[c];
-                }
-            }
-        }
-        self.flex_bodies(ws, true);
-        for (fi, force) in self.model.forces.iter().enumerate() {
-            match force {
-                Force::Gravity { g } => {
-                    bump(&self.counters.gravity);
-                    for (s, &b) in self.moving.iter().enumerate() {
-                        let o = self.vel_local(s);
-                        let gt = g.map(cst::<T>);
-                        match &ws.inv.get(s).and_then(|i| i.as_ref()) {
-                            Some(inv) if self.modes[s] > 0 => {
-                                let k = &ws.kin[s];
-                                let gb = k.a.transpose() * gt;
-                                let sm = inv.first_moment(&k.q);
-                                let tq = sm.cross(&gb);
-                                let modal = inv.i3t(&gb);
-                                for c in 0..3 {
-                                    ws.q[o + c] += inv.mass * gt[c];
-                                    ws.q[o + 3 + c] += tq[c];
-                                }
-                                for (j, f) in modal.iter().enumerate() {
-                                    ws.q[o + 6 + j] += *f;
-                                }
-                            }
-                            _ => {
-                                let m = pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass);
-                                for c in 0..3 {
-                                    ws.q[o + c] += m * gt[c];
-                                }
-                            }
-                        }
-                    }
-                }
-                Force::BodyLoad { body, load } => {
-                    bump(&self.counters.loads);
-                    if let Some(s) = self.slot[*body] {
-                        let (force, torque) = load.eval(t);
-                        let tb = ws.kin[s].a.transpose() * torque.map(cst::<T>);
-                        let o = self.vel_local(s);
-                        // A flexible body's frame origin is not its centre
-                        // of mass: the force acts at the centre of mass.
-                        let arm = match ws.inv.get(s).and_then(|i| i.as_ref()) {
-                            Some(inv) if self.modes[s] > 0 => {
-                                Some(inv.first_moment(&ws.kin[s].q) / inv.mass)
-                            }
-                            _ => None,
-                        };
-                        let fb = ws.kin[s].a.transpose() * force.map(cst::<T>);
-                        let extra = arm.map_or(Vector3::zeros(), |c| c.cross(&fb));
-                        for c in 0..3 {
-                            ws.q[o + c] += cst::<T>(force[c]);
-                            ws.q[o + 3 + c] += tb[c] + extra[c];
-                        }
-                        if let Some(inv) = ws.inv.get(s).and_then(|i| i.as_ref()) {
-                            if self.modes[s] > 0 {
-                                let modal = inv.i3t(&fb);
-                                let m = inv.mass;
-                                for (j, f) in modal.iter().enumerate() {
-                                    ws.q[o + 6 + j] += *f / m;
-                                }
-                            }
-                        }
-                    }
-                }
-                Force::Rotational {
-                    joint,
-                    law,
-                    damping,
-                } => {
-                    bump(&self.counters.actuators);
-                    let jt = &self.model.joints[*joint];
-                    let mi = ws.mk[jt.i];
-                    let mj = ws.mk[jt.j];
-                    let (th, thd) = angle_of(&mi, &mj);
-                    let mut m = pval(&ws.params, Param::Damping(fi), *damping) * thd;
-                    if let Some(law) = law {
-                        let k = match ws.segments.get(fi) {
-                            Some(&k) if k < law.segments.len() => k,
-                            _ => law.segment_index(th.to_subset().unwrap_or(f64::NAN)),
-                        };
-                        let seg = &law.segments[k];
-                        let anchor = pval(&ws.params, Param::Anchor(fi, k), seg.anchor);
-                        m += cst::<T>(seg.value) + cst::<T>(seg.slope) * (anchor - th);
-                    }
-                    let axis: Vector3<T> = mi.frame.column(2).into();
-                    let tau = axis * (-m);
-                    self.apply_torque(ws, jt.j, &tau);
-                    self.apply_torque(ws, jt.i, &(-tau));
-                }
-                Force::SpringDamper {
-                    i,
-                    j,
-                    stiffness,
-                    damping,
-                    length,
-                } => {
-                    bump(&self.counters.springs);
-                    let mi = ws.mk[*i];
-                    let mj = ws.mk[*j];
-                    let d = mj.x - mi.x;
-                    let l = d.norm();
-                    let u = d / l;
-                    let ldot = u.dot(&(mj.v - mi.v));
-                    let k = pval(&ws.params, Param::Stiffness(fi), *stiffness);
-                    let c = pval(&ws.params, Param::Damping(fi), *damping);
-                    let tension = k * (l - cst::<T>(*length)) + c * ldot;
-                    let f = u * tension; // on i, towards j
-                    self.apply_force(ws, *i, &f);
-                    self.apply_force(ws, *j, &(-f));
-                }
-            }
-        }
-    }
-
-    /// Add a global torque on the carrier of marker `m` (and on the modes
-    /// through `Ψ_kᵀ` for a flexible node).
-    fn apply_torque<T: Scalar>(&self, ws: &mut Workspace<T>, m: usize, tau: &Vector3<T>) {
-        let mk = ws.mk[m];
-        let Some(s) = mk.slot else { return };
-        let o = self.vel_local(s);
-        let tb = ws.kin[s].a.transpose() * tau;
-        for c in 0..3 {
-            ws.q[o + 3 + c] += tb[c];
-        }
-        if mk.node.is_some() {
-            let tt = mk.tangent.transpose() * tb;
-            for (j, p) in ws.shapes[m].1.iter().enumerate() {
-                ws.q[o + 6 + j] += p.dot(&tt);
-            }
-        }
-    }
-
-    /// Add a global force at marker `m` (and on the modes through `Φ_kᵀ`).
-    fn apply_force<T: Scalar>(&self, ws: &mut Workspace<T>, m: usize, f: &Vector3<T>) {
-        let mk = ws.mk[m];
-        let Some(s) = mk.slot else { return };
-        let o = self.vel_local(s);
-        let at = ws.kin[s].a.transpose();
-        let tb = at * mk.s.cross(f);
-        for c in 0..3 {
-            ws.q[o + c] += f[c];
-            ws.q[o + 3 + c] += tb[c];
-        }
-        if mk.node.is_some() {
-            let fb = at * f;
-            for (j, p) in ws.shapes[m].0.iter().enumerate() {
-                ws.q[o + 6 + j] += p.dot(&fb);
-            }
-        }
     }
 
     /// Kinematics (bodies and markers) of `y` into `ws`.
@@ -766,12 +586,10 @@ impl System {
         dy[vo..vo + self.nvel].copy_from_slice(&acc);
         let io = self.integral_off();
         for (i, integral) in self.model.integrals.iter().enumerate() {
-            let mut v = T::zero();
-            for &b in &integral.bodies {
-                if let Some(s) = self.slot[b] {
-                    v += self.strain_energy_dual(y, s, &ws.kin[s].design);
-                }
-            }
+            let v = integral
+                .terms
+                .iter()
+                .fold(T::zero(), |acc, e| acc + self.energy_term(*e, y, ws));
             dy[io + i] = v * cst::<T>(integral.scale);
         }
     }

@@ -3,11 +3,14 @@
 //! (paper Eqs. 5–6; [`flex`], [`flexdyn`], bases from closed-form beams
 //! [`beam`] or from composite panels `crate::panels::panel_basis`),
 //! markers (on flexible bodies: on mesh nodes, moving and rotating with the
-//! modes), joints (spherical, revolute, driven/locked revolute, fixed),
-//! force elements (gravity, the paper's Eq. 32 spring-damper-actuator,
-//! linear spring-dampers, constant or time-tabulated loads), the equations
+//! modes), joints (spherical, revolute, driven/locked revolute, fixed,
+//! prismatic, cylindrical), force elements ([`forces`]: gravity, the
+//! paper's Eq. 32 spring-damper-actuator, linear spring-dampers between
+//! markers or along a sliding joint, constant or time-tabulated loads at
+//! a centre of mass or a marker, in global or body axes), the equations
 //! of motion with Lagrange multipliers, consistent initial conditions,
-//! and outputs. It knows nothing of files: scenes are built by
+//! energies ([`energy`]: kinetic and strain, as outputs and response
+//! terms) and outputs. It knows nothing of files: scenes are built by
 //! [`crate::scene`], simulated by [`crate::simulate`].
 //!
 //! ## Method
@@ -37,7 +40,7 @@
 //! Where things go: a new joint type is a [`JointKind`] variant with its
 //! equation count in [`model`] and its constraint rows in [`rows`]
 //! (assembled in [`dynamics`]); a new force element is a [`Force`] variant
-//! applied in [`dynamics`]; the scene names both ([`crate::scene`]).
+//! applied in [`forces`]; the scene names both ([`crate::scene`]).
 //!
 //! ## Limitations
 //! - Linear elasticity in a floating frame: no geometric stiffening, so a
@@ -58,8 +61,10 @@
 pub mod analysis;
 pub mod beam;
 pub mod dynamics;
+pub mod energy;
 pub mod flex;
 pub mod flexdyn;
+pub mod forces;
 pub mod linalg;
 pub mod model;
 pub mod ode;
@@ -71,7 +76,9 @@ pub mod workspace;
 
 pub use analysis::{Projection, Reaction};
 pub use dynamics::{System, Workspace};
+pub use energy::Energy;
 pub use flex::{BasisDerivative, Invariants, ModalBasis};
 pub use model::{
-    Body, Drive, Force, Joint, JointKind, Marker, Model, Param, PiecewiseLaw, Segment,
+    Body, Drive, Force, Joint, JointKind, Load, LoadFrame, Marker, Model, Param, PiecewiseLaw,
+    Segment,
 };

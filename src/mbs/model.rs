@@ -10,7 +10,11 @@
 //! - A joint connects marker `i` to marker `j`. Revolute axes are the
 //!   markers' z axes; the relative angle `θ` is the rotation of `j`
 //!   relative to `i` about `z_i`, `θ = atan2(z_i·(x_i × x_j), x_i·x_j)`.
+//! - Prismatic and cylindrical joints slide along marker i's z axis; the
+//!   displacement is `s = z_i·(x_j − x_i)` (m), zero at the start (a
+//!   scene makes both markers at the joint point).
 
+use super::energy::Energy;
 use super::flex::{Invariants, ModalBasis};
 use crate::error::{Error, Result};
 use nalgebra::{Matrix3, Vector3};
@@ -179,6 +183,12 @@ pub enum JointKind {
     Driven(Drive),
     /// Coincident points and frames (6 equations).
     Fixed,
+    /// Translation along `z_i` only: frames parallel, point j on the line
+    /// of marker i's z axis (5 equations).
+    Prismatic,
+    /// Translation along and rotation about `z_i`: parallel z axes, point
+    /// j on the line of marker i's z axis (4 equations).
+    Cylindrical,
 }
 
 impl JointKind {
@@ -186,13 +196,22 @@ impl JointKind {
     pub fn equations(&self) -> usize {
         match self {
             JointKind::Spherical => 3,
-            JointKind::Revolute => 5,
+            JointKind::Cylindrical => 4,
+            JointKind::Revolute | JointKind::Prismatic => 5,
             JointKind::Driven(_) | JointKind::Fixed => 6,
         }
     }
     /// Whether the joint has a relative rotation angle about z.
     pub fn has_angle(&self) -> bool {
-        matches!(self, JointKind::Revolute | JointKind::Driven(_))
+        matches!(
+            self,
+            JointKind::Revolute | JointKind::Driven(_) | JointKind::Cylindrical
+        )
+    }
+    /// Whether the joint has a displacement along z (prismatic,
+    /// cylindrical).
+    pub fn has_slide(&self) -> bool {
+        matches!(self, JointKind::Prismatic | JointKind::Cylindrical)
     }
 }
 
@@ -274,7 +293,8 @@ impl PiecewiseLaw {
 /// dual-number value gives the exact parameter derivative `∂f/∂p`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Param {
-    /// Stiffness `k` of the spring-damper `forces[i]` (N/m).
+    /// Stiffness `k` of the spring-damper `forces[i]` (N/m), between
+    /// markers or along a joint.
     Stiffness(usize),
     /// Damping of `forces[i]`: `c` of a spring-damper (N·s/m) or of a
     /// rotational actuator (N·m·s).
@@ -302,12 +322,14 @@ impl Param {
         match *self {
             Param::Mass(b) => model.bodies.get(b).map(|b| b.mass),
             Param::Stiffness(f) => match model.forces.get(f) {
-                Some(Force::SpringDamper { stiffness, .. }) => Some(*stiffness),
+                Some(Force::SpringDamper { stiffness, .. })
+                | Some(Force::JointSpring { stiffness, .. }) => Some(*stiffness),
                 _ => None,
             },
             Param::Damping(f) => match model.forces.get(f) {
-                Some(Force::SpringDamper { damping, .. }) => Some(*damping),
-                Some(Force::Rotational { damping, .. }) => Some(*damping),
+                Some(Force::SpringDamper { damping, .. })
+                | Some(Force::JointSpring { damping, .. })
+                | Some(Force::Rotational { damping, .. }) => Some(*damping),
                 _ => None,
             },
             Param::Anchor(f, k) => match model.forces.get(f) {
@@ -354,15 +376,16 @@ impl Param {
     pub fn set(&self, model: &mut Model, v: f64) {
         match *self {
             Param::Mass(b) => model.bodies[b].mass = v,
-            Param::Stiffness(f) => {
-                if let Force::SpringDamper { stiffness, .. } = &mut model.forces[f] {
-                    *stiffness = v;
+            Param::Stiffness(f) => match &mut model.forces[f] {
+                Force::SpringDamper { stiffness, .. } | Force::JointSpring { stiffness, .. } => {
+                    *stiffness = v
                 }
-            }
+                _ => {}
+            },
             Param::Damping(f) => match &mut model.forces[f] {
-                Force::SpringDamper { damping, .. } | Force::Rotational { damping, .. } => {
-                    *damping = v
-                }
+                Force::SpringDamper { damping, .. }
+                | Force::JointSpring { damping, .. }
+                | Force::Rotational { damping, .. } => *damping = v,
                 _ => {}
             },
             Param::Anchor(f, k) => {
@@ -406,12 +429,50 @@ pub enum Force {
         damping: f64,
         length: f64,
     },
-    /// Global force (N) at the centre of mass and global torque (N·m) on
-    /// a body, constant or tabulated in time. On a flexible body the force
-    /// is distributed in proportion to mass (as a uniform acceleration
-    /// field `f/m`, so it also loads the modes through `i3ᵀ`); the torque
-    /// acts on the frame.
-    BodyLoad { body: usize, load: Load },
+    /// Translational spring-damper-actuator along the axis `z_i` of the
+    /// prismatic or cylindrical joint `joint`: tension
+    /// `T = k(s − s0) − f + c·ṡ` (N) with `s` the joint displacement, `s0`
+    /// = `length` and `f` = `force` a constant actuator force pushing the
+    /// markers apart along `z_i`; `−T z_i` on marker j, `+T z_i` on marker
+    /// i and the torque `−T z_i×(x_j − x_i)` on marker i, which makes the
+    /// spring the exact gradient of `½k(s − s0)²` also off the axis.
+    JointSpring {
+        joint: usize,
+        stiffness: f64,
+        damping: f64,
+        length: f64,
+        force: f64,
+    },
+    /// Force (N) at the centre of mass and torque (N·m) on a body,
+    /// constant or tabulated in time, with components in global or body
+    /// axes (`frame`). On a flexible body the force is distributed in
+    /// proportion to mass (as a uniform acceleration field `f/m`, so it
+    /// also loads the modes through `i3ᵀ`); the torque acts on the frame.
+    BodyLoad {
+        body: usize,
+        load: Load,
+        frame: LoadFrame,
+    },
+    /// Force (N) at the point of a marker and torque (N·m) on its body,
+    /// constant or tabulated in time, with components in global or body
+    /// axes: on the body, the force `f` and the moment `s × f` of the
+    /// marker's lever arm `s`, plus the torque; on a flexible node, also
+    /// the modal forces `Φ_kᵀAᵀf` and `Ψ_kᵀ(…)τ` of the node.
+    MarkerLoad {
+        marker: usize,
+        load: Load,
+        frame: LoadFrame,
+    },
+}
+
+/// The axes a load's components are given in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoadFrame {
+    /// Global axes: the load keeps its direction in space.
+    Global,
+    /// The body's frame axes (`A` of the rigid body or of the flexible
+    /// body's floating frame): a follower load turning with the body.
+    Body,
 }
 
 /// A force and torque, constant or piecewise linear in time.
@@ -480,12 +541,13 @@ pub struct Model {
     pub ties: Vec<Vec<(usize, usize)>>,
 }
 
-/// `∫ scale · Σ_b U_b dt` over the strain energies `U_b = ½ wᵀΛw` of the
-/// flexible bodies `bodies` (the paper's objective Ψ₀ = ∫ 2U dt, Eq. 33,
-/// is `scale = 2`). Rigid bodies contribute zero.
+/// `∫ scale · Σ terms dt` over energy terms (strain and kinetic energies
+/// of bodies, [`Energy`]): the paper's objective Ψ₀ = ∫ 2U dt (Eq. 33) is
+/// the strain energies of the flexible bodies with `scale = 2`; the
+/// IDAS slider-crank's `G = ∫ T dt` the kinetic energies with 1.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Integral {
-    pub bodies: Vec<usize>,
+    pub terms: Vec<Energy>,
     pub scale: f64,
 }
 

@@ -1,7 +1,8 @@
-//! Response functionals of a simulation (paper §4–§6, Eqs. 29–34): the
-//! time integral of strain energies (the objective Ψ₀ = ∫ 2U dt, Eq. 33)
-//! and their peak over the run (the constraints max U ≤ c, Eq. 34), with
-//! their sensitivities.
+//! Response functionals of a simulation (paper §4–§6, Eqs. 29–34) over a
+//! sum of energies ([`Energy`]: strain energies, kinetic energies): its
+//! time integral (the objective Ψ₀ = ∫ 2U dt, Eq. 33; the IDAS
+//! slider-crank's G = ∫ T dt), its peak over the run (the constraints
+//! max U ≤ c, Eq. 34) and its final value, with their sensitivities.
 //!
 //! - **Integrals** are extra states of the integration
 //!   ([`crate::mbs::model::Integral`]): value and sensitivities come with
@@ -17,18 +18,23 @@
 //!   interpolated to `t*` by the same three-point rule. A peak at the first
 //!   or last output time is taken there (a boundary maximum, whose time
 //!   does not move with the parameters).
+//! - **Final values** are the sum at the end time, with the derivative
+//!   `dE/dp = ∂E/∂y · s(t_end) + ∂E/∂p` ([`energy_lanes`]).
 
-use super::dynamics::System;
+use super::dynamics::{System, Workspace};
+use super::energy::Energy;
 use super::model::Param;
 use num_dual::Dual64;
 
 /// The kind of a response functional (paper Eqs. 33–34).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ResponseKind {
-    /// `∫ scale·ΣU dt` over the run, an integrated state (Eq. 33).
+    /// `∫ scale·Σ E dt` over the run, an integrated state (Eq. 33).
     Integral,
-    /// `max_t scale·ΣU(t)` at its critical time point (Eq. 34).
+    /// `max_t scale·Σ E(t)` at its critical time point (Eq. 34).
     Peak,
+    /// `scale·Σ E(t_end)`.
+    Final,
 }
 
 impl std::fmt::Display for ResponseKind {
@@ -37,6 +43,7 @@ impl std::fmt::Display for ResponseKind {
         f.write_str(match self {
             ResponseKind::Integral => "integral",
             ResponseKind::Peak => "peak",
+            ResponseKind::Final => "final",
         })
     }
 }
@@ -45,31 +52,29 @@ impl std::fmt::Display for ResponseKind {
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResponseValue {
     pub name: String,
-    /// Integral over the run or peak value.
+    /// Integral over the run, peak or final value.
     pub kind: ResponseKind,
     pub value: f64,
-    /// Time of the peak (s); `None` for integrals.
+    /// Time of the peak or the end time (s); `None` for integrals.
     pub time: Option<f64>,
     /// `d value / d p` for each sensitivity parameter of the scene.
     pub gradient: Vec<f64>,
 }
 
-/// `scale · Σ_b U_b` at state `y` and its derivatives along each
-/// sensitivity lane `(∂y/∂p, p)` (exact: dual numbers, with the design
-/// seed of ply-angle parameters for `dΛ/dθ`).
-pub fn strain_sum(
+/// `scale · Σ terms` at state `y` and its derivatives along each
+/// sensitivity lane `(∂y/∂p, p)`: `∂E/∂y · ∂y/∂p + ∂E/∂p`, exact from one
+/// dual-number evaluation per lane with `y + ε ∂y/∂p` and `p + ε` (so a
+/// mass enters the kinetic energy explicitly, a ply angle the strain
+/// energy through `dΛ/dθ` and the flexible mass matrix through the
+/// invariants' derivatives).
+pub fn energy_lanes(
     sys: &System,
-    bodies: &[usize],
-    scale: f64,
+    (terms, scale): (&[Energy], f64),
     y: &[f64],
     lanes: &[(&[f64], Param)],
 ) -> (f64, Vec<f64>) {
-    let value: f64 = bodies
-        .iter()
-        .filter_map(|&b| sys.slot[b])
-        .map(|s| sys.strain_energy(y, s))
-        .sum::<f64>()
-        * scale;
+    let value = sys.energy_sum(terms, y, &mut Workspace::empty()) * scale;
+    let mut ws = Workspace::<Dual64>::empty();
     let grad = lanes
         .iter()
         .map(|(lane, p)| {
@@ -78,18 +83,9 @@ pub fn strain_sum(
                 .zip(*lane)
                 .map(|(&a, &b)| Dual64::new(a, b))
                 .collect();
-            bodies
-                .iter()
-                .filter_map(|&b| sys.slot[b].map(|s| (b, s)))
-                .map(|(b, s)| {
-                    let seeds: Vec<(usize, Dual64)> = match p.design_of(&sys.model, b) {
-                        Some(var) => vec![(var, Dual64::new(0.0, 1.0))],
-                        None => Vec::new(),
-                    };
-                    sys.strain_energy_dual(&yd, s, &seeds).eps
-                })
-                .sum::<f64>()
-                * scale
+            let v = p.value(&sys.model).unwrap_or(0.0);
+            ws.params = vec![(*p, Dual64::new(v, 1.0))];
+            sys.energy_sum(terms, &yd, &mut ws).eps * scale
         })
         .collect();
     (value, grad)

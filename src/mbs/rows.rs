@@ -1,9 +1,66 @@
 //! Constraint rows of the joints: value, Jacobian blocks per body and the
-//! velocity-dependent part `γ` of the constraint accelerations.
+//! velocity-dependent part `γ` of the constraint accelerations, and the
+//! rows each joint kind is made of (`joint_rows`).
+//!
+//! Every row's rate is written as `P·v_point + W·ω_marker` of the two
+//! markers (point velocity, marker frame angular velocity), which
+//! [`super::dynamics`] turns into body and modal Jacobian entries.
 
 use super::linalg::{cst, Scalar};
+use super::model::JointKind;
 use super::workspace::{MarkerKin, Row, RIGID};
 use nalgebra::Vector3;
+
+/// The constraint rows of a joint of kind `kind` between markers `mi` and
+/// `mj` at time `t`, appended to `rows`:
+///
+/// | kind | rows |
+/// |---|---|
+/// | spherical | `x_i − x_j = 0` (3) |
+/// | revolute | + `x_i·z_j = 0`, `y_i·z_j = 0` (5) |
+/// | driven | + `θ − f(t) = 0` (6) |
+/// | fixed | revolute + `x_i·y_j = 0` (6) |
+/// | cylindrical | `x_i·d = 0`, `y_i·d = 0` with `d = x_j − x_i`, + `x_i·z_j = 0`, `y_i·z_j = 0` (4) |
+/// | prismatic | cylindrical + `x_i·y_j = 0` (5) |
+pub(crate) fn joint_rows<T: Scalar>(
+    kind: &JointKind,
+    (mi, mj): (&MarkerKin<T>, &MarkerKin<T>),
+    t: f64,
+    rows: &mut Vec<Row<T>>,
+) {
+    let col = |m: &MarkerKin<T>, c: usize| -> Vector3<T> { m.frame.column(c).into() };
+    let (xi, yi) = (col(mi, 0), col(mi, 1));
+    let (yj, zj) = (col(mj, 1), col(mj, 2));
+    if kind.has_slide() {
+        rows.push(line_row(mi, mj, &xi));
+        rows.push(line_row(mi, mj, &yi));
+    } else {
+        for k in 0..3 {
+            rows.push(point_row(mi, mj, k));
+        }
+    }
+    if matches!(kind, JointKind::Spherical) {
+        return;
+    }
+    // Parallel z axes.
+    rows.push(dot_row(mi, mj, &xi, &zj));
+    rows.push(dot_row(mi, mj, &yi, &zj));
+    match kind {
+        JointKind::Fixed | JointKind::Prismatic => rows.push(dot_row(mi, mj, &xi, &yj)),
+        JointKind::Driven(drive) => rows.push(angle_row(mi, mj, drive.eval(t))),
+        _ => {}
+    }
+}
+
+/// Displacement along the axis `s = z_i·(x_j − x_i)` (m) and its rate
+/// `ṡ = (ω_i×z_i)·(x_j − x_i) + z_i·(v_j − v_i)` (m/s), with `ω_i` the
+/// angular velocity of marker i's frame. Zero at the start of a scene
+/// joint, whose two markers are made at the joint point.
+pub fn slide_of<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>) -> (T, T) {
+    let zi: Vector3<T> = mi.frame.column(2).into();
+    let d = mj.x - mi.x;
+    (zi.dot(&d), mi.w.cross(&zi).dot(&d) + zi.dot(&(mj.v - mi.v)))
+}
 
 /// `θ = atan2(z_i·(x_i × x_j), x_i·x_j)` and `θ̇ = z_i·(ω_j − ω_i)`.
 pub fn angle_of<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>) -> (T, T) {
@@ -95,6 +152,32 @@ pub(crate) fn angle_row<T: Scalar>(
         blocks: [
             block(mi, Vector3::zeros(), -zi),
             block(mj, Vector3::zeros(), zi),
+        ],
+        markers: [0, 0],
+        modal: [RIGID, RIGID],
+    }
+}
+
+/// `a·d = 0` with `a` fixed in marker i's frame and `d = x_j − x_i`
+/// (point j on a line or plane of marker i). Rate:
+/// `(ω_i×a)·d + a·(v_j − v_i)`, so `P_i = −a`, `W_i = a×d`, `P_j = a`,
+/// `W_j = 0`; in body blocks `∂/∂ω_i = a×(d + s_i)`, `∂/∂ω_j = s_j×a`.
+/// `γ = −[d·(α_i×a + ω_i×(ω_i×a)) + 2(ω_i×a)·(v_j − v_i)
+///       + a·(acc_j − acc_i)]` with the velocity-dependent accelerations
+/// [`MarkerKin::acc`] and [`MarkerKin::alpha`].
+pub(crate) fn line_row<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>, a: &Vector3<T>) -> Row<T> {
+    let d = mj.x - mi.x;
+    let wa = mi.w.cross(a);
+    let quad = d.dot(&(mi.alpha.cross(a) + mi.w.cross(&wa)))
+        + cst::<T>(2.0) * wa.dot(&(mj.v - mi.v))
+        + a.dot(&(mj.acc - mi.acc));
+    Row {
+        phi: a.dot(&d),
+        phidot: T::zero(),
+        gamma: -quad,
+        blocks: [
+            block(mi, -*a, a.cross(&(d + mi.s))),
+            block(mj, *a, mj.s.cross(a)),
         ],
         markers: [0, 0],
         modal: [RIGID, RIGID],

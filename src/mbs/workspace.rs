@@ -77,6 +77,10 @@ pub struct Workspace<T: Scalar> {
     /// Whether `inv[s]` carries design seeds (then it is rebuilt at the
     /// next evaluation).
     pub(crate) inv_seeded: Vec<bool>,
+    /// Per moving body: the kinetic energy `½ vᵀMv` of a flexible body,
+    /// from its mass matrix before the factorization (zero for rigid
+    /// bodies, whose energy [`super::energy`] computes directly).
+    pub(crate) kinetic: Vec<T>,
     /// Rank of the last factorization.
     pub rank: usize,
     /// Parameter values overriding the model's (sensitivity analysis);

@@ -4,16 +4,14 @@
 //! the key below `scene` in its errors.
 
 use super::parts::{
-    finite3, flexible_body, initial_distance, load_table, make_marker, parse_param, parse_quantity,
-    PanelBases,
+    finite3, flexible_body, make_marker, parse_energy, parse_param, parse_quantity, PanelBases,
 };
 use super::quantity::{Quantity, Response};
-use super::spec::{Effect, ForceSpec, JointSpec, SceneSpec, SegmentSpec};
+use super::spec::{Effect, JointSpec, SceneSpec};
 use crate::error::{Error, Result};
 use crate::integrate::{Options, SensitivityForm};
 use crate::mbs::model::{
-    axis_angle, frame_from_axis, Body, Drive, Force, Integral, Joint, JointKind, Load, Model,
-    Param, PiecewiseLaw, Segment,
+    axis_angle, frame_from_axis, Body, Drive, Integral, Joint, JointKind, Model, Param,
 };
 use nalgebra::{Matrix3, Vector3};
 
@@ -84,7 +82,7 @@ impl SceneSpec {
     }
 
     /// Whether the scene lists effect `e`.
-    fn has(&self, e: Effect) -> bool {
+    pub(super) fn has(&self, e: Effect) -> bool {
         self.effects.iter().any(|x| x == e.name())
     }
 
@@ -215,191 +213,6 @@ impl SceneSpec {
         Ok(())
     }
 
-    /// Gravity and the `[[scene.forces]]` the effects list builds;
-    /// returns the model index of each scene force (None: not built).
-    fn add_forces(&self, model: &mut Model) -> Result<Vec<Option<usize>>> {
-        if self.has(Effect::Gravity) {
-            model.forces.push(Force::Gravity {
-                g: finite3("gravity".into(), self.gravity)?,
-            });
-        }
-        // Model index of each scene force (None: not built).
-        let mut force_index: Vec<Option<usize>> = vec![None; self.forces.len()];
-        for (k, f) in self.forces.iter().enumerate() {
-            let key = format!("forces[{k}]");
-            let built = match f {
-                ForceSpec::Actuator {
-                    joint,
-                    damping,
-                    segments,
-                } => self.actuator(model, &key, joint, *damping, segments)?,
-                ForceSpec::Spring {
-                    marker_i,
-                    marker_j,
-                    stiffness,
-                    damping,
-                    length,
-                } => self.spring(
-                    model,
-                    &key,
-                    [marker_i, marker_j],
-                    [*stiffness, *damping],
-                    *length,
-                )?,
-                ForceSpec::Load {
-                    body,
-                    force,
-                    torque,
-                    table,
-                } => self.load(model, &key, body, [*force, *torque], table.as_deref())?,
-            };
-            if let Some(force) = built {
-                force_index[k] = Some(model.forces.len());
-                model.forces.push(force);
-            }
-        }
-        Ok(force_index)
-    }
-
-    /// The Eq. 32 spring-damper-actuator of a revolute joint (None when
-    /// the effects build neither its law nor its damping).
-    fn actuator(
-        &self,
-        model: &Model,
-        key: &str,
-        joint: &str,
-        damping: f64,
-        segments: &[SegmentSpec],
-    ) -> Result<Option<Force>> {
-        let jt = model.joint(joint).ok_or_else(|| {
-            Error::input(
-                format!("{key}.joint"),
-                joint,
-                "the name of a joint in scene.joints",
-            )
-        })?;
-        if !model.joints[jt].kind.has_angle()
-            || matches!(model.joints[jt].kind, JointKind::Driven(_))
-        {
-            return Err(Error::input(
-                format!("{key}.joint"),
-                joint,
-                "a free revolute joint",
-            ));
-        }
-        if !(damping.is_finite() && damping >= 0.0) {
-            return Err(Error::input(
-                format!("{key}.damping"),
-                damping,
-                "a finite damping ≥ 0 (N·m·s)",
-            ));
-        }
-        let law = if self.has(Effect::Actuators) && !segments.is_empty() {
-            let segs = segments
-                .iter()
-                .map(|s| Segment {
-                    lower: s.lower,
-                    upper: s.upper,
-                    value: s.value,
-                    slope: s.slope,
-                    anchor: s.anchor,
-                })
-                .collect();
-            Some(PiecewiseLaw::new(&format!("{key}.segments"), segs)?)
-        } else {
-            None
-        };
-        let c = if self.has(Effect::Damping) {
-            damping
-        } else {
-            0.0
-        };
-        Ok((law.is_some() || c != 0.0).then_some(Force::Rotational {
-            joint: jt,
-            law,
-            damping: c,
-        }))
-    }
-
-    /// A linear spring-damper between two markers (None without the
-    /// `springs` effect); the rest length defaults to the initial distance.
-    fn spring(
-        &self,
-        model: &Model,
-        key: &str,
-        [marker_i, marker_j]: [&String; 2],
-        [stiffness, damping]: [f64; 2],
-        length: Option<f64>,
-    ) -> Result<Option<Force>> {
-        let find = |key: String, name: &str| {
-            model
-                .marker(name)
-                .ok_or_else(|| Error::input(key, name, "the name of a marker in scene.markers"))
-        };
-        let i = find(format!("{key}.marker_i"), marker_i)?;
-        let j = find(format!("{key}.marker_j"), marker_j)?;
-        let l0 = initial_distance(model, i, j);
-        let length = length.unwrap_or(l0);
-        for (name, v) in [
-            ("stiffness", stiffness),
-            ("damping", damping),
-            ("length", length),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::input(
-                    format!("{key}.{name}"),
-                    v,
-                    "a finite value ≥ 0",
-                ));
-            }
-        }
-        if l0 < 1e-9 {
-            return Err(Error::input(
-                format!("{key}.marker_j"),
-                marker_j,
-                "a point distinct from marker_i",
-            ));
-        }
-        if !self.has(Effect::Springs) {
-            return Ok(None);
-        }
-        let c = if self.has(Effect::Damping) {
-            damping
-        } else {
-            0.0
-        };
-        Ok(Some(Force::SpringDamper {
-            i,
-            j,
-            stiffness,
-            damping: c,
-            length,
-        }))
-    }
-
-    /// A constant or tabulated load at a body's centre of mass (None
-    /// without the `loads` effect).
-    fn load(
-        &self,
-        model: &Model,
-        key: &str,
-        body: &str,
-        [force, torque]: [[f64; 3]; 2],
-        table: Option<&[[f64; 7]]>,
-    ) -> Result<Option<Force>> {
-        let b = find_body(format!("{key}.body"), body, model)?
-            .ok_or_else(|| Error::input(format!("{key}.body"), body, "a body (not ground)"))?;
-        let force = finite3(format!("{key}.force"), force)?;
-        let torque = finite3(format!("{key}.torque"), torque)?;
-        let load = match table {
-            None => Load::Constant { force, torque },
-            Some(rows) => Load::Table(load_table(&format!("{key}.table"), rows)?),
-        };
-        Ok(self
-            .has(Effect::Loads)
-            .then_some(Force::BodyLoad { body: b, load }))
-    }
-
     /// Integrator options with the output times `0, dt_out, .., t_end`.
     fn options(&self) -> Result<Options> {
         let it = &self.integrator;
@@ -451,13 +264,20 @@ impl SceneSpec {
         }
         if let Some(p) = &self.outputs.plot {
             match parse_quantity(model, flex_names, "outputs.plot", p)? {
-                Quantity::Angle(_) | Quantity::Rate(_) | Quantity::Energy | Quantity::Violation => {
-                }
+                Quantity::Angle(_)
+                | Quantity::Rate(_)
+                | Quantity::Displacement(_)
+                | Quantity::Velocity(_)
+                | Quantity::Strain(_)
+                | Quantity::Kinetic(_)
+                | Quantity::Energy
+                | Quantity::Violation => {}
                 _ => {
                     return Err(Error::input(
                         "outputs.plot",
                         p,
-                        "a scalar output (angle, rate, energy, violation)",
+                        "a scalar output (angle, rate, displacement, velocity, strain or \
+                         kinetic energy, energy, violation)",
                     ))
                 }
             }
@@ -498,8 +318,9 @@ impl SceneSpec {
                     &key,
                     name,
                     "<body>.mass (rigid body), <body>.design.<variable> (flexible body), \
-                 forces[i].stiffness, forces[i].damping or \
-                 forces[i].segments[k].anchor of a force the effects list builds",
+                 <force name>.stiffness, <force name>.damping, forces[i].stiffness, \
+                 forces[i].damping or forces[i].segments[k].anchor of a force the effects \
+                 list builds",
                 )
             })?;
             if params.iter().any(|(_, q)| *q == p) {
@@ -529,49 +350,38 @@ impl SceneSpec {
                     "a finite factor",
                 ));
             }
-            let mut bodies = Vec::new();
+            let mut terms = Vec::new();
             for (i, q) in r.of.iter().enumerate() {
-                let body = q
-                    .strip_suffix(".strain_energy")
-                    .filter(|b| flex_names.contains(b))
-                    .and_then(|b| model.body(b))
-                    .ok_or_else(|| {
-                        Error::input(
-                            format!("{key}.of[{i}]"),
-                            q,
-                            "<body>.strain_energy of a body with a `flexible` table",
-                        )
-                    })?;
-                bodies.push(body);
+                terms.extend(parse_energy(model, flex_names, q).ok_or_else(|| {
+                    Error::input(
+                        format!("{key}.of[{i}]"),
+                        q,
+                        "kinetic_energy (all bodies), <body>.kinetic_energy or \
+                         <body>.strain_energy of a body with a `flexible` table",
+                    )
+                })?);
             }
-            if bodies.is_empty() {
+            if r.of.is_empty() {
                 return Err(Error::input(
                     format!("{key}.of"),
                     "[]",
-                    "at least one strain energy",
+                    "at least one energy",
                 ));
             }
+            let (name, scale) = (r.name.clone(), r.scale);
             out.push(match r.kind.as_str() {
                 "integral" => {
-                    model.integrals.push(Integral {
-                        bodies,
-                        scale: r.scale,
-                    });
-                    Response::Integral {
-                        name: r.name.clone(),
-                        index: model.integrals.len() - 1,
-                    }
+                    model.integrals.push(Integral { terms, scale });
+                    let index = model.integrals.len() - 1;
+                    Response::Integral { name, index }
                 }
-                "peak" => Response::Peak {
-                    name: r.name.clone(),
-                    bodies,
-                    scale: r.scale,
-                },
+                "peak" => Response::Peak { name, terms, scale },
+                "final" => Response::Final { name, terms, scale },
                 other => {
                     return Err(Error::input(
                         format!("{key}.kind"),
                         other,
-                        "integral or peak",
+                        "integral, peak or final",
                     ));
                 }
             });
@@ -582,7 +392,7 @@ impl SceneSpec {
 
 /// A body by name: `None` for `"ground"`; an unknown name is an input
 /// error on `key`.
-fn find_body(key: String, name: &str, model: &Model) -> Result<Option<usize>> {
+pub(super) fn find_body(key: String, name: &str, model: &Model) -> Result<Option<usize>> {
     if name == "ground" {
         return Ok(None);
     }
@@ -601,6 +411,15 @@ fn joint_kind(key: &str, j: &JointSpec) -> Result<JointKind> {
         "spherical" => JointKind::Spherical,
         "revolute" => JointKind::Revolute,
         "fixed" => JointKind::Fixed,
+        "cylindrical" => JointKind::Cylindrical,
+        "prismatic" if j.angle != 0.0 => {
+            return Err(Error::input(
+                format!("{key}.angle"),
+                j.angle,
+                "0 for a prismatic joint (its frames stay parallel)",
+            ))
+        }
+        "prismatic" => JointKind::Prismatic,
         "locked" => JointKind::Driven(Drive {
             coefficients: vec![j.angle],
         }),
@@ -622,7 +441,7 @@ fn joint_kind(key: &str, j: &JointSpec) -> Result<JointKind> {
             return Err(Error::input(
                 format!("{key}.type"),
                 other,
-                "spherical, revolute, locked, driven or fixed",
+                "spherical, revolute, locked, driven, fixed, prismatic or cylindrical",
             ))
         }
     })

@@ -22,7 +22,8 @@
 //! gravity = [0.0, 0.0, -9.81]                       # m/s²
 //! baumgarte = 10.0                                  # 1/s
 //! sensitivities = ["forces[0].damping", "forces[0].segments[0].anchor", "B4.mass",
-//!                  "B3.design.theta_1_4"]            # ply angle of a flexible body
+//!                  "B3.design.theta_1_4",            # ply angle of a flexible body
+//!                  "spring.stiffness", "spring.damping"]   # of a named force
 //! [[scene.bodies]]
 //! name = "B4"; mass = 1.5; com = [1.2, 0.0, -0.3]   # kg, m (global, initial)
 //! inertia = [[..], [..], [..]]                      # kg·m², about com, global axes
@@ -33,21 +34,30 @@
 //!              x_axis = [..], y_axis = [..], derivatives = "updated", damping = 0.0 }
 //! # kind = "beam": length, ei_y, ei_z, rho_a, rho_ip (closed-form cantilever modes)
 //! [[scene.joints]]
-//! name = "R3"; type = "revolute"   # spherical | revolute | locked | driven | fixed
+//! name = "R3"; type = "revolute"   # spherical | revolute | locked | driven | fixed |
+//!                                  # prismatic | cylindrical (slide along the axis)
 //! body_i = "B12"; body_j = "B8"    # "ground" allowed
-//! point = [..]; axis = [..]; angle = 3.12   # global initial point, axis, θ0 (rad)
+//! point = [..]; axis = [..]; angle = 3.12   # global initial point, axis, θ0 (rad; 0 if prismatic)
 //! drive = [c0, c1, ..]             # driven: θ(t) = Σ c_k t^k
-//! [[scene.markers]]  name, body, point       # extra points (springs, outputs)
+//! [[scene.markers]]  name, body, point       # extra points (springs, loads, outputs);
+//!                                            # each joint also makes <joint>.i, <joint>.j
 //! [[scene.forces]]
-//! type = "actuator"; joint = "R3"; damping = 0.5
+//! type = "actuator"; name = "M3"; joint = "R3"; damping = 0.5
 //! segments = [{ lower, upper, value, slope, anchor }, ..]  # Eq. 32
-//! type = "spring"; marker_i, marker_j, stiffness, damping, length
-//! type = "load"; body, force, torque       # or table = [[t, fx, fy, fz, tx, ty, tz], ..]
+//! type = "spring"; name = "spring"; marker_i, marker_j, stiffness, damping, length
+//! type = "spring"; joint = "slide"; stiffness, damping, length = s0, force = f
+//!                                  # along a prismatic/cylindrical joint: T = k(s − s0) − f + c ṡ
+//! type = "load"; body | marker; frame = "global" | "body"; force, torque
+//!                                  # or table = [[t, fx, fy, fz, tx, ty, tz], ..]
 //! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out, events = true,
 //!                     sensitivity_form = "fused" | "staggered"   # default: fused with tsit45
 //! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation",
-//!                                "B3.strain_energy", "B3.modal", "<marker>.deflection"]
+//!                                "B3.strain_energy", "B3.modal", "<marker>.deflection",
+//!                                "slide.displacement", "slide.velocity",
+//!                                "B4.kinetic_energy", "kinetic_energy"]
 //!                  plot = "R3.angle"; plot_file = "theta"   # theta.svg
+//! [[scene.responses]]  name = "G"; kind = "integral" | "peak" | "final"
+//!                      of = ["kinetic_energy", "B3.strain_energy", ..]; scale = 1.0
 //! ```
 //! Rigid bodies start with their axes along the global axes, so `inertia`
 //! is both the global and the body-frame tensor at `t = 0`. A flexible
@@ -93,6 +103,7 @@
 //! ```
 
 pub mod build;
+pub mod forces;
 pub mod load;
 pub mod parts;
 pub mod quantity;

@@ -9,6 +9,7 @@ use crate::mbs::beam::Beam;
 use crate::mbs::flex::ModalBasis;
 use crate::mbs::linalg::euler_from_rotation;
 use crate::mbs::model::{Body, Flex, Force, Marker, Model, Param};
+use crate::mbs::Energy;
 use crate::modal::ModeUpdate;
 use nalgebra::{Matrix3, Vector3};
 
@@ -41,6 +42,18 @@ pub(super) fn parse_param(
     if let Some(body) = name.strip_suffix(".mass") {
         let b = model.body(body)?;
         return model.bodies[b].flex.is_none().then_some(Param::Mass(b));
+    }
+    for (suffix, which) in [
+        (".stiffness", Param::Stiffness as fn(usize) -> Param),
+        (".damping", Param::Damping),
+    ] {
+        let Some(force) = name.strip_suffix(suffix) else {
+            continue;
+        };
+        if let Some(k) = forces.iter().position(|f| f.name() == Some(force)) {
+            let p = which((*force_index.get(k)?)?);
+            return p.value(model).map(|_| p);
+        }
     }
     if let Some((body, var)) = name.split_once(".design.") {
         let b = model.body(body)?;
@@ -90,18 +103,35 @@ pub(super) fn parse_quantity(
     match q {
         "energy" => return Ok(Quantity::Energy),
         "violation" => return Ok(Quantity::Violation),
+        "kinetic_energy" => return Ok(Quantity::Kinetic(None)),
         _ => {}
     }
     let bad = || {
         Error::input(
             key,
             q,
-            "energy, violation, <joint>.angle|rate|reaction, <body>.position, \
-             <flexible body>.modal|strain_energy or <marker on a flexible node>.deflection",
+            "energy, violation, <joint>.angle|rate|reaction, \
+             <prismatic or cylindrical joint>.displacement|velocity, <body>.position, \
+             kinetic_energy, <body>.kinetic_energy, <flexible body>.modal|strain_energy or \
+             <marker on a flexible node>.deflection",
         )
     };
     let (name, what) = q.rsplit_once('.').ok_or_else(bad)?;
     match what {
+        "displacement" | "velocity" => {
+            let j = model.joint(name).ok_or_else(bad)?;
+            if !model.joints[j].kind.has_slide() {
+                return Err(Error::input(
+                    key,
+                    q,
+                    "a displacement or velocity of a prismatic or cylindrical joint",
+                ));
+            }
+            Ok(match what {
+                "displacement" => Quantity::Displacement(j),
+                _ => Quantity::Velocity(j),
+            })
+        }
         "angle" | "rate" | "reaction" => {
             let j = model.joint(name).ok_or_else(bad)?;
             if what != "reaction" && !model.joints[j].kind.has_angle() {
@@ -120,6 +150,10 @@ pub(super) fn parse_quantity(
         "position" => {
             let b = model.body(name).ok_or_else(bad)?;
             Ok(Quantity::Position(b))
+        }
+        "kinetic_energy" => {
+            let b = model.body(name).ok_or_else(bad)?;
+            Ok(Quantity::Kinetic(Some(b)))
         }
         "modal" | "strain_energy" => {
             let b = model.body(name).ok_or_else(bad)?;
@@ -145,6 +179,22 @@ pub(super) fn parse_quantity(
         }
         _ => Err(bad()),
     }
+}
+
+/// An energy name → its terms: `kinetic_energy` (every moving body),
+/// `<body>.kinetic_energy`, or `<body>.strain_energy` of a body named in
+/// `flex_names` (a `flexible` table; zero when the scene runs it rigid).
+pub(super) fn parse_energy(model: &Model, flex_names: &[&str], q: &str) -> Option<Vec<Energy>> {
+    if q == "kinetic_energy" {
+        return Some(Energy::kinetic_total(model));
+    }
+    if let Some(b) = q.strip_suffix(".kinetic_energy") {
+        return Some(vec![Energy::Kinetic(model.body(b)?)]);
+    }
+    let b = q
+        .strip_suffix(".strain_energy")
+        .filter(|b| flex_names.contains(b))?;
+    Some(vec![Energy::Strain(model.body(b)?)])
 }
 
 /// A marker `(name, body)` at the global point `p` with global frame

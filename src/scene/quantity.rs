@@ -1,15 +1,23 @@
 //! The output plan of a scene: output columns ([`Quantity`]) and
 //! response functionals ([`Response`]) resolved to model indices.
 
-/// A built response: the bodies whose strain energies it sums.
+use crate::mbs::Energy;
+
+/// A built response: a functional of a sum of energies over the run.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Response {
-    /// `∫ scale·ΣU dt`: index into [`crate::mbs::Model::integrals`].
+    /// `∫ scale·Σ terms dt`: index into [`crate::mbs::Model::integrals`].
     Integral { name: String, index: usize },
-    /// `max_t scale·ΣU(t)`.
+    /// `max_t scale·Σ terms(t)` at its critical time point.
     Peak {
         name: String,
-        bodies: Vec<usize>,
+        terms: Vec<Energy>,
+        scale: f64,
+    },
+    /// `scale·Σ terms` at the end time.
+    Final {
+        name: String,
+        terms: Vec<Energy>,
         scale: f64,
     },
 }
@@ -18,7 +26,9 @@ impl Response {
     /// The response's name.
     pub fn name(&self) -> &str {
         match self {
-            Response::Integral { name, .. } | Response::Peak { name, .. } => name,
+            Response::Integral { name, .. }
+            | Response::Peak { name, .. }
+            | Response::Final { name, .. } => name,
         }
     }
 }
@@ -28,6 +38,10 @@ impl Response {
 pub enum Quantity {
     Angle(usize),
     Rate(usize),
+    /// Displacement of a prismatic or cylindrical joint along its axis (m).
+    Displacement(usize),
+    /// Its rate (m/s).
+    Velocity(usize),
     /// Reaction force (3) and torque (3) of a joint.
     Reaction(usize),
     /// Global position of a body's centre of mass (of a flexible body:
@@ -37,6 +51,8 @@ pub enum Quantity {
     Modal(usize, usize),
     /// Strain energy `½ wᵀΛw` of a flexible body (J).
     Strain(usize),
+    /// Kinetic energy of a body, or of all bodies (`None`) (J).
+    Kinetic(Option<usize>),
     /// Elastic displacement `Φ_k w` of a marker on a flexible node, in
     /// the body's frame axes (m).
     Deflection(usize),
@@ -50,6 +66,8 @@ impl Quantity {
         match self {
             Quantity::Angle(_) => vec![format!("{label} [rad]")],
             Quantity::Rate(_) => vec![format!("{label} [rad/s]")],
+            Quantity::Displacement(_) => vec![format!("{label} [m]")],
+            Quantity::Velocity(_) => vec![format!("{label} [m/s]")],
             Quantity::Reaction(_) => {
                 let base = label.trim_end_matches(".reaction");
                 let mut h: Vec<String> = ["x", "y", "z"]
@@ -70,7 +88,7 @@ impl Quantity {
             Quantity::Modal(_, n) => (1..=*n)
                 .map(|j| format!("{label}_{j} [kg^0.5*m]"))
                 .collect(),
-            Quantity::Strain(_) => vec![format!("{label} [J]")],
+            Quantity::Strain(_) | Quantity::Kinetic(_) => vec![format!("{label} [J]")],
             Quantity::Deflection(_) => ["x", "y", "z"]
                 .iter()
                 .map(|c| format!("{label}_{c} [m]"))

@@ -121,7 +121,8 @@ pub struct SceneSpec {
     #[serde(default)]
     pub outputs: OutputSpec,
     /// Parameters for forward sensitivities of the outputs:
-    /// `"<body>.mass"`, `"forces[i].stiffness"`, `"forces[i].damping"`,
+    /// `"<body>.mass"`, `"<force>.stiffness"`, `"<force>.damping"` (a
+    /// named force), `"forces[i].stiffness"`, `"forces[i].damping"`,
     /// `"forces[i].segments[k].anchor"` (indices as in `scene.forces`).
     #[serde(default)]
     pub sensitivities: Vec<String>,
@@ -131,10 +132,13 @@ pub struct SceneSpec {
     pub responses: Vec<ResponseSpec>,
 }
 
-/// `[[scene.responses]] name = "psi0"; kind = "integral" | "peak";
-/// of = ["B2.strain_energy", ..]; scale = 2.0`: the time integral (as an
-/// extra integrated state) or the largest value over the run (located
-/// from dense output) of `scale · Σ` the listed strain energies.
+/// `[[scene.responses]] name = "psi0"; kind = "integral" | "peak" |
+/// "final"; of = ["B2.strain_energy", "crank.kinetic_energy",
+/// "kinetic_energy", ..]; scale = 2.0`: the time integral (as an extra
+/// integrated state), the largest value over the run (located from dense
+/// output) or the value at the end time of `scale · Σ` the listed
+/// energies (strain energies of flexible bodies, kinetic energies of a
+/// body or of all bodies).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ResponseSpec {
@@ -299,22 +303,38 @@ pub struct SegmentSpec {
 #[allow(clippy::large_enum_variant)]
 pub enum ForceSpec {
     Actuator {
+        /// Name for sensitivity parameters (`<name>.damping`).
+        name: Option<String>,
         joint: String,
         #[serde(default)]
         damping: f64,
         #[serde(default)]
         segments: Vec<SegmentSpec>,
     },
+    /// A spring-damper between two markers (`marker_i`, `marker_j`; rest
+    /// `length` default: the initial distance) or along a prismatic or
+    /// cylindrical `joint` (rest displacement `length`, default 0, and a
+    /// constant actuator `force` along the axis, default 0).
     Spring {
-        marker_i: String,
-        marker_j: String,
+        /// Name for sensitivity parameters (`<name>.stiffness`,
+        /// `<name>.damping`).
+        name: Option<String>,
+        marker_i: Option<String>,
+        marker_j: Option<String>,
+        joint: Option<String>,
         stiffness: f64,
         #[serde(default)]
         damping: f64,
         length: Option<f64>,
+        force: Option<f64>,
     },
+    /// A force and torque at a body's centre of mass (`body`) or at a
+    /// marker (`marker`), in global or body axes (`frame`).
     Load {
-        body: String,
+        body: Option<String>,
+        marker: Option<String>,
+        /// `global` (default) or `body`, as written.
+        frame: Option<String>,
         #[serde(default)]
         force: [f64; 3],
         #[serde(default)]
@@ -323,6 +343,16 @@ pub enum ForceSpec {
         /// linear between rows; replaces `force` and `torque`.
         table: Option<Vec<[f64; 7]>>,
     },
+}
+
+impl ForceSpec {
+    /// The force's name, if it has one (loads have none).
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            ForceSpec::Actuator { name, .. } | ForceSpec::Spring { name, .. } => name.as_deref(),
+            ForceSpec::Load { .. } => None,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Deserialize)]

@@ -1,8 +1,9 @@
 //! Study sections: the panel modes table (`plyscape modes`: `[modes]`,
 //! `[convergence]`), the kernel benchmark
 //! (`[kernel_bench]`), the Eq. 32 events benchmark (`[events_bench]`) and
-//! the flexible-scene convergence grid (`[scene_convergence]`) and the
-//! cost of one design evaluation (`[eval_bench]`), and the fixed- against
+//! the flexible-scene convergence grid (`[scene_convergence]`), the
+//! cost of one design evaluation (`[eval_bench]`), the cost of a scene's
+//! sensitivities in both forms (`[sens_bench]`) and the fixed- against
 //! updated-mode gradients (`[gradient_check]`). Each
 //! reads its section, runs scenes through [`crate::scene`] and
 //! [`crate::simulate`], and writes its table through [`crate::report`].
@@ -16,4 +17,5 @@ pub mod gradient_check;
 pub mod kernel_bench;
 pub mod modes;
 pub mod scene_convergence;
+pub mod sens_bench;
 pub mod stats;

@@ -5,8 +5,8 @@
 use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Stats};
 use crate::mbs::analysis::Projection;
-use crate::mbs::responses::{peak, strain_sum, ResponseKind, ResponseValue};
-use crate::mbs::{Param, Reaction, System, Workspace};
+use crate::mbs::responses::{energy_lanes, peak, ResponseKind, ResponseValue};
+use crate::mbs::{Energy, Param, Reaction, System, Workspace};
 use crate::report::csv::{sci, write_table};
 use crate::report::{line_plot, Axes, Curve};
 use crate::scene::{Quantity, Response, Scene};
@@ -81,8 +81,8 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
                 .collect()
         };
         for (r, series) in scene.responses.iter().zip(peaks.iter_mut()) {
-            if let Response::Peak { bodies, scale, .. } = r {
-                let (v, g) = strain_sum(&sys, bodies, *scale, y, &lanes);
+            if let Response::Peak { terms, scale, .. } = r {
+                let (v, g) = energy_lanes(&sys, (terms, *scale), y, &lanes);
                 series.push((t, v, g));
             }
         }
@@ -174,8 +174,9 @@ fn unwrap_angles(row: &mut [f64], prev: &[f64], columns: &[usize]) {
     }
 }
 
-/// The output columns that have sensitivities (angles, rates, positions,
-/// modal coordinates, strain energies, deflections).
+/// The output columns that have sensitivities (angles, rates, joint
+/// displacements and velocities, positions, modal coordinates, strain
+/// energies, deflections).
 fn sens_quantities(scene: &Scene) -> Vec<(String, Quantity)> {
     scene
         .outputs
@@ -185,9 +186,12 @@ fn sens_quantities(scene: &Scene) -> Vec<(String, Quantity)> {
                 q,
                 Quantity::Angle(_)
                     | Quantity::Rate(_)
+                    | Quantity::Displacement(_)
+                    | Quantity::Velocity(_)
                     | Quantity::Position(_)
                     | Quantity::Modal(..)
                     | Quantity::Strain(_)
+                    | Quantity::Kinetic(_)
                     | Quantity::Deflection(_)
             )
         })
@@ -227,6 +231,8 @@ fn output_row(
         match q {
             Quantity::Angle(j) => row.push(sys.angle(y, *j, ws).0),
             Quantity::Rate(j) => row.push(sys.angle(y, *j, ws).1),
+            Quantity::Displacement(j) => row.push(sys.slide(y, *j, ws).0),
+            Quantity::Velocity(j) => row.push(sys.slide(y, *j, ws).1),
             Quantity::Reaction(j) => {
                 let r = reactions.map(|r| r[*j]).unwrap_or(Reaction {
                     force: Default::default(),
@@ -249,6 +255,7 @@ fn output_row(
                 None => row.extend(std::iter::repeat_n(0.0, *n)),
             },
             Quantity::Strain(b) => row.push(sys.slot[*b].map_or(0.0, |s| sys.strain_energy(y, s))),
+            Quantity::Kinetic(b) => row.push(sys.energy_sum(&kinetic_terms(sys, *b), y, ws)),
             Quantity::Deflection(m) => row.extend(sys.deflection(y, *m).iter()),
             Quantity::Energy => row.push(sys.energy(y, ws)),
             Quantity::Violation => row.push(viol),
@@ -281,6 +288,22 @@ fn collect_responses(
                     .map(|i| s_end[i * n + io + index])
                     .collect(),
             },
+            Response::Final { name, terms, scale } => {
+                let lanes: Vec<(&[f64], Param)> = scene
+                    .params
+                    .iter()
+                    .enumerate()
+                    .map(|(i, (_, p))| (&s_end[i * n..(i + 1) * n], *p))
+                    .collect();
+                let (value, gradient) = energy_lanes(sys, (terms, *scale), y_end, &lanes);
+                ResponseValue {
+                    name: name.clone(),
+                    kind: ResponseKind::Final,
+                    value,
+                    time: scene.options.times.last().copied(),
+                    gradient,
+                }
+            }
             Response::Peak { name, .. } => {
                 let (t, value, gradient) = peak(series).ok_or_else(|| {
                     Error::numerical("simulate: responses", format!("no samples for {name}"))
@@ -310,13 +333,10 @@ fn output_sensitivities(
 ) -> Vec<f64> {
     let (s, param) = lane;
     let yd: Vec<Dual64> = y.iter().zip(s).map(|(&a, &b)| Dual64::new(a, b)).collect();
-    let seeds: Vec<(Param, Dual64)> = match param {
-        p if p.is_design() => vec![(
-            param,
-            Dual64::new(param.value(&sys.model).unwrap_or(0.0), 1.0),
-        )],
-        _ => Vec::new(),
-    };
+    let seeds = vec![(
+        param,
+        Dual64::new(param.value(&sys.model).unwrap_or(0.0), 1.0),
+    )];
     let mut kin = Vec::new();
     sys.body_kin(&yd, &seeds, &mut kin);
     let mut out = Vec::new();
@@ -324,6 +344,8 @@ fn output_sensitivities(
         match q {
             Quantity::Angle(j) => out.push(sys.joint_angle(&kin, *j).0.eps),
             Quantity::Rate(j) => out.push(sys.joint_angle(&kin, *j).1.eps),
+            Quantity::Displacement(j) => out.push(sys.joint_slide(&kin, *j).0.eps),
+            Quantity::Velocity(j) => out.push(sys.joint_slide(&kin, *j).1.eps),
             Quantity::Position(b) => match sys.slot[*b] {
                 Some(k) => {
                     let p = sys.pos_off(k);
@@ -342,6 +364,11 @@ fn output_sensitivities(
                 Some(k) => sys.strain_energy_dual(&yd, k, &kin[k].design).eps,
                 None => 0.0,
             }),
+            Quantity::Kinetic(b) => {
+                let mut ws = Workspace::empty();
+                ws.params = seeds.clone();
+                out.push(sys.energy_sum(&kinetic_terms(sys, *b), &yd, &mut ws).eps);
+            }
             Quantity::Deflection(m) => {
                 let d = sys.deflection_kin(&kin, *m);
                 out.extend(d.iter().map(|v| v.eps));
@@ -350,6 +377,15 @@ fn output_sensitivities(
         }
     }
     out
+}
+
+/// The kinetic energy terms of output `<body>.kinetic_energy` (`Some`) or
+/// `kinetic_energy` (`None`: every body).
+fn kinetic_terms(sys: &System, body: Option<usize>) -> Vec<Energy> {
+    match body {
+        Some(b) => vec![Energy::Kinetic(b)],
+        None => Energy::kinetic_total(&sys.model),
+    }
 }
 
 /// Write `history.csv`, `stats.csv`, `sensitivities.csv` and
