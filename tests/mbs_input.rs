@@ -259,7 +259,9 @@ fn simulate_command_writes_history_stats_and_svg() {
         &study,
         BASE.replace(
             "quantities = [\"pin.angle\"]",
-            "quantities = [\"pin.angle\", \"pin.reaction\"]\nplot = \"pin.angle\"",
+            "quantities = [\"pin.angle\", \"pin.reaction\"]\nplot = \"pin.angle\"\n\
+             [[scene.responses]]\nname = \"T_int\"\nkind = \"integral\"\nof = [\"kinetic_energy\"]\n\
+             [[scene.responses]]\nname = \"T_max\"\nkind = \"peak\"\nof = [\"kinetic_energy\"]",
         ),
     )
     .unwrap();
@@ -289,6 +291,21 @@ fn simulate_command_writes_history_stats_and_svg() {
     let stats = std::fs::read_to_string(res.join("stats.csv")).unwrap();
     assert!(stats.contains("redundant_equations,0"), "{stats}");
     assert!(res.join("pin.angle.svg").exists());
+    // responses.csv names each response's unit.
+    let resp = std::fs::read_to_string(res.join("responses.csv")).unwrap();
+    let lines: Vec<&str> = resp.lines().collect();
+    assert!(
+        lines[0].starts_with("response,kind,value,unit,time [s]"),
+        "{resp}"
+    );
+    assert!(
+        lines[1].starts_with("T_int,integral,") && lines[1].contains(",J*s,"),
+        "{resp}"
+    );
+    assert!(
+        lines[2].starts_with("T_max,peak,") && lines[2].contains(",J,"),
+        "{resp}"
+    );
     // The manifest: the build's commit, the study text, start and end (UTC).
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(res.join("manifest.json")).unwrap()).unwrap();

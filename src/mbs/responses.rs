@@ -48,6 +48,17 @@ impl std::fmt::Display for ResponseKind {
     }
 }
 
+impl ResponseKind {
+    /// SI unit of a response of this kind over energies (J) with a
+    /// dimensionless scale: `J*s` for an integral, `J` otherwise.
+    pub fn unit(&self) -> &'static str {
+        match self {
+            ResponseKind::Integral => "J*s",
+            ResponseKind::Peak | ResponseKind::Final => "J",
+        }
+    }
+}
+
 /// One evaluated response.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResponseValue {

@@ -453,6 +453,7 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
             "response".to_string(),
             "kind".into(),
             "value".into(),
+            "unit".into(),
             "time [s]".into(),
         ];
         head.extend(scene.params.iter().map(|(p, _)| format!("d/d({p})")));
@@ -464,6 +465,7 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
                     r.name.clone(),
                     r.kind.to_string(),
                     sci(r.value, 12),
+                    r.kind.unit().to_string(),
                     r.time.map_or(String::new(), |t| format!("{t:.6}")),
                 ];
                 rec.extend(r.gradient.iter().map(|g| sci(*g, 12)));
