@@ -367,8 +367,15 @@ pub fn run_scene(cfg: &RunConfig) -> Result<()> {
             .into(),
     );
     crate::report::record_command(&dir, &cfg.study, 1, "simulate", entry, Default::default())?;
+    let (rigid_lines, warnings) = simulate::rigid_summary(&scene);
+    for w in &warnings {
+        eprintln!("{w}");
+    }
     if !cfg.quiet {
         println!("{}", simulate::summary(&sim));
+        for l in &rigid_lines {
+            println!("{l}");
+        }
         for f in files {
             println!("wrote {}", f.display());
         }

@@ -59,6 +59,30 @@ pub struct BasisDerivative {
     pub shapes: Vec<f64>,
 }
 
+/// A mode left out of a basis because it is almost a rigid motion of the
+/// frame ([`crate::panels::rigid`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DroppedMode {
+    /// 1-based index among the computed modes (ascending frequency).
+    pub mode: usize,
+    /// Frequency `√λ/(2π)` \[Hz\].
+    pub frequency_hz: f64,
+    /// Rigid-body content `‖Pφ‖²_M / ‖φ‖²_M` (dimensionless).
+    pub content: f64,
+}
+
+/// Rigid-body content of a basis's modes, and the modes left out for it
+/// (empty for bases that do not compute it, e.g. closed-form beams).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RigidScreen {
+    /// Content of each kept mode, in basis order (empty if not computed).
+    pub content: Vec<f64>,
+    /// Modes dropped because their content exceeded `limit`.
+    pub dropped: Vec<DroppedMode>,
+    /// The content above which a mode is dropped (0 if not screened).
+    pub limit: f64,
+}
+
 /// The modal data of a flexible body: everything the multibody kernel
 /// needs from a finite element model (or from closed-form modes).
 #[derive(Debug, Clone, PartialEq)]
@@ -82,6 +106,8 @@ pub struct ModalBasis {
     pub eigenvalues: Vec<f64>,
     /// Derivatives with respect to design variables (may be empty).
     pub derivatives: Vec<BasisDerivative>,
+    /// Rigid-body content of the modes and the modes dropped for it.
+    pub rigid: RigidScreen,
 }
 
 impl ModalBasis {
@@ -204,6 +230,10 @@ impl ModalBasis {
                     shapes: pick(&d.shapes),
                 })
                 .collect(),
+            rigid: RigidScreen {
+                content: self.rigid.content.iter().take(n).copied().collect(),
+                ..self.rigid.clone()
+            },
         }
     }
 
@@ -440,6 +470,7 @@ mod tests {
                     d
                 },
             }],
+            rigid: RigidScreen::default(),
         }
     }
 

@@ -71,7 +71,7 @@ pub mod workspace;
 
 pub use analysis::{Projection, Reaction};
 pub use dynamics::{System, Workspace};
-pub use flex::{BasisDerivative, Invariants, ModalBasis};
+pub use flex::{BasisDerivative, DroppedMode, Invariants, ModalBasis, RigidScreen};
 pub use model::{
     Body, Drive, Force, Joint, JointKind, Marker, Model, Param, PiecewiseLaw, Segment,
 };

@@ -6,6 +6,7 @@
 //! the mirrors x → −x and y → −y (`SS`, `SA`, `AS`, `AA`; `-` where the
 //! mesh has no mirror nodes or the correlation is weak).
 
+use super::rigid::RigidFrame;
 use crate::error::{Error, Result};
 use crate::fe::{Derivatives, Panel, PanelSystem};
 use crate::modal::{
@@ -38,6 +39,12 @@ pub struct PanelModes {
     pub dof_map: Vec<(usize, usize)>,
     /// Node coordinates, panel frame \[m\].
     pub nodes: Vec<[f64; 2]>,
+    /// Rigid-body content per mode, `‖Pφ‖²_M / ‖φ‖²_M` in \[0, 1\]
+    /// ([`super::rigid`]): ≈ 1 for the centre clamp's drilling mode, ≈ 0
+    /// for free–free elastic modes.
+    pub rigid_content: Vec<f64>,
+    /// The panel's rigid frame (all node masses, `RᵀMR`) for this lay-up.
+    pub frame: RigidFrame,
 }
 
 /// Lay-up as `[a/b/c]` in degrees (rounded to 0.01°).
@@ -183,6 +190,17 @@ impl PanelAnalysis {
                 format!("theta_{}", plies.join("_"))
             })
             .collect();
+        let frame = RigidFrame::of_panel(&self.panel, laminate)?;
+        let rigid_content = (0..modes.lambda.len())
+            .map(|j| {
+                frame.content(
+                    sys.dof_map
+                        .iter()
+                        .enumerate()
+                        .map(|(f, &(node, comp))| (node, comp, modes.modes[(f, j)])),
+                )
+            })
+            .collect();
         let mut with_layup = self.panel.clone();
         with_layup.laminate = laminate.clone();
         Ok(PanelModes {
@@ -200,6 +218,8 @@ impl PanelAnalysis {
             ],
             dof_map: sys.dof_map.clone(),
             nodes: self.panel.mesh.nodes.clone(),
+            rigid_content,
+            frame,
         })
     }
 }

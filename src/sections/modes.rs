@@ -89,6 +89,8 @@ pub struct ModeRow {
     pub residual: f64,
     pub kind: &'static str,
     pub symmetry: &'static str,
+    /// Rigid-body content `‖Pφ‖²_M / ‖φ‖²_M` ([`crate::panels::rigid`]).
+    pub rigid_content: f64,
 }
 
 impl ModesSpec {
@@ -170,6 +172,7 @@ pub fn mode_rows(results: &[PanelModes]) -> Vec<ModeRow> {
                 residual: r.modes.residuals[j],
                 kind: r.labels[j].0,
                 symmetry: r.labels[j].1,
+                rigid_content: r.rigid_content[j],
             });
         }
     }
@@ -191,6 +194,7 @@ pub fn write_results(dir: &Path, results: &[PanelModes], spec: &ModesSpec) -> Re
         "residual",
         "kind",
         "symmetry",
+        "rigid_content",
     ])?;
     for row in mode_rows(results) {
         let reference = spec
@@ -208,6 +212,7 @@ pub fn write_results(dir: &Path, results: &[PanelModes], spec: &ModesSpec) -> Re
             format!("{:.2e}", row.residual),
             row.kind.to_string(),
             row.symmetry.to_string(),
+            format!("{:.9}", row.rigid_content),
         ])?;
     }
     w.finish()?;
