@@ -313,12 +313,20 @@ fn handlers() -> Vec<(&'static str, Handler)> {
         ("events_bench", run_events_bench_handler),
         ("scene_convergence", run_scene_convergence_handler),
         ("eval_bench", run_eval_bench_handler),
+        ("support_compare", run_support_compare_handler),
     ]
 }
 
 /// The `[scene_convergence]` section: responses vs mesh and modes, with cost.
 fn run_scene_convergence_handler(cfg: &RunConfig) -> Result<()> {
     crate::sections::scene_convergence::run_scene_convergence(&cfg.study, &cfg.out, cfg.quiet)
+        .map(|_| ())
+}
+
+/// The `[support_compare]` section: a flexible scene per panel support
+/// and integrator, cost and answers against the first support.
+fn run_support_compare_handler(cfg: &RunConfig) -> Result<()> {
+    crate::sections::support_compare::run_support_compare(&cfg.study, &cfg.out, cfg.quiet)
         .map(|_| ())
 }
 

@@ -2,7 +2,8 @@
 //! `[convergence]`), the kernel benchmark
 //! (`[kernel_bench]`), the Eq. 32 events benchmark (`[events_bench]`) and
 //! the flexible-scene convergence grid (`[scene_convergence]`) and the
-//! cost of one design evaluation (`[eval_bench]`). Each
+//! cost of one design evaluation (`[eval_bench]`) and the panel
+//! reference-condition comparison (`[support_compare]`). Each
 //! reads its section, runs scenes through [`crate::scene`] and
 //! [`crate::simulate`], and writes its table through [`crate::report`].
 //!
@@ -15,3 +16,4 @@ pub mod kernel_bench;
 pub mod modes;
 pub mod scene_convergence;
 pub mod stats;
+pub mod support_compare;
