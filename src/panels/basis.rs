@@ -288,10 +288,11 @@ pub const RIGID_CONTENT_LIMIT: f64 = 0.9;
 /// the dropped ones. `lambda` \[1/s²\] and `content` per computed mode.
 /// Error ([`Error::Numerical`]) if every mode would be dropped.
 fn screen_rigid(lambda: &[f64], content: &[f64]) -> Result<(Vec<usize>, RigidScreen)> {
-    let limit = RIGID_CONTENT_LIMIT;
-    let keep: Vec<usize> = (0..lambda.len()).filter(|&j| content[j] <= limit).collect();
+    let keep: Vec<usize> = (0..lambda.len())
+        .filter(|&j| content[j] <= RIGID_CONTENT_LIMIT)
+        .collect();
     let dropped = (0..lambda.len())
-        .filter(|&j| content[j] > limit)
+        .filter(|&j| content[j] > RIGID_CONTENT_LIMIT)
         .map(|j| DroppedMode {
             mode: j + 1,
             frequency_hz: lambda[j].sqrt() / (2.0 * std::f64::consts::PI),
@@ -303,14 +304,14 @@ fn screen_rigid(lambda: &[f64], content: &[f64]) -> Result<(Vec<usize>, RigidScr
             "panels::basis",
             format!(
                 "every computed mode is almost a rigid motion of the frame (rigid content \
-                 {content:?} > {limit}); ask for more modes"
+                 {content:?} > {RIGID_CONTENT_LIMIT}); ask for more modes"
             ),
         ));
     }
     let screen = RigidScreen {
         content: keep.iter().map(|&j| content[j]).collect(),
         dropped,
-        limit: limit,
+        limit: RIGID_CONTENT_LIMIT,
     };
     Ok((keep, screen))
 }
