@@ -9,6 +9,7 @@ use plyscape::fe::{assemble, Derivatives, Mesh, MeshParams, Panel, Support};
 use plyscape::laminate::{DesignMap, Laminate, Orthotropic, Ply};
 use plyscape::mbs::{Invariants, ModalBasis};
 use plyscape::modal::{ModalOptions, ModalSolver, ModeUpdate};
+use plyscape::panels::basis::RIGID_CONTENT_LIMIT;
 use plyscape::panels::{basis_for_study, panel_basis};
 use plyscape::study::Study;
 
@@ -174,13 +175,7 @@ fn modes_are_the_solvers_and_m_orthonormal() {
     let n = 8;
     let basis = panel_basis(&p, n, None).unwrap();
     basis.validate("basis").unwrap();
-    // The centre clamp's nearly rigid modes (rigid content > the limit)
-    // are dropped; the others are the solver's, in order.
-    assert!(!basis.rigid.dropped.is_empty());
-    assert_eq!(basis.n_modes + basis.rigid.dropped.len(), n);
-    let kept: Vec<usize> = (0..n)
-        .filter(|&j| basis.rigid.dropped.iter().all(|d| d.mode != j + 1))
-        .collect();
+    assert_eq!(basis.n_modes, n);
     assert_eq!(basis.n_nodes(), p.mesh.nodes.len());
     let e = orthonormality_error(&basis);
     assert!(e < 1e-9, "mww − I = {e:e}");
@@ -197,19 +192,23 @@ fn modes_are_the_solvers_and_m_orthonormal() {
         .unwrap()
         .solve(&ModalOptions::new(n))
         .unwrap();
-    for (b, &j) in kept.iter().enumerate() {
-        let (l, r) = (basis.eigenvalues[b], modes.lambda[j]);
+    for j in 0..n {
+        let (l, r) = (basis.eigenvalues[j], modes.lambda[j]);
         assert!((l - r).abs() <= 1e-12 * r, "mode {j}: {l} vs {r}");
         for (f, &(node, comp)) in sys.dof_map.iter().enumerate() {
-            assert_eq!(basis.shape(node, comp, b), modes.modes[(f, j)]);
+            assert_eq!(basis.shape(node, comp, j), modes.modes[(f, j)]);
         }
     }
-    for d in &basis.rigid.dropped {
-        assert!(d.content > basis.rigid.limit, "{d:?}");
-        let l = modes.lambda[d.mode - 1];
-        assert!((d.frequency_hz - l.sqrt() / (2.0 * std::f64::consts::PI)).abs() < 1e-12);
+    // Centre clamp: all six components at the centre node are zero.
+    let c = p.mesh.centre;
+    assert_eq!(p.mesh.nodes[c], [0.0, 0.0]);
+    for comp in 0..6 {
+        for j in 0..n {
+            assert_eq!(basis.shape(c, comp, j), 0.0);
+        }
     }
-    assert!(basis.rigid.content.iter().all(|&c| c <= basis.rigid.limit));
+    // The centre node still carries its lumped mass.
+    assert!(basis.node_mass[c] > 0.0);
 }
 
 #[test]
@@ -341,13 +340,16 @@ fn check_design_derivatives(support: Support) {
     check_panel_derivatives(&p, 6);
 }
 
-/// [`check_design_derivatives`] for panel `p` and `n_asked` computed modes
-/// (the basis keeps those below the rigid-content limit; their
-/// derivatives are checked, the same modes being dropped at ±h).
+/// [`check_design_derivatives`] for panel `p` and `n_asked` computed modes,
+/// screened as a scene does (modes above the rigid-content limit dropped;
+/// the kept modes' derivatives are checked, the same modes being dropped
+/// at ±h). Returns the number dropped.
 fn check_panel_derivatives(p: &Panel, n_asked: usize) -> usize {
     let support = p.support;
-    let up = panel_basis(p, n_asked, Some(ModeUpdate::Updated)).unwrap();
-    let fixed = panel_basis(p, n_asked, Some(ModeUpdate::Fixed)).unwrap();
+    // The scene's screening (ModalBasis::screened at the default limit).
+    let screen = |b: ModalBasis| b.screened(RIGID_CONTENT_LIMIT).unwrap();
+    let up = screen(panel_basis(p, n_asked, Some(ModeUpdate::Updated)).unwrap());
+    let fixed = screen(panel_basis(p, n_asked, Some(ModeUpdate::Fixed)).unwrap());
     let n = up.n_modes;
     println!(
         "{support:?}: {n} of {n_asked} modes kept, dropped {:?}",
@@ -366,7 +368,10 @@ fn check_panel_derivatives(p: &Panel, n_asked: usize) -> usize {
     // relative, rounding ~ 1e-10 (Lanczos tolerance) / h ~ 1e-6.
     let h = 1e-4;
     for v in 0..2 {
-        let (bp, bm) = (basis_at(p, n_asked, v, h), basis_at(p, n_asked, v, -h));
+        let (bp, bm) = (
+            screen(basis_at(p, n_asked, v, h)),
+            screen(basis_at(p, n_asked, v, -h)),
+        );
         assert_eq!(
             (bp.rigid.dropped.len(), bm.rigid.dropped.len()),
             (n_asked - n, n_asked - n)
@@ -490,8 +495,7 @@ plies = [{ angle = 0.0, thickness = 0.5e-3 }, { angle = 90.0, thickness = 0.5e-3
     let study = Study::parse("basis.toml", text).unwrap();
     // The named panel works.
     let b = basis_for_study(&study, "panel3", 3, None).unwrap();
-    // (The centre clamp's nearly rigid modes are dropped.)
-    assert_eq!(b.n_modes + b.rigid.dropped.len(), 3);
+    assert_eq!(b.n_modes, 3);
     // Unknown name: input error naming file, key and value.
     match basis_for_study(&study, "panel9", 3, None) {
         Err(Error::Input {
@@ -533,9 +537,7 @@ plies = [{ angle = 0.0, thickness = 0.5e-3 }, { angle = 90.0, thickness = 0.5e-3
 fn repeated_modes_refuse_updated_derivatives() {
     // A square plate of an isotropic material (E1 = E2, G = E/2(1+ν)) on the
     // union-jack mesh, which is invariant under a 90° rotation: the two
-    // rocking modes of the centre clamp form an exactly repeated pair
-    // (dropped from the basis: rigid content 0.993), and so do modes 6
-    // and 7 (0-based 5, 6; rigid content 0.003).
+    // rocking modes of the centre clamp form an exactly repeated pair.
     let e = 70e9;
     let nu = 0.3;
     let g = e / (2.0 * (1.0 + nu));
@@ -559,15 +561,44 @@ fn repeated_modes_refuse_updated_derivatives() {
             .collect(),
     )
     .unwrap();
-    let fixed = panel_basis(&p, 8, Some(ModeUpdate::Fixed)).unwrap();
-    assert_eq!(fixed.rigid.dropped.len(), 2);
+    let fixed = panel_basis(&p, 4, Some(ModeUpdate::Fixed)).unwrap();
     let l = &fixed.eigenvalues;
-    assert!((l[4] - l[3]).abs() < 1e-8 * l[4], "{l:?}");
-    match panel_basis(&p, 8, Some(ModeUpdate::Updated)) {
+    assert!((l[1] - l[0]).abs() < 1e-8 * l[1], "{l:?}");
+    match panel_basis(&p, 4, Some(ModeUpdate::Updated)) {
         Err(Error::Numerical { place, detail, .. }) => {
             assert!(place.contains("panels::basis"), "{place}");
-            assert!(detail.contains("modes 5..=6"), "{detail}");
+            assert!(detail.contains("modes 0..=1"), "{detail}");
         }
         other => panic!("expected a numerical error, got {other:?}"),
     }
+}
+
+#[test]
+fn screening_drops_the_nearly_rigid_modes_only() {
+    // A panel basis carries every computed mode with its rigid-body
+    // content; screening at 0.9 drops the centre clamp's rocking modes
+    // (content > 0.98) and keeps the others as they are.
+    let p = test_panel(Support::CentreClamp);
+    let n = 8;
+    let b = panel_basis(&p, n, None).unwrap();
+    assert_eq!((b.n_modes, b.rigid.content.len()), (n, n));
+    assert!(b.rigid.dropped.is_empty());
+    let s = b.screened(RIGID_CONTENT_LIMIT).unwrap();
+    s.validate("screened").unwrap();
+    assert!(!s.rigid.dropped.is_empty());
+    assert_eq!(s.n_modes + s.rigid.dropped.len(), n);
+    assert!(orthonormality_error(&s) < 1e-9);
+    let mut k = 0;
+    for j in 0..n {
+        if let Some(d) = s.rigid.dropped.iter().find(|d| d.mode == j + 1) {
+            assert!(d.content > 0.98 && d.content == b.rigid.content[j], "{d:?}");
+            continue;
+        }
+        assert!(b.rigid.content[j] < 0.9);
+        assert_eq!(s.eigenvalues[k], b.eigenvalues[j]);
+        assert_eq!(column(&s.shapes, s.n_modes, k), column(&b.shapes, n, j));
+        k += 1;
+    }
+    // Limit 1 keeps every mode.
+    assert_eq!(b.screened(1.0).unwrap().n_modes, n);
 }

@@ -79,7 +79,8 @@ pub struct RigidScreen {
     pub content: Vec<f64>,
     /// Modes dropped because their content exceeded `limit`.
     pub dropped: Vec<DroppedMode>,
-    /// The content above which a mode is dropped (0 if not screened).
+    /// The content above which modes were dropped
+    /// ([`ModalBasis::screened`]); 1 if the basis was not screened.
     pub limit: f64,
 }
 
@@ -235,6 +236,70 @@ impl ModalBasis {
                 ..self.rigid.clone()
             },
         }
+    }
+
+    /// The basis without its modes of rigid-body content above `limit`
+    /// (`rigid.content` per mode, [`crate::panels::rigid`]): the kept
+    /// modes keep their order, eigenvalues and derivative columns, and
+    /// `rigid` lists the dropped ones (1-based computed-mode numbers,
+    /// frequency \[Hz\], content). A basis without contents (closed-form
+    /// beams) is returned as is. Error ([`Error::Numerical`]) if no mode
+    /// would be left.
+    pub fn screened(&self, limit: f64) -> Result<ModalBasis> {
+        if self.rigid.content.len() != self.n_modes {
+            return Ok(self.clone());
+        }
+        let keep: Vec<usize> = (0..self.n_modes)
+            .filter(|&j| self.rigid.content[j] <= limit)
+            .collect();
+        if keep.is_empty() {
+            return Err(Error::numerical(
+                "mbs::ModalBasis::screened",
+                format!(
+                    "every mode is almost a rigid motion of the frame (rigid content {:?} > \
+                     {limit}); ask for more modes or raise rigid_limit",
+                    self.rigid.content
+                ),
+            ));
+        }
+        let n = self.n_modes;
+        let pick = |v: &[f64]| -> Vec<f64> {
+            v.chunks(n)
+                .flat_map(|row| keep.iter().map(move |&j| row[j]))
+                .collect()
+        };
+        let mut dropped = self.rigid.dropped.clone();
+        dropped.extend(
+            (0..n)
+                .filter(|&j| self.rigid.content[j] > limit)
+                .map(|j| DroppedMode {
+                    mode: j + 1,
+                    frequency_hz: self.eigenvalues[j].sqrt() / (2.0 * std::f64::consts::PI),
+                    content: self.rigid.content[j],
+                }),
+        );
+        Ok(ModalBasis {
+            nodes: self.nodes.clone(),
+            node_mass: self.node_mass.clone(),
+            node_inertia: self.node_inertia.clone(),
+            n_modes: keep.len(),
+            shapes: pick(&self.shapes),
+            eigenvalues: keep.iter().map(|&j| self.eigenvalues[j]).collect(),
+            derivatives: self
+                .derivatives
+                .iter()
+                .map(|d| BasisDerivative {
+                    name: d.name.clone(),
+                    eigenvalues: keep.iter().map(|&j| d.eigenvalues[j]).collect(),
+                    shapes: pick(&d.shapes),
+                })
+                .collect(),
+            rigid: RigidScreen {
+                content: keep.iter().map(|&j| self.rigid.content[j]).collect(),
+                dropped,
+                limit,
+            },
+        })
     }
 
     /// The same body with its frame origin moved to the body-frame point

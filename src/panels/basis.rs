@@ -72,12 +72,18 @@
 //! Every computed mode's rigid-body content `c = ‖Pφ‖²_M / ‖φ‖²_M`
 //! ([`super::rigid`]: `P = R (RᵀMR)⁻¹ RᵀM` projects M-orthogonally onto
 //! the six rigid motions `R` of the frame, all node masses included) is
-//! recorded in [`ModalBasis::rigid`], and a mode with
-//! `c > `[`RIGID_CONTENT_LIMIT`]` = 0.9` is **dropped** from the basis
-//! (the basis then has fewer modes than asked; the dropped ones are listed
-//! with frequency and content, and `plyscape simulate` prints them).
+//! recorded in [`ModalBasis::rigid`]. A scene's panel body then drops
+//! every mode with `c >` its `rigid_limit` (default
+//! [`RIGID_CONTENT_LIMIT`]` = 0.9`; [`ModalBasis::screened`], called in
+//! [`crate::scene`]): the body has fewer modes than asked; the dropped
+//! ones are listed with frequency and content, and `plyscape simulate`
+//! prints them. `rigid_limit = 1` keeps every mode: right when the frame
+//! is itself held at the clamped node (a panel welded at its centre to a
+//! hub), where these modes are the clamp's real compliance and not a
+//! second description of the frame's motion.
 //!
-//! Why. The strain energy does not see rigid motions (`K R = 0` for the
+//! Why (a free frame, the panel held by joints elsewhere, as in the SAR
+//! scene). The strain energy does not see rigid motions (`K R = 0` for the
 //! unconstrained panel, and a mode is zero on the clamped DOFs), so the
 //! elastic part `(I − P)φ` of a mass-normalised mode has stiffness `λ` and
 //! mass `1 − c`: in a floating-frame body, whose frame already carries the
@@ -128,7 +134,7 @@ use super::rigid::RigidFrame;
 use crate::error::{Error, Result};
 use crate::fe::{Panel, NODE_DOF};
 use crate::laminate::Laminate;
-use crate::mbs::{BasisDerivative, DroppedMode, ModalBasis, RigidScreen};
+use crate::mbs::{BasisDerivative, ModalBasis, RigidScreen};
 use crate::modal::ModeUpdate;
 use crate::study::Study;
 use nalgebra::Vector3;
@@ -180,7 +186,14 @@ impl BasisBuilder {
                 ));
             }
         }
-        let (keep, rigid) = screen_rigid(&run.modes.lambda, &run.rigid_content)?;
+        // Every computed mode, with its rigid-body content; the scene
+        // drops the nearly rigid ones (ModalBasis::screened).
+        let keep: Vec<usize> = (0..run.modes.lambda.len()).collect();
+        let rigid = RigidScreen {
+            content: run.rigid_content.clone(),
+            dropped: Vec::new(),
+            limit: 1.0,
+        };
         let n = keep.len();
         // Scatter the kept columns of a free-DOF matrix (n_dof × computed)
         // into the 6-per-node layout.
@@ -199,11 +212,7 @@ impl BasisBuilder {
         for (d, name) in run.derivatives.iter().zip(&run.variables) {
             let dshapes = match (self.update, &d.dmodes) {
                 (Some(ModeUpdate::Updated), Some(dx)) => {
-                    // A cluster matters only if it holds a kept mode.
-                    let kept = |c: &&crate::modal::Cluster| {
-                        (c.first..c.first + c.len).any(|j| keep.contains(&j))
-                    };
-                    if let Some(c) = d.clusters.iter().find(kept) {
+                    if let Some(c) = d.clusters.first() {
                         return Err(Error::numerical(
                             "panels::basis",
                             format!(
@@ -282,39 +291,6 @@ impl BasisBuilder {
 /// spectrum: rocking and drilling modes have `c ≥ 0.979`, every other
 /// mode `c ≤ 0.575` (SAR panel, 8 to 48 divisions).
 pub const RIGID_CONTENT_LIMIT: f64 = 0.9;
-
-/// Which computed modes a basis keeps (content ≤ [`RIGID_CONTENT_LIMIT`])
-/// and the [`RigidScreen`] that records the content of the kept ones and
-/// the dropped ones. `lambda` \[1/s²\] and `content` per computed mode.
-/// Error ([`Error::Numerical`]) if every mode would be dropped.
-fn screen_rigid(lambda: &[f64], content: &[f64]) -> Result<(Vec<usize>, RigidScreen)> {
-    let keep: Vec<usize> = (0..lambda.len())
-        .filter(|&j| content[j] <= RIGID_CONTENT_LIMIT)
-        .collect();
-    let dropped = (0..lambda.len())
-        .filter(|&j| content[j] > RIGID_CONTENT_LIMIT)
-        .map(|j| DroppedMode {
-            mode: j + 1,
-            frequency_hz: lambda[j].sqrt() / (2.0 * std::f64::consts::PI),
-            content: content[j],
-        })
-        .collect();
-    if keep.is_empty() {
-        return Err(Error::numerical(
-            "panels::basis",
-            format!(
-                "every computed mode is almost a rigid motion of the frame (rigid content \
-                 {content:?} > {RIGID_CONTENT_LIMIT}); ask for more modes"
-            ),
-        ));
-    }
-    let screen = RigidScreen {
-        content: keep.iter().map(|&j| content[j]).collect(),
-        dropped,
-        limit: RIGID_CONTENT_LIMIT,
-    };
-    Ok((keep, screen))
-}
 
 /// The modal basis of a panel for a floating-frame flexible body (module
 /// doc): mesh nodes (panel coordinates, `z = 0` mid-surface, origin at the

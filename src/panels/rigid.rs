@@ -25,7 +25,7 @@
 //! mode: every free–free elastic mode), `c ≈ 1` that the mode is almost a
 //! rigid motion. The single clamped node of `centre_clamp` leaves the
 //! in-plane rotation about it resisted only by the drilling stiffness:
-//! that mode has `c ≈ 1 − 1e-6` (SAR panel, 32 divisions), and in a
+//! that mode has `c ≈ 1 − 5e-7` (SAR panel 3, 32 divisions), and in a
 //! floating-frame body it duplicates the frame's own rotation about the
 //! panel normal (see [`crate::panels::basis`] for the treatment).
 //!

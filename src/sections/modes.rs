@@ -20,6 +20,13 @@
 //! Where the mesh has no mirror nodes (an asymmetric set of attachment
 //! points) or the correlation is weak, the symmetry is `-`.
 //!
+//! `rigid_content` is the share `‖Pφ‖²_M / ‖φ‖²_M` (dimensionless, 0..1)
+//! of the mode that is a rigid motion of the panel frame, `P` the
+//! M-orthogonal projector on the six rigid motions about the panel centre
+//! ([`crate::panels::rigid`]). The modal bases of flexible bodies drop
+//! modes above 0.9 ([`crate::panels::basis`]); this table lists every
+//! computed mode.
+//!
 //! The analysis itself is [`crate::panels`].
 
 use super::stats::median;
@@ -293,7 +300,7 @@ pub fn print_table(results: &[PanelModes], spec: &ModesSpec) {
         );
         let reference = spec.reference_hz.get(&r.panel);
         println!(
-            "  mode  f [Hz]     {}kind      symmetry",
+            "  mode  f [Hz]     {}kind      symmetry  rigid content",
             if reference.is_some() {
                 "ref [Hz]  ratio  "
             } else {
@@ -307,11 +314,12 @@ pub fn print_table(results: &[PanelModes], spec: &ModesSpec) {
                 None => String::new(),
             };
             println!(
-                "  {:>4}  {:<9.4}  {refcol}{:<9} {}",
+                "  {:>4}  {:<9.4}  {refcol}{:<9} {:<9} {:.7}",
                 j + 1,
                 f,
                 r.labels[j].0,
-                r.labels[j].1
+                r.labels[j].1,
+                r.rigid_content[j]
             );
         }
     }
