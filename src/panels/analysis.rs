@@ -73,6 +73,9 @@ pub struct PanelAnalysis {
     solver: ModalSolver,
     want: Option<ModeUpdate>,
     mirrors: [Option<Vec<usize>>; 2],
+    /// The rigid frame of the last run, keyed by the laminate's mass and
+    /// rotary inertia per area (it does not depend on the ply angles).
+    frame: Option<([f64; 2], RigidFrame)>,
     /// Wall time of the set-up \[s\].
     pub setup_seconds: f64,
 }
@@ -113,6 +116,7 @@ impl PanelAnalysis {
             solver,
             want,
             mirrors,
+            frame: None,
             setup_seconds: t0.elapsed().as_secs_f64(),
         })
     }
@@ -190,7 +194,15 @@ impl PanelAnalysis {
                 format!("theta_{}", plies.join("_"))
             })
             .collect();
-        let frame = RigidFrame::of_panel(&self.panel, laminate)?;
+        let key = [laminate.mass_per_area(), laminate.rotary_inertia_per_area()];
+        let frame = match &self.frame {
+            Some((k, f)) if *k == key => f.clone(),
+            _ => {
+                let f = RigidFrame::of_panel(&self.panel, laminate)?;
+                self.frame = Some((key, f.clone()));
+                f
+            }
+        };
         let rigid_content = (0..modes.lambda.len())
             .map(|j| {
                 frame.content(
