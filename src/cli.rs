@@ -318,6 +318,7 @@ fn handlers() -> Vec<(&'static str, Handler)> {
         ("eval_bench", run_eval_bench_handler),
         ("gradient_check", run_gradient_check_handler),
         ("sens_bench", run_sens_bench_handler),
+        ("support_compare", run_support_compare_handler),
     ]
 }
 
@@ -329,6 +330,13 @@ fn run_sens_bench_handler(cfg: &RunConfig) -> Result<()> {
 /// The `[scene_convergence]` section: responses vs mesh and modes, with cost.
 fn run_scene_convergence_handler(cfg: &RunConfig) -> Result<()> {
     crate::sections::scene_convergence::run_scene_convergence(&cfg.study, &cfg.out, cfg.quiet)
+        .map(|_| ())
+}
+
+/// The `[support_compare]` section: a flexible scene per panel support
+/// and integrator, cost and answers against the first support.
+fn run_support_compare_handler(cfg: &RunConfig) -> Result<()> {
+    crate::sections::support_compare::run_support_compare(&cfg.study, &cfg.out, cfg.quiet)
         .map(|_| ())
 }
 
@@ -382,8 +390,15 @@ pub fn run_scene(cfg: &RunConfig) -> Result<()> {
             .into(),
     );
     crate::report::record_command(&dir, &cfg.study, 1, "simulate", entry, Default::default())?;
+    let (rigid_lines, warnings) = simulate::rigid_summary(&scene);
+    for w in &warnings {
+        eprintln!("{w}");
+    }
     if !cfg.quiet {
         println!("{}", simulate::summary(&sim));
+        for l in &rigid_lines {
+            println!("{l}");
+        }
         for f in files {
             println!("wrote {}", f.display());
         }
@@ -435,6 +450,7 @@ pub fn check_study(study: &Study) -> Result<()> {
             "eval_bench" => sections::eval_bench::check(study).map(|_| ())?,
             "gradient_check" => sections::gradient_check::check(study).map(|_| ())?,
             "sens_bench" => sections::sens_bench::check(study).map(|_| ())?,
+            "support_compare" => sections::support_compare::check(study).map(|_| ())?,
             "scene_convergence" => sections::scene_convergence::check(study).map(|_| ())?,
             k if EXPLORE.contains(&k) => {
                 crate::explore::check(study, "problem")?;

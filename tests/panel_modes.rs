@@ -271,9 +271,16 @@ fn modes_command_writes_reproducible_tables() {
     }
     assert_eq!(outputs[0], outputs[1]);
     let m = &outputs[0].0;
-    assert!(m.starts_with("panel,layup,mode,frequency_hz,reference_hz,residual,kind,symmetry\n"));
+    assert!(m.starts_with(
+        "panel,layup,mode,frequency_hz,reference_hz,residual,kind,symmetry,rigid_content\n"
+    ));
     let rows: Vec<&str> = m.lines().skip(1).collect();
     assert_eq!(rows.len(), 12);
+    // Rigid-body content (panels::rigid): a share in [0, 1] per mode.
+    for r in &rows {
+        let c: f64 = r.rsplit(',').next().unwrap().parse().unwrap();
+        assert!((0.0..=1.0).contains(&c), "{r}");
+    }
     assert!(rows[0].starts_with("a,[55/-55/-55/55],1,"));
     assert!(rows[0].contains(",1,"), "reference column: {}", rows[0]);
     // Twin panels (same mesh, lay-up, support): identical rows but for the

@@ -305,6 +305,7 @@ impl Beam {
             shapes,
             eigenvalues,
             derivatives: Vec::new(),
+            rigid: super::flex::RigidScreen::default(),
         })
     }
 

@@ -59,6 +59,31 @@ pub struct BasisDerivative {
     pub shapes: Vec<f64>,
 }
 
+/// A mode left out of a basis because it is almost a rigid motion of the
+/// frame ([`crate::panels::rigid`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DroppedMode {
+    /// 1-based index among the computed modes (ascending frequency).
+    pub mode: usize,
+    /// Frequency `√λ/(2π)` \[Hz\].
+    pub frequency_hz: f64,
+    /// Rigid-body content `‖Pφ‖²_M / ‖φ‖²_M` (dimensionless).
+    pub content: f64,
+}
+
+/// Rigid-body content of a basis's modes, and the modes left out for it
+/// (empty for bases that do not compute it, e.g. closed-form beams).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RigidScreen {
+    /// Content of each kept mode, in basis order (empty if not computed).
+    pub content: Vec<f64>,
+    /// Modes dropped because their content exceeded `limit`.
+    pub dropped: Vec<DroppedMode>,
+    /// The content above which modes were dropped
+    /// ([`ModalBasis::screened`]); 1 if the basis was not screened.
+    pub limit: f64,
+}
+
 /// The modal data of a flexible body: everything the multibody kernel
 /// needs from a finite element model (or from closed-form modes).
 #[derive(Debug, Clone, PartialEq)]
@@ -82,6 +107,8 @@ pub struct ModalBasis {
     pub eigenvalues: Vec<f64>,
     /// Derivatives with respect to design variables (may be empty).
     pub derivatives: Vec<BasisDerivative>,
+    /// Rigid-body content of the modes and the modes dropped for it.
+    pub rigid: RigidScreen,
 }
 
 impl ModalBasis {
@@ -204,7 +231,75 @@ impl ModalBasis {
                     shapes: pick(&d.shapes),
                 })
                 .collect(),
+            rigid: RigidScreen {
+                content: self.rigid.content.iter().take(n).copied().collect(),
+                ..self.rigid.clone()
+            },
         }
+    }
+
+    /// The basis without its modes of rigid-body content above `limit`
+    /// (`rigid.content` per mode, [`crate::panels::rigid`]): the kept
+    /// modes keep their order, eigenvalues and derivative columns, and
+    /// `rigid` lists the dropped ones (1-based computed-mode numbers,
+    /// frequency \[Hz\], content). A basis without contents (closed-form
+    /// beams) is returned as is. Error ([`Error::Numerical`]) if no mode
+    /// would be left.
+    pub fn screened(&self, limit: f64) -> Result<ModalBasis> {
+        if self.rigid.content.len() != self.n_modes {
+            return Ok(self.clone());
+        }
+        let keep: Vec<usize> = (0..self.n_modes)
+            .filter(|&j| self.rigid.content[j] <= limit)
+            .collect();
+        if keep.is_empty() {
+            return Err(Error::numerical(
+                "mbs::ModalBasis::screened",
+                format!(
+                    "every mode is almost a rigid motion of the frame (rigid content {:?} > \
+                     {limit}); ask for more modes or raise rigid_limit",
+                    self.rigid.content
+                ),
+            ));
+        }
+        let n = self.n_modes;
+        let pick = |v: &[f64]| -> Vec<f64> {
+            v.chunks(n)
+                .flat_map(|row| keep.iter().map(move |&j| row[j]))
+                .collect()
+        };
+        let mut dropped = self.rigid.dropped.clone();
+        dropped.extend(
+            (0..n)
+                .filter(|&j| self.rigid.content[j] > limit)
+                .map(|j| DroppedMode {
+                    mode: j + 1,
+                    frequency_hz: self.eigenvalues[j].sqrt() / (2.0 * std::f64::consts::PI),
+                    content: self.rigid.content[j],
+                }),
+        );
+        Ok(ModalBasis {
+            nodes: self.nodes.clone(),
+            node_mass: self.node_mass.clone(),
+            node_inertia: self.node_inertia.clone(),
+            n_modes: keep.len(),
+            shapes: pick(&self.shapes),
+            eigenvalues: keep.iter().map(|&j| self.eigenvalues[j]).collect(),
+            derivatives: self
+                .derivatives
+                .iter()
+                .map(|d| BasisDerivative {
+                    name: d.name.clone(),
+                    eigenvalues: keep.iter().map(|&j| d.eigenvalues[j]).collect(),
+                    shapes: pick(&d.shapes),
+                })
+                .collect(),
+            rigid: RigidScreen {
+                content: keep.iter().map(|&j| self.rigid.content[j]).collect(),
+                dropped,
+                limit,
+            },
+        })
     }
 
     /// The same body with its frame origin moved to the body-frame point
@@ -440,6 +535,7 @@ mod tests {
                     d
                 },
             }],
+            rigid: RigidScreen::default(),
         }
     }
 

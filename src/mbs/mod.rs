@@ -77,7 +77,7 @@ pub mod workspace;
 pub use analysis::{Projection, Reaction};
 pub use dynamics::{System, Workspace};
 pub use energy::Energy;
-pub use flex::{BasisDerivative, Invariants, ModalBasis};
+pub use flex::{BasisDerivative, DroppedMode, Invariants, ModalBasis, RigidScreen};
 pub use model::{
     Body, Drive, Force, Joint, JointKind, Load, LoadFrame, Marker, Model, Param, PiecewiseLaw,
     Segment,

@@ -6,6 +6,7 @@
 //! the mirrors x → −x and y → −y (`SS`, `SA`, `AS`, `AA`; `-` where the
 //! mesh has no mirror nodes or the correlation is weak).
 
+use super::rigid::RigidFrame;
 use crate::error::{Error, Result};
 use crate::fe::{Derivatives, Panel, PanelSystem};
 use crate::modal::{
@@ -38,6 +39,12 @@ pub struct PanelModes {
     pub dof_map: Vec<(usize, usize)>,
     /// Node coordinates, panel frame \[m\].
     pub nodes: Vec<[f64; 2]>,
+    /// Rigid-body content per mode, `‖Pφ‖²_M / ‖φ‖²_M` in \[0, 1\]
+    /// ([`super::rigid`]): ≈ 1 for the centre clamp's drilling mode, ≈ 0
+    /// for free–free elastic modes.
+    pub rigid_content: Vec<f64>,
+    /// The panel's rigid frame (all node masses, `RᵀMR`) for this lay-up.
+    pub frame: RigidFrame,
 }
 
 /// Lay-up as `[a/b/c]` in degrees (rounded to 0.01°).
@@ -66,6 +73,9 @@ pub struct PanelAnalysis {
     solver: ModalSolver,
     want: Option<ModeUpdate>,
     mirrors: [Option<Vec<usize>>; 2],
+    /// The rigid frame of the last run, keyed by the laminate's mass and
+    /// rotary inertia per area (it does not depend on the ply angles).
+    frame: Option<([f64; 2], RigidFrame)>,
     /// Wall time of the set-up \[s\].
     pub setup_seconds: f64,
 }
@@ -106,6 +116,7 @@ impl PanelAnalysis {
             solver,
             want,
             mirrors,
+            frame: None,
             setup_seconds: t0.elapsed().as_secs_f64(),
         })
     }
@@ -183,6 +194,25 @@ impl PanelAnalysis {
                 format!("theta_{}", plies.join("_"))
             })
             .collect();
+        let key = [laminate.mass_per_area(), laminate.rotary_inertia_per_area()];
+        let frame = match &self.frame {
+            Some((k, f)) if *k == key => f.clone(),
+            _ => {
+                let f = RigidFrame::of_panel(&self.panel, laminate)?;
+                self.frame = Some((key, f.clone()));
+                f
+            }
+        };
+        let rigid_content = (0..modes.lambda.len())
+            .map(|j| {
+                frame.content(
+                    sys.dof_map
+                        .iter()
+                        .enumerate()
+                        .map(|(f, &(node, comp))| (node, comp, modes.modes[(f, j)])),
+                )
+            })
+            .collect();
         let mut with_layup = self.panel.clone();
         with_layup.laminate = laminate.clone();
         Ok(PanelModes {
@@ -200,6 +230,8 @@ impl PanelAnalysis {
             ],
             dof_map: sys.dof_map.clone(),
             nodes: self.panel.mesh.nodes.clone(),
+            rigid_content,
+            frame,
         })
     }
 }

@@ -68,6 +68,57 @@
 //!   node's elastic displacement `Φ_k w` (with the centre clamp, joints at
 //!   the centre node see none).
 //!
+//! # Modes that are almost rigid motions
+//! Every computed mode's rigid-body content `c = ‖Pφ‖²_M / ‖φ‖²_M`
+//! ([`super::rigid`]: `P = R (RᵀMR)⁻¹ RᵀM` projects M-orthogonally onto
+//! the six rigid motions `R` of the frame, all node masses included) is
+//! recorded in [`ModalBasis::rigid`]. A scene's panel body then drops
+//! every mode with `c >` its `rigid_limit` (default
+//! [`RIGID_CONTENT_LIMIT`]` = 0.9`; [`ModalBasis::screened`], called in
+//! [`crate::scene`]): the body has fewer modes than asked; the dropped
+//! ones are listed with frequency and content, and `plyscape simulate`
+//! prints them. `rigid_limit = 1` keeps every mode: right when the frame
+//! is itself held at the clamped node (a panel welded at its centre to a
+//! hub), where these modes are the clamp's real compliance and not a
+//! second description of the frame's motion.
+//!
+//! Why (a free frame, the panel held by joints elsewhere, as in the SAR
+//! scene). The strain energy does not see rigid motions (`K R = 0` for the
+//! unconstrained panel, and a mode is zero on the clamped DOFs), so the
+//! elastic part `(I − P)φ` of a mass-normalised mode has stiffness `λ` and
+//! mass `1 − c`: in a floating-frame body, whose frame already carries the
+//! rigid part `Pφ`, the mode moves at `ω/√(1 − c)`. The centre clamp's
+//! in-plane (drilling) rotation has `c = 1 − 5e-7` at 32 divisions:
+//! 8.5 Hz becomes `2π·8.5/√(5.4e-7) = 7.3e4 1/s`, the eigenvalue that
+//! made the scene stiff (measured ±7.2e4i 1/s). The two rocking modes
+//! (`c = 0.98–0.996`) are the same kind: a single clamped node has no
+//! stiffness in the continuum limit, so these three modes tend to rigid
+//! motions (`c → 1`, their frequencies depend on the mesh,
+//! `docs/numerics.md`) and describe, up to a local dimple at the clamped
+//! node, what the frame does; with the joints holding the panel the
+//! dimple gives a 445 1/s eigenvalue (free–free basis: 148 1/s). Every
+//! other mode has `c ≤ 0.575` (8–48 divisions), so the limit 0.9 sits in
+//! a wide gap and the set of dropped modes does not change under small
+//! changes of the ply angles.
+//!
+//! Why dropping and not a projection. Replacing `Φ` by `(I − P)Φ` and a
+//! Rayleigh–Ritz step on `(ΦᵀK Φ, Φᵀ(I − P)ᵀM(I − P)Φ) = (Λ, I − BᵀG⁻¹B)`,
+//! `B = RᵀMΦ`, `G = RᵀMR`, spans together with `R` the *same* space as
+//! `Φ` with `R` and has the same stiffness: to first order it only moves
+//! the frame from the clamped node to the mean axes. Its largest Ritz
+//! value is at least every Rayleigh quotient `λ_j/(1 − c_j)` of the
+//! subspace (the drilling mode's is `(7.3e4)²` again), so the nearly
+//! rigid modes must be dropped in any case; dropping them from the
+//! clamped basis is the simplest exact form. Exact derivatives: a kept
+//! mode's `dλ/dθ`, `dX/dθ` (Eq. 18/19, Nelson) depend on that mode alone,
+//! and neither `P` nor the dropped set depends on the ply angles (`M`
+//! depends on density and thickness only; the set is fixed while no
+//! content crosses the limit, guaranteed by the gap), so the basis's
+//! derivatives are the columns of the kept modes
+//! (`tests/panel_basis.rs` checks them against central differences).
+//! Free–free bases have `c ≈ 1e-23` (elastic modes are M-orthogonal to
+//! `R`): nothing is dropped.
+//!
 //! # Repeated eigenvalues
 //! In the updated-mode approach, the eigenvector derivatives of a cluster
 //! of (nearly) repeated eigenvalues refer to adjacent vectors that depend
@@ -79,10 +130,11 @@
 //! the sorted eigenvalues).
 
 use super::analysis::{in_panel, PanelAnalysis};
+use super::rigid::RigidFrame;
 use crate::error::{Error, Result};
-use crate::fe::{Panel, Triangle, NODE_DOF};
+use crate::fe::{Panel, NODE_DOF};
 use crate::laminate::Laminate;
-use crate::mbs::{BasisDerivative, ModalBasis};
+use crate::mbs::{BasisDerivative, ModalBasis, RigidScreen};
 use crate::modal::ModeUpdate;
 use crate::study::Study;
 use nalgebra::Vector3;
@@ -93,8 +145,6 @@ use nalgebra::Vector3;
 pub struct BasisBuilder {
     analysis: PanelAnalysis,
     update: Option<ModeUpdate>,
-    /// Element geometry, in mesh triangle order (for the lumped masses).
-    tris: Vec<Triangle>,
 }
 
 /// Lumped node masses of a panel: translational (kg) and rotary
@@ -109,16 +159,9 @@ impl BasisBuilder {
     /// later [`BasisBuilder::basis`] computes (none, fixed-mode `dλ`, or
     /// updated-mode `dλ` and `dX`).
     pub fn new(panel: &Panel, derivatives: Option<ModeUpdate>) -> Result<BasisBuilder> {
-        let tris = panel
-            .mesh
-            .triangles
-            .iter()
-            .map(|t| Triangle::new(t.map(|i| panel.mesh.nodes[i])))
-            .collect::<Result<Vec<_>>>()?;
         Ok(BasisBuilder {
             analysis: PanelAnalysis::new(panel, derivatives)?,
             update: derivatives,
-            tris,
         })
     }
 
@@ -132,10 +175,9 @@ impl BasisBuilder {
             return Err(Error::input("n_modes", 0, "at least 1 mode"));
         }
         let run = self.analysis.run(laminate, n_modes)?;
-        let lumped = self.node_masses(laminate)?;
+        let lumped = self.node_masses(&run.frame)?;
         let nn = self.analysis.panel.mesh.nodes.len();
         let x = &run.modes.modes;
-        let n = run.modes.lambda.len();
         for (j, &l) in run.modes.lambda.iter().enumerate() {
             if !(l.is_finite() && l > 0.0) {
                 return Err(Error::numerical(
@@ -144,12 +186,22 @@ impl BasisBuilder {
                 ));
             }
         }
-        // Scatter a free-DOF matrix (n_dof × n) into the 6-per-node layout.
+        // Every computed mode, with its rigid-body content; the scene
+        // drops the nearly rigid ones (ModalBasis::screened).
+        let keep: Vec<usize> = (0..run.modes.lambda.len()).collect();
+        let rigid = RigidScreen {
+            content: run.rigid_content.clone(),
+            dropped: Vec::new(),
+            limit: 1.0,
+        };
+        let n = keep.len();
+        // Scatter the kept columns of a free-DOF matrix (n_dof × computed)
+        // into the 6-per-node layout.
         let expand = |m: &faer::Mat<f64>| -> Vec<f64> {
             let mut out = vec![0.0; NODE_DOF * nn * n];
             for (f, &(node, comp)) in run.dof_map.iter().enumerate() {
                 let row = &mut out[(node * NODE_DOF + comp) * n..][..n];
-                for (j, r) in row.iter_mut().enumerate() {
+                for (r, &j) in row.iter_mut().zip(&keep) {
                     *r = m[(f, j)];
                 }
             }
@@ -180,7 +232,7 @@ impl BasisBuilder {
             };
             derivatives.push(BasisDerivative {
                 name: name.clone(),
-                eigenvalues: d.dlambda.clone(),
+                eigenvalues: keep.iter().map(|&j| d.dlambda[j]).collect(),
                 shapes: dshapes,
             });
         }
@@ -198,30 +250,18 @@ impl BasisBuilder {
             node_inertia: lumped.inertia,
             n_modes: n,
             shapes,
-            eigenvalues: run.modes.lambda,
+            eigenvalues: keep.iter().map(|&j| run.modes.lambda[j]).collect(),
             derivatives,
+            rigid,
         })
     }
 
-    /// HRZ lumped masses of every node for `laminate`, summed in the
-    /// assembly's element order; each free DOF's value is checked against
-    /// the assembled diagonal of M (the basis must be M-orthonormal with
+    /// HRZ lumped masses of every node (from the analysis's
+    /// [`RigidFrame`]); each free DOF's value is checked against the
+    /// assembled diagonal of M (the basis must be M-orthonormal with
     /// exactly these masses).
-    fn node_masses(&self, laminate: &Laminate) -> Result<NodeMasses> {
-        let mesh = &self.analysis.panel.mesh;
-        let nn = mesh.nodes.len();
-        let (mu, ir) = (laminate.mass_per_area(), laminate.rotary_inertia_per_area());
-        let mut mass = vec![0.0; nn];
-        let mut inertia = vec![Vector3::zeros(); nn];
-        for (t, tri) in mesh.triangles.iter().zip(&self.tris) {
-            let me = tri.lumped_mass(mu, ir);
-            for (a, &node) in t.iter().enumerate() {
-                mass[node] += me[NODE_DOF * a];
-                for c in 0..3 {
-                    inertia[node][c] += me[NODE_DOF * a + 3 + c];
-                }
-            }
-        }
+    fn node_masses(&self, frame: &RigidFrame) -> Result<NodeMasses> {
+        let (mass, inertia) = (frame.mass().to_vec(), frame.inertia().to_vec());
         let sys = &self.analysis.sys;
         for (f, &(node, comp)) in sys.dof_map.iter().enumerate() {
             let ours = if comp < 3 {
@@ -243,6 +283,14 @@ impl BasisBuilder {
         Ok(NodeMasses { mass, inertia })
     }
 }
+
+/// Largest rigid-body content `c` a mode of a basis may have (module doc,
+/// "Modes that are almost rigid motions"). 0.9: a kept mode is at most
+/// 90 % frame motion, so the frame raises its frequency by at most
+/// `1/√(1 − c) = 3.2`. It lies in a wide gap of the centre clamp's
+/// spectrum: rocking and drilling modes have `c ≥ 0.979`, every other
+/// mode `c ≤ 0.575` (SAR panel, 8 to 48 divisions).
+pub const RIGID_CONTENT_LIMIT: f64 = 0.9;
 
 /// The modal basis of a panel for a floating-frame flexible body (module
 /// doc): mesh nodes (panel coordinates, `z = 0` mid-surface, origin at the

@@ -6,9 +6,11 @@
 
 pub mod analysis;
 pub mod basis;
+pub mod rigid;
 
 pub use analysis::{
     analyse_panel, dfreq_hz_per_deg, in_panel, layup_label, PanelAnalysis, PanelModes,
     FREE_FREE_SHIFT,
 };
 pub use basis::{basis_for_study, panel_basis, unknown_panel, BasisBuilder};
+pub use rigid::RigidFrame;

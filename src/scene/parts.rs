@@ -309,13 +309,25 @@ pub(super) fn flexible_body(
                     "the name of a [[panels]] entry",
                 )
             })?;
-            panels(panel, f.modes, f.derivatives(&fk)?).map_err(|e| match e {
-                // The mode count is this body's key, not the panel's.
-                Error::Input { key, expected, .. } if key.ends_with("n_modes") => {
-                    Error::input(format!("{fk}.modes"), f.modes, expected)
-                }
-                e => e,
-            })?
+            let limit = f
+                .rigid_limit
+                .unwrap_or(crate::panels::basis::RIGID_CONTENT_LIMIT);
+            if !(limit > 0.0 && limit <= 1.0) {
+                return Err(Error::input(
+                    format!("{fk}.rigid_limit"),
+                    limit,
+                    "a rigid-body content share in (0, 1] (1 keeps every mode)",
+                ));
+            }
+            panels(panel, f.modes, f.derivatives(&fk)?)
+                .map_err(|e| match e {
+                    // The mode count is this body's key, not the panel's.
+                    Error::Input { key, expected, .. } if key.ends_with("n_modes") => {
+                        Error::input(format!("{fk}.modes"), f.modes, expected)
+                    }
+                    e => e,
+                })?
+                .screened(limit)?
         }
     };
     basis.validate(&fk)?;

@@ -219,6 +219,10 @@ pub struct FlexSpec {
     /// [`FlexSpec::derivatives`] gives the [`ModeUpdate`].
     #[serde(rename = "derivatives")]
     pub derivatives_name: Option<String>,
+    /// Panel: drop the modes whose rigid-body content exceeds this share
+    /// (in (0, 1]; default [`crate::panels::basis::RIGID_CONTENT_LIMIT`]
+    /// = 0.9; 1 keeps every mode), see [`crate::panels::basis`].
+    pub rigid_limit: Option<f64>,
 }
 
 /// Where a flexible body's modes come from.

@@ -3,8 +3,9 @@
 //! (`[kernel_bench]`), the Eq. 32 events benchmark (`[events_bench]`) and
 //! the flexible-scene convergence grid (`[scene_convergence]`), the
 //! cost of one design evaluation (`[eval_bench]`), the cost of a scene's
-//! sensitivities in both forms (`[sens_bench]`) and the fixed- against
-//! updated-mode gradients (`[gradient_check]`). Each
+//! sensitivities in both forms (`[sens_bench]`), the fixed- against
+//! updated-mode gradients (`[gradient_check]`) and the panel
+//! reference-condition comparison (`[support_compare]`). Each
 //! reads its section, runs scenes through [`crate::scene`] and
 //! [`crate::simulate`], and writes its table through [`crate::report`].
 //!
@@ -19,3 +20,4 @@ pub mod modes;
 pub mod scene_convergence;
 pub mod sens_bench;
 pub mod stats;
+pub mod support_compare;

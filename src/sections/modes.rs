@@ -20,6 +20,13 @@
 //! Where the mesh has no mirror nodes (an asymmetric set of attachment
 //! points) or the correlation is weak, the symmetry is `-`.
 //!
+//! `rigid_content` is the share `‖Pφ‖²_M / ‖φ‖²_M` (dimensionless, 0..1)
+//! of the mode that is a rigid motion of the panel frame, `P` the
+//! M-orthogonal projector on the six rigid motions about the panel centre
+//! ([`crate::panels::rigid`]). The modal bases of flexible bodies drop
+//! modes above 0.9 ([`crate::panels::basis`]); this table lists every
+//! computed mode.
+//!
 //! The analysis itself is [`crate::panels`].
 
 use super::stats::median;
@@ -89,6 +96,8 @@ pub struct ModeRow {
     pub residual: f64,
     pub kind: &'static str,
     pub symmetry: &'static str,
+    /// Rigid-body content `‖Pφ‖²_M / ‖φ‖²_M` ([`crate::panels::rigid`]).
+    pub rigid_content: f64,
 }
 
 impl ModesSpec {
@@ -189,6 +198,7 @@ pub fn mode_rows(results: &[PanelModes]) -> Vec<ModeRow> {
                 residual: r.modes.residuals[j],
                 kind: r.labels[j].0,
                 symmetry: r.labels[j].1,
+                rigid_content: r.rigid_content[j],
             });
         }
     }
@@ -210,6 +220,7 @@ pub fn write_results(dir: &Path, results: &[PanelModes], spec: &ModesSpec) -> Re
         "residual",
         "kind",
         "symmetry",
+        "rigid_content",
     ])?;
     for row in mode_rows(results) {
         let reference = spec
@@ -227,6 +238,7 @@ pub fn write_results(dir: &Path, results: &[PanelModes], spec: &ModesSpec) -> Re
             format!("{:.2e}", row.residual),
             row.kind.to_string(),
             row.symmetry.to_string(),
+            format!("{:.9}", row.rigid_content),
         ])?;
     }
     w.finish()?;
@@ -307,7 +319,7 @@ pub fn print_table(results: &[PanelModes], spec: &ModesSpec) {
         );
         let reference = spec.reference_hz.get(&r.panel);
         println!(
-            "  mode  f [Hz]     {}kind      symmetry",
+            "  mode  f [Hz]     {}kind      symmetry  rigid content",
             if reference.is_some() {
                 "ref [Hz]  ratio  "
             } else {
@@ -321,11 +333,12 @@ pub fn print_table(results: &[PanelModes], spec: &ModesSpec) {
                 None => String::new(),
             };
             println!(
-                "  {:>4}  {:<9.4}  {refcol}{:<9} {}",
+                "  {:>4}  {:<9.4}  {refcol}{:<9} {:<9} {:.7}",
                 j + 1,
                 f,
                 r.labels[j].0,
-                r.labels[j].1
+                r.labels[j].1,
+                r.rigid_content[j]
             );
         }
     }

@@ -508,6 +508,65 @@ pub fn plot_column(path: &Path, label: &str, rows: &[Vec<f64>], col: usize) -> R
     )
 }
 
+/// The rigid-body content of each flexible body's modes
+/// ([`crate::panels::rigid`]): per body the kept modes' largest content
+/// (mode, frequency, content) and every mode dropped for exceeding the
+/// limit. Returns `(lines, warnings)`: one line per body with a screened
+/// basis, one warning per dropped mode. Mode numbers count the computed
+/// modes (ascending frequency, 1-based).
+pub fn rigid_summary(scene: &Scene) -> (Vec<String>, Vec<String>) {
+    let (mut lines, mut warnings) = (Vec::new(), Vec::new());
+    for b in &scene.model.bodies {
+        let Some(f) = &b.flex else { continue };
+        let r = &f.basis.rigid;
+        if r.content.is_empty() {
+            continue;
+        }
+        let hz = |l: f64| l.sqrt() / (2.0 * std::f64::consts::PI);
+        // Computed-mode numbers of the kept modes.
+        let kept: Vec<usize> = (1..=r.content.len() + r.dropped.len())
+            .filter(|m| r.dropped.iter().all(|d| d.mode != *m))
+            .collect();
+        let (j, c) = r
+            .content
+            .iter()
+            .enumerate()
+            .fold(
+                (0, f64::NEG_INFINITY),
+                |a, (j, &c)| if c > a.1 { (j, c) } else { a },
+            );
+        let c = if c >= 1e-3 {
+            format!("{c:.4}")
+        } else {
+            format!("{c:.1e}")
+        };
+        let mut line = format!(
+            "{} modes: {} kept, largest rigid content {c} (mode {}, {:.3} Hz)",
+            b.name,
+            r.content.len(),
+            kept[j],
+            hz(f.basis.eigenvalues[j])
+        );
+        if !r.dropped.is_empty() {
+            let d: Vec<String> = r
+                .dropped
+                .iter()
+                .map(|d| format!("{} ({:.3} Hz, {:.7})", d.mode, d.frequency_hz, d.content))
+                .collect();
+            line += &format!("; dropped (content > {}): {}", r.limit, d.join(", "));
+        }
+        for d in &r.dropped {
+            warnings.push(format!(
+                "warning: {}: mode {} ({:.3} Hz) dropped from the modal basis: rigid-body \
+                 content {:.7} > {} (almost a rigid motion of the frame)",
+                b.name, d.mode, d.frequency_hz, d.content, r.limit
+            ));
+        }
+        lines.push(line);
+    }
+    (lines, warnings)
+}
+
 /// One-paragraph summary for the terminal.
 pub fn summary(sim: &Simulation) -> String {
     let s = &sim.stats;
