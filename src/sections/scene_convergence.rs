@@ -56,6 +56,8 @@ pub struct Variant {
     pub steps: usize,
     /// `(name, value)` of each response.
     pub responses: Vec<(String, f64)>,
+    /// SI unit of each response (`J*s`, `J`), in the same order.
+    pub units: Vec<&'static str>,
 }
 
 /// The scene study with `divisions` on every panel, `modes` on every
@@ -156,6 +158,7 @@ pub fn run_grid(
                     .iter()
                     .map(|r| (r.name.clone(), r.value))
                     .collect(),
+                units: sim.responses.iter().map(|r| r.kind.unit()).collect(),
             };
             report(&v);
             out.push(v);
@@ -186,8 +189,8 @@ pub fn write_csv(rows: &[Variant], dir: &Path) -> Result<PathBuf> {
     .iter()
     .map(|s| s.to_string())
     .collect();
-    for (name, _) in &reference.responses {
-        head.push(name.clone());
+    for ((name, _), unit) in reference.responses.iter().zip(&reference.units) {
+        head.push(format!("{name} [{unit}]"));
         head.push(format!("{name}_rel_error"));
     }
     w.row(&head)?;
