@@ -25,7 +25,8 @@ pub struct Simulation {
     pub stats: Stats,
     /// Largest `|Φ|` over the output times.
     pub max_violation: f64,
-    /// Largest relative energy change, when the scene is conservative.
+    /// Largest energy change relative to the largest |E| of the run,
+    /// `max |E − E0| / max |E|`, when the scene is conservative.
     pub energy_error: Option<f64>,
     /// Redundant equations (equations − rank) at the start.
     pub redundant: usize,
@@ -54,7 +55,10 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
     let conservative = sys.conservative();
     let mut rows: Vec<Vec<f64>> = Vec::new();
     let mut max_violation = 0.0f64;
-    let mut energy_error = 0.0f64;
+    // Largest |E − E0| and the largest |E| of the run (its scale: a run
+    // that starts with E0 = 0, e.g. from rest at the potential's zero,
+    // is measured against the energy it reaches, not against 0).
+    let (mut energy_change, mut energy_scale) = (0.0f64, 0.0f64);
     let mut y_end = y0.clone();
     let wants_reactions = scene
         .outputs
@@ -108,7 +112,8 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         max_violation = max_violation.max(viol);
         if conservative {
             let e = sys.energy(y, &mut ws);
-            energy_error = energy_error.max((e - e0).abs() / e0.abs().max(1e-300));
+            energy_change = energy_change.max((e - e0).abs());
+            energy_scale = energy_scale.max(e.abs()).max(e0.abs());
         }
         let mut row = output_row(&sys, scene, (t, y), &mut ws, reactions.as_deref(), viol);
         if let Some(prev) = rows.last() {
@@ -141,7 +146,7 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         projection,
         stats,
         max_violation,
-        energy_error: conservative.then_some(energy_error),
+        energy_error: conservative.then(|| energy_change / energy_scale.max(1e-300)),
         sens_headers,
         sens_rows,
         responses,
@@ -438,9 +443,9 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
     ];
     let rows: Vec<Vec<String>> = records
         .into_iter()
-        .map(|(k, v)| vec![k.to_string(), v])
+        .map(|(k, v)| vec![k.to_string(), v, stat_unit(k).to_string()])
         .collect();
-    write_table(&stats_path, &["quantity", "value"], &rows)?;
+    write_table(&stats_path, &["quantity", "value", "unit"], &rows)?;
     let mut written = vec![hist, stats_path];
     if !sim.sens_rows.is_empty() {
         let path = dir.join("sensitivities.csv");
@@ -488,6 +493,18 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
         }
     }
     Ok(written)
+}
+
+/// The unit of a `stats.csv` quantity (`-`: a count, a name or a ratio).
+fn stat_unit(quantity: &str) -> &'static str {
+    match quantity {
+        "wall_time_s" | "output_wall_time_s" => "s",
+        // Constraint rows mix lengths and rotations: the largest residual.
+        "initial_violation" | "position_correction" | "max_violation" => "m or rad",
+        "velocity_correction" => "m/s or rad/s",
+        "atol" => "state units",
+        _ => "-",
+    }
 }
 
 /// Plot column `col` of `rows` against time (column 0) into an SVG file.
