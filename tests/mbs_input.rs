@@ -291,7 +291,10 @@ fn simulate_command_writes_history_stats_and_svg() {
     let stats = std::fs::read_to_string(res.join("stats.csv")).unwrap();
     assert!(stats.contains("redundant_equations,0"), "{stats}");
     assert!(stats.starts_with("quantity,value,unit"), "{stats}");
-    assert!(stats.contains("max_violation,") && stats.contains(",m or rad"), "{stats}");
+    assert!(
+        stats.contains("max_violation,") && stats.contains(",m or rad"),
+        "{stats}"
+    );
     assert!(res.join("pin.angle.svg").exists());
     // responses.csv names each response's unit.
     let resp = std::fs::read_to_string(res.join("responses.csv")).unwrap();
