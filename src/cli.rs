@@ -441,6 +441,10 @@ pub fn check_sections(study: &Study) -> Result<()> {
 pub fn check_study(study: &Study) -> Result<()> {
     use crate::sections;
     const EXPLORE: &[&str] = &["multistart", "evolve", "compare", "map", "scaling"];
+    if study.table.keys().any(|k| EXPLORE.contains(&k.as_str())) {
+        // The drivers' problem, once for all of them.
+        crate::explore::check(study, "problem")?;
+    }
     for key in study.table.keys() {
         match key.as_str() {
             "modes" => sections::modes::check(study).map(|_| ())?,
@@ -452,10 +456,7 @@ pub fn check_study(study: &Study) -> Result<()> {
             "sens_bench" => sections::sens_bench::check(study).map(|_| ())?,
             "support_compare" => sections::support_compare::check(study).map(|_| ())?,
             "scene_convergence" => sections::scene_convergence::check(study).map(|_| ())?,
-            k if EXPLORE.contains(&k) => {
-                crate::explore::check(study, "problem")?;
-                crate::explore::check(study, k)?;
-            }
+            k if EXPLORE.contains(&k) => crate::explore::check(study, k)?,
             _ => {}
         }
     }

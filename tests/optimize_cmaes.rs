@@ -32,28 +32,36 @@ fn rosenbrock_2_and_10_dimensions_to_1e8() {
     }
 }
 
+/// Seeds 0..10 of `restarts` CMA-ES on Rastrigin in `n` dimensions that
+/// reach the global minimum f* = 0 at the origin within `budget`.
+fn rastrigin_hits(n: usize, budget: usize, restarts: Restarts) -> usize {
+    let p = tp::rastrigin(n);
+    let mut hits = 0;
+    for seed in 0..10 {
+        let o = run(
+            &p,
+            &CmaesOptions {
+                seed,
+                max_evaluations: budget,
+                restarts,
+                target: Some(1e-8),
+                ..CmaesOptions::default()
+            },
+        );
+        assert!(o.function_calls <= budget);
+        if o.f <= 1e-8 && o.x.iter().all(|x| x.abs() < 1e-3) {
+            hits += 1;
+        }
+    }
+    hits
+}
+
 #[test]
 fn rastrigin_global_minimum_in_9_of_10_seeds() {
     // Global minimum f* = 0 at the origin among ~11ⁿ local minima
     // (Rastrigin 1974). Budgets: 10 000 evaluations in 2-D, 60 000 in 5-D.
     for (n, budget) in [(2, 10_000), (5, 60_000)] {
-        let p = tp::rastrigin(n);
-        let mut hits = 0;
-        for seed in 0..10 {
-            let o = run(
-                &p,
-                &CmaesOptions {
-                    seed,
-                    max_evaluations: budget,
-                    target: Some(1e-8),
-                    ..CmaesOptions::default()
-                },
-            );
-            assert!(o.function_calls <= budget);
-            if o.f <= 1e-8 && o.x.iter().all(|x| x.abs() < 1e-3) {
-                hits += 1;
-            }
-        }
+        let hits = rastrigin_hits(n, budget, Restarts::Ipop);
         assert!(hits >= 9, "rastrigin{n}: {hits} of 10 seeds");
     }
 }
@@ -364,24 +372,7 @@ fn bipop_schedule_properties() {
 #[test]
 fn bipop_rastrigin_global_minimum_in_most_seeds() {
     for (n, budget) in [(2, 10_000), (5, 60_000)] {
-        let p = tp::rastrigin(n);
-        let mut hits = 0;
-        for seed in 0..10 {
-            let o = run(
-                &p,
-                &CmaesOptions {
-                    seed,
-                    max_evaluations: budget,
-                    restarts: Restarts::Bipop,
-                    target: Some(1e-8),
-                    ..CmaesOptions::default()
-                },
-            );
-            assert!(o.function_calls <= budget);
-            if o.f <= 1e-8 && o.x.iter().all(|x| x.abs() < 1e-3) {
-                hits += 1;
-            }
-        }
+        let hits = rastrigin_hits(n, budget, Restarts::Bipop);
         assert!(hits >= 6, "bipop rastrigin{n}: {hits} of 10 seeds");
     }
 }

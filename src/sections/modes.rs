@@ -481,7 +481,8 @@ pub fn write_convergence(dir: &Path, rows: &[ConvergenceRow]) -> Result<PathBuf>
 
 /// `plyscape modes` / the `[modes]` handler of `plyscape run`.
 pub fn run_modes(study: &Study, out_root: &Path, quiet: bool) -> Result<()> {
-    let spec = check(study)?;
+    // The panels are checked by `analyse_study`, the rest below.
+    let spec: ModesSpec = study.require_section("modes", "what modal analysis to run")?;
     let results = analyse_study(study, &spec)?;
     let dir = study.output_dir(out_root)?;
     let mut files = write_results(&dir, &results, &spec)?;
