@@ -296,7 +296,14 @@ fn run_map_handler(cfg: &RunConfig) -> Result<()> {
 }
 
 /// Sections that hold data other sections use; they do no work themselves.
-const DATA_SECTIONS: &[&str] = &["problem", "panels", "convergence", "scene_problem"];
+/// (`[optimum_report]` is read and written by the multistart.)
+const DATA_SECTIONS: &[&str] = &[
+    "problem",
+    "panels",
+    "convergence",
+    "scene_problem",
+    "optimum_report",
+];
 
 /// A kind of work a study can ask for: the top-level section that asks for
 /// it, and the function that does it.
@@ -440,7 +447,14 @@ pub fn check_sections(study: &Study) -> Result<()> {
 /// values refused) and checked as far as that needs no computation.
 pub fn check_study(study: &Study) -> Result<()> {
     use crate::sections;
-    const EXPLORE: &[&str] = &["multistart", "evolve", "compare", "map", "scaling"];
+    const EXPLORE: &[&str] = &[
+        "multistart",
+        "evolve",
+        "compare",
+        "map",
+        "scaling",
+        "optimum_report",
+    ];
     if study.table.keys().any(|k| EXPLORE.contains(&k.as_str())) {
         // The drivers' problem, once for all of them.
         crate::explore::check(study, "problem")?;

@@ -32,10 +32,53 @@ fn solve(p: &Analytic, x0: &[f64], options: &MmfdOptions) -> LocalOutcome {
         out.termination,
         Termination::Infeasible | Termination::MaxIterations
     ));
-    let last = h.0.last().expect("records");
-    assert_eq!(last.function_calls, out.function_calls);
-    assert!(h.0.len() >= out.iterations);
+    check_records(p, x0, &h, &out);
     out
+}
+
+/// The records tell the run as `IterRecord` documents: the start first
+/// (iteration 0, its one evaluation with gradients), iterations counted
+/// up by one (a final check repeats the last number), calls never
+/// decreasing, and the last record is the outcome: design, f, g, calls,
+/// iterations and the active constraints (g >= the final CT).
+fn check_records(p: &Analytic, x0: &[f64], h: &History, out: &LocalOutcome) {
+    let first = h.0.first().expect("records");
+    let x0: Vec<f64> = p
+        .variables()
+        .iter()
+        .zip(x0)
+        .map(|(v, &x)| v.wrap(x))
+        .collect();
+    assert_eq!(
+        (first.iteration, &first.x, first.step),
+        (0, &x0, 0.0),
+        "{}",
+        p.name()
+    );
+    assert_eq!((first.function_calls, first.gradient_calls), (1, 1));
+    assert_eq!(first.f, p.evaluate(&x0, false).unwrap().f);
+    for w in h.0.windows(2) {
+        let d = w[1].iteration - w[0].iteration;
+        assert!(d <= 1, "{}: {:?}", p.name(), w);
+        assert!(w[1].function_calls >= w[0].function_calls);
+        assert!(w[1].gradient_calls >= w[0].gradient_calls);
+        assert!(w[1].ct.unwrap() >= w[0].ct.unwrap());
+        assert_eq!(w[1].g.len(), p.n_constraints());
+    }
+    let last = h.0.last().unwrap();
+    assert_eq!(
+        (&last.x, last.f, &last.g),
+        (&out.x, out.f, &out.g),
+        "{}",
+        p.name()
+    );
+    assert_eq!(
+        (last.iteration, last.function_calls, last.gradient_calls),
+        (out.iterations, out.function_calls, out.gradient_calls),
+        "{}",
+        p.name()
+    );
+    assert_eq!(last.active().len(), out.active_constraints, "{}", p.name());
 }
 
 /// (iterations, function calls, gradient calls)

@@ -19,8 +19,10 @@
 //! Study sections read here: `[problem]` ([`problems::ProblemSpec`]; with
 //! `name = "scene"` also `[scene_problem]`, [`scene_problem`]),
 //! `[multistart]` ([`MultistartSection`]), `[evolve]` ([`EvolveSection`]),
-//! `[compare]` (no keys), `[map]` ([`MapSection`]) and `[scaling]`
-//! ([`scaling::ScalingSection`]).
+//! `[compare]` (no keys), `[map]` ([`MapSection`]), `[scaling]`
+//! ([`scaling::ScalingSection`]) and `[optimum_report]`
+//! ([`optimum_report`]: the run from the first start as the paper's
+//! Table 5 and Figs. 10–12, written by the multistart).
 //!
 //! A problem from a study, evaluated with its gradient (Himmelblau's
 //! function has a minimum f = 0 at (3, 2)):
@@ -46,6 +48,7 @@ pub mod cluster;
 pub mod evolve;
 pub mod map;
 pub mod multistart;
+pub mod optimum_report;
 pub mod problems;
 pub mod sampling;
 pub mod scaling;
@@ -354,6 +357,7 @@ fn multistart_with(
     }
     ctx.manifest(&dir, "multistart", json!({"complete": false}))?;
     let solver = solvers::local(&plan.section.method, &plan.section.mmfd)?;
+    let report_plan = optimum_report::prepare(ctx, problem, plan)?;
     let settings = multistart::Settings {
         threads: ctx.threads,
         max_evaluations: plan.section.max_evaluations,
@@ -362,6 +366,7 @@ fn multistart_with(
         resume: ctx.flags.resume,
         shard: ctx.flags.shard,
         quiet: ctx.quiet,
+        history_start: report_plan.as_ref().map(|_| optimum_report::REPORTED_START),
     };
     let report = multistart::run(
         problem,
@@ -387,6 +392,9 @@ fn multistart_with(
     )?;
     if !ctx.quiet {
         print_optima(problem, &report);
+    }
+    if let Some(p) = report_plan {
+        p.finish(ctx, &dir, problem, plan, &report)?;
     }
     Ok(report)
 }
@@ -813,6 +821,7 @@ pub fn check(study: &Study, key: &str) -> Result<()> {
         "evolve" => evolve_plan(study).map(|_| ()),
         "compare" => study.section::<CompareSection>("compare").map(|_| ()),
         "map" => map_section(study).map(|_| ()),
+        optimum_report::KEY => optimum_report::check(study).map(|_| ()),
         "scaling" => study
             .require_section::<scaling::ScalingSection>("scaling", "threads = [1, 2]")
             .map(|_| ()),

@@ -21,7 +21,9 @@
 use super::cluster::{cluster, Optimum, Tolerances};
 use super::tables::{num, read_runs, write_atomic, RunRecord, RunResult, RunsAppender};
 use crate::error::{Error, Result};
-use crate::optimize::{Counted, LocalOutcome, Problem, Variable};
+use crate::optimize::{
+    Counted, LocalOutcome, NoObserver, Observer, Problem, TimedHistory, Variable,
+};
 use crate::report::Progress;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -29,8 +31,10 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
-/// A local optimizer: from `x0` on `problem` to a local outcome.
-pub type LocalSolver<'a> = dyn Fn(&dyn Problem, &[f64]) -> Result<LocalOutcome> + Sync + 'a;
+/// A local optimizer: from `x0` on `problem` to a local outcome, its
+/// iteration records to the observer.
+pub type LocalSolver<'a> =
+    dyn Fn(&dyn Problem, &[f64], &mut dyn Observer) -> Result<LocalOutcome> + Sync + 'a;
 
 /// Run every `n`-th start beginning at `index` (`--shard index/count`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -77,6 +81,8 @@ pub struct Settings {
     pub shard: Shard,
     /// No progress bar.
     pub quiet: bool,
+    /// Keep the iteration records of this start (when it runs here).
+    pub history_start: Option<usize>,
 }
 
 /// The result of a multistart.
@@ -94,6 +100,9 @@ pub struct Report {
     pub wall_seconds: f64,
     /// Runs done in this invocation (not read back from `runs.csv`).
     pub new_runs: usize,
+    /// The iteration records of [`Settings::history_start`], with their
+    /// wall times, when that start ran in this invocation.
+    pub history: Option<TimedHistory>,
 }
 
 impl Report {
@@ -103,24 +112,33 @@ impl Report {
     }
 }
 
-/// One run from `x0`: counts, time, and the outcome as a table row.
-pub fn one_run(problem: &dyn Problem, solver: &LocalSolver, start: usize, x0: &[f64]) -> RunRecord {
+/// One run from `x0`: counts, time, and the outcome as a table row; the
+/// solver's iteration records go to `observer`.
+pub fn one_run(
+    problem: &dyn Problem,
+    solver: &LocalSolver,
+    start: usize,
+    x0: &[f64],
+    observer: &mut dyn Observer,
+) -> RunRecord {
     let t = Instant::now();
     let counted = Counted::new(problem);
     // A panic inside one run (a solver bug) becomes that run's error
     // instead of ending a long campaign.
-    let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| solver(&counted, x0)))
-        .unwrap_or_else(|p| {
-            let msg = p
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| p.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown panic".into());
-            Err(Error::numerical(
-                "explore::multistart",
-                format!("solver panicked: {msg}"),
-            ))
-        });
+    let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        solver(&counted, x0, observer)
+    }))
+    .unwrap_or_else(|p| {
+        let msg = p
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| p.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        Err(Error::numerical(
+            "explore::multistart",
+            format!("solver panicked: {msg}"),
+        ))
+    });
     let wall_seconds = t.elapsed().as_secs_f64();
     let (result, exit, iterations) = match out {
         Ok(o) if o.f.is_finite() && o.x.iter().chain(&o.g).all(|v| v.is_finite()) => (
@@ -205,7 +223,8 @@ pub fn run(
     let mut evals_now = 0usize;
     let mut write_error = None;
     let mut new_rows = Vec::new();
-    let (tx, rx) = std::sync::mpsc::channel::<RunRecord>();
+    let mut history = None;
+    let (tx, rx) = std::sync::mpsc::channel::<(RunRecord, Option<TimedHistory>)>();
     std::thread::scope(|ts| {
         let (todo, next, stop, finished_evals, pool) =
             (&todo, &next, &stop, &finished_evals, &pool);
@@ -238,12 +257,20 @@ pub fn run(
                             stop.store(true, Ordering::SeqCst);
                             break;
                         }
-                        let row = one_run(problem, solver, k, &starts[k]);
+                        let (row, history) = if settings.history_start == Some(k) {
+                            let mut h = TimedHistory::start();
+                            (one_run(problem, solver, k, &starts[k], &mut h), Some(h))
+                        } else {
+                            (
+                                one_run(problem, solver, k, &starts[k], &mut NoObserver),
+                                None,
+                            )
+                        };
                         finished_evals
                             .lock()
                             .expect("no panics")
                             .insert(k, row.function_calls);
-                        if tx.send(row).is_err() {
+                        if tx.send((row, history)).is_err() {
                             break;
                         }
                     });
@@ -251,7 +278,10 @@ pub fn run(
             });
             drop(tx);
         });
-        for row in rx {
+        for (row, h) in rx {
+            if h.is_some() {
+                history = h;
+            }
             if write_error.is_none() {
                 if let Err(e) = appender.append(&row) {
                     write_error = Some(e);
@@ -287,7 +317,11 @@ pub fn run(
         dir,
         t0.elapsed().as_secs_f64(),
     )?;
-    Ok(Report { new_runs, ..report })
+    Ok(Report {
+        new_runs,
+        history,
+        ..report
+    })
 }
 
 /// Keep the runs (sorted by start) before the cumulative function calls
@@ -326,6 +360,7 @@ pub fn finish(
         optima,
         wall_seconds,
         new_runs: 0,
+        history: None,
     })
 }
 
@@ -395,15 +430,16 @@ mod tests {
     #[test]
     fn failing_and_panicking_runs_become_rows_with_an_error() {
         let p = crate::optimize::testproblems::himmelblau();
-        let fails: &LocalSolver =
-            &|_: &dyn Problem, _: &[f64]| Err(Error::numerical("test", "singular"));
-        let row = one_run(&p, fails, 3, &[0.0, 1.0]);
+        let fails: &LocalSolver = &|_: &dyn Problem, _: &[f64], _: &mut dyn Observer| {
+            Err(Error::numerical("test", "singular"))
+        };
+        let row = one_run(&p, fails, 3, &[0.0, 1.0], &mut NoObserver);
         assert!(row.result.is_none() && row.exit.contains("singular"));
-        let panics: &LocalSolver = &|q: &dyn Problem, x: &[f64]| {
+        let panics: &LocalSolver = &|q: &dyn Problem, x: &[f64], _: &mut dyn Observer| {
             q.evaluate(x, true)?;
             panic!("index out of bounds")
         };
-        let row = one_run(&p, panics, 4, &[0.0, 1.0]);
+        let row = one_run(&p, panics, 4, &[0.0, 1.0], &mut NoObserver);
         assert!(
             row.exit.contains("solver panicked: index out of bounds"),
             "{}",

@@ -47,7 +47,9 @@ pub struct ScalingRow {
     pub load_average: Option<f64>,
 }
 
-fn load_average() -> Option<f64> {
+/// The machine's 1-minute load average (Linux `/proc/loadavg`), if
+/// readable.
+pub fn load_average() -> Option<f64> {
     std::fs::read_to_string("/proc/loadavg")
         .ok()?
         .split_whitespace()

@@ -64,10 +64,10 @@
 use crate::error::{Error, Result};
 use crate::integrate::SensitivityForm;
 use crate::laminate::Laminate;
-use crate::mbs::responses::ResponseValue;
+use crate::mbs::responses::{ResponseKind, ResponseValue};
 use crate::optimize::{Evaluation, Problem, Variable};
 use crate::scene::{BuildProfile, ScenePlan};
-use crate::simulate::simulate;
+use crate::simulate::{simulate, Simulation};
 use crate::study::Study;
 use serde::Deserialize;
 
@@ -299,6 +299,40 @@ impl SceneProblem {
     /// The constraint bounds `c_j` (response units).
     pub fn bounds(&self) -> Vec<f64> {
         self.constraints.iter().map(|c| c.1).collect()
+    }
+
+    /// The objective's response name and its SI unit (`J*s` for an
+    /// integral of energies, `J` for a peak or final value): the response
+    /// is `f ×` [`SceneProblem::objective_scale`] in that unit.
+    pub fn objective_response(&self) -> (&str, &'static str) {
+        let name = self.objective.0.as_str();
+        (name, self.response_unit(name))
+    }
+
+    /// The constraints' response names, in the order of `g`.
+    pub fn constraint_responses(&self) -> Vec<&str> {
+        self.constraints.iter().map(|c| c.0.as_str()).collect()
+    }
+
+    /// SI unit of the `[[scene.responses]]` entry `name` (from its kind).
+    fn response_unit(&self, name: &str) -> &'static str {
+        let kind = self.plan.spec().responses.iter().find(|r| r.name == name);
+        match kind.map(|r| r.kind.as_str()) {
+            Some("integral") => ResponseKind::Integral.unit(),
+            _ => ResponseKind::Peak.unit(),
+        }
+    }
+
+    /// Simulate design `x` \[deg\] without sensitivities, with exactly the
+    /// output columns `quantities` (names as in `[scene.outputs]`).
+    pub fn simulate_outputs(&self, x: &[f64], quantities: &[String]) -> Result<Simulation> {
+        let at = |e: Error| at_design(e, &self.vars, x);
+        let laminates = self.laminates_at(x)?;
+        let scene = self
+            .plan
+            .build_outputs(&laminates, quantities)
+            .map_err(at)?;
+        Ok(simulate(&scene).map_err(at)?.1)
     }
 
     /// The panels' lay-ups at design `x` \[deg\]: each variable's angle

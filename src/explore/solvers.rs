@@ -18,7 +18,9 @@ use super::evolve::{GlobalSolver, Request};
 use super::multistart::LocalSolver;
 use crate::error::{Error, Result};
 use crate::optimize::cmaes::Restarts;
-use crate::optimize::{Counted, LocalOutcome, NoObserver, Problem, Termination};
+use crate::optimize::{
+    Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination,
+};
 
 /// Local methods by name.
 pub const LOCAL_METHODS: &str = "mmfd, steepest";
@@ -94,9 +96,11 @@ pub fn local(method: &str, mmfd: &MmfdSettings) -> Result<Box<LocalSolver<'stati
     check_local(method)?;
     let options = mmfd.options();
     Ok(match method {
-        "steepest" => Box::new(|p: &dyn Problem, x0: &[f64]| steepest(p, x0)),
-        _ => Box::new(move |p: &dyn Problem, x0: &[f64]| {
-            crate::optimize::mmfd::minimize(p, x0, &options, &mut NoObserver)
+        "steepest" => {
+            Box::new(|p: &dyn Problem, x0: &[f64], obs: &mut dyn Observer| steepest(p, x0, obs))
+        }
+        _ => Box::new(move |p: &dyn Problem, x0: &[f64], obs: &mut dyn Observer| {
+            crate::optimize::mmfd::minimize(p, x0, &options, obs)
         }),
     })
 }
@@ -126,8 +130,35 @@ pub fn global_method(restarts: Restarts) -> &'static str {
     }
 }
 
-/// Projected steepest descent (see the module doc).
-pub fn steepest(problem: &dyn Problem, x0: &[f64]) -> Result<LocalOutcome> {
+/// The record of a steepest-descent design (no constraints, no active
+/// set).
+fn steepest_record(
+    counted: &Counted,
+    iteration: usize,
+    x: &[f64],
+    e: &Evaluation,
+    step: f64,
+) -> IterRecord {
+    IterRecord {
+        iteration,
+        x: x.to_vec(),
+        f: e.f,
+        g: e.g.clone(),
+        max_g: e.max_g(),
+        ct: None,
+        step,
+        function_calls: counted.function_calls(),
+        gradient_calls: counted.gradient_calls(),
+    }
+}
+
+/// Projected steepest descent (see the module doc); records as
+/// [`IterRecord`] describes go to `observer`.
+pub fn steepest(
+    problem: &dyn Problem,
+    x0: &[f64],
+    observer: &mut dyn Observer,
+) -> Result<LocalOutcome> {
     let vars = problem.variables();
     if problem.n_constraints() > 0 {
         return Err(Error::input(
@@ -142,8 +173,10 @@ pub fn steepest(problem: &dyn Problem, x0: &[f64]) -> Result<LocalOutcome> {
         |x: &[f64]| -> Vec<f64> { x.iter().zip(vars).map(|(&v, var)| var.wrap(v)).collect() };
     let mut x = project(x0);
     let mut e = problem.evaluate(&x, true)?;
+    observer.observe(&steepest_record(&counted, 0, &x, &e, 0.0));
     let mut alpha = 1.0;
     let mut iterations = 0;
+    let mut recorded_calls = counted.function_calls();
     let termination = loop {
         if iterations == 10_000 {
             break Termination::MaxIterations;
@@ -186,12 +219,24 @@ pub fn steepest(problem: &dyn Problem, x0: &[f64]) -> Result<LocalOutcome> {
             break Termination::KuhnTucker;
         };
         let df = (e.f - fnew).abs();
+        let step = vars
+            .iter()
+            .zip(xn.iter().zip(&x))
+            .map(|(var, (a, b))| (var.difference(*a, *b) / (var.upper - var.lower)).powi(2))
+            .sum::<f64>()
+            .sqrt();
         x = xn;
         e = problem.evaluate(&x, true)?;
+        observer.observe(&steepest_record(&counted, iterations, &x, &e, step));
+        recorded_calls = counted.function_calls();
         if df <= 1e-14 * e.f.abs().max(1.0) {
             break Termination::AbsoluteChange;
         }
     };
+    if counted.function_calls() != recorded_calls {
+        // The last iteration's trials found no decrease: it did not move.
+        observer.observe(&steepest_record(&counted, iterations, &x, &e, 0.0));
+    }
     Ok(LocalOutcome {
         f: e.f,
         g: e.g,
@@ -219,7 +264,7 @@ mod tests {
         // Himmelblau from (0, 0) flows to the minimum (3, 2), f* = 0
         // (Himmelblau 1972, p. 428).
         let h = testproblems::himmelblau();
-        let o = steepest(&h, &[0.0, 0.0]).unwrap();
+        let o = steepest(&h, &[0.0, 0.0], &mut crate::optimize::NoObserver).unwrap();
         assert!(
             o.f < 1e-12 && (o.x[0] - 3.0).abs() < 1e-6 && (o.x[1] - 2.0).abs() < 1e-6,
             "{o:?}"
@@ -228,14 +273,19 @@ mod tests {
         // The seam problem: from (-80, 80) the optimum (88, -85) lies across
         // the +-90 seam (testproblems::seam doc); wrapping must find it.
         let s = testproblems::seam();
-        let o = steepest(&s, &[-80.0, 80.0]).unwrap();
+        let o = steepest(&s, &[-80.0, 80.0], &mut crate::optimize::NoObserver).unwrap();
         assert!(o.f < 1e-10, "{o:?}");
         assert!(
             (o.x[0] - 88.0).abs() < 1e-3 && (o.x[1] + 85.0).abs() < 1e-3,
             "{o:?}"
         );
         // Constraints are refused with an input error.
-        let e = steepest(&crate::explore::problems::Hs22::new(), &[0.0, 0.0]).unwrap_err();
+        let e = steepest(
+            &crate::explore::problems::Hs22::new(),
+            &[0.0, 0.0],
+            &mut crate::optimize::NoObserver,
+        )
+        .unwrap_err();
         assert_eq!(e.exit_code(), 2);
     }
 }

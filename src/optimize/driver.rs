@@ -18,7 +18,8 @@ pub type OptState = IterState<Vec<f64>, (), (), (), (), f64>;
 
 /// A solver that exposes the record of its last iteration.
 pub trait Recorded {
-    /// The record of the iteration just completed (taken once).
+    /// The next record not yet taken (each is taken once; the loop takes
+    /// until `None` after every step).
     fn take_record(&mut self) -> Option<IterRecord>;
 }
 
@@ -80,7 +81,7 @@ where
     S: Solver<Counted<'a>, OptState> + Recorded,
 {
     let (mut state, _) = solver.init(problem, state).map_err(from_argmin)?;
-    if let Some(r) = solver.take_record() {
+    while let Some(r) = solver.take_record() {
         observer.observe(&r);
     }
     loop {
@@ -90,7 +91,7 @@ where
         let (next, _) = solver.next_iter(problem, state).map_err(from_argmin)?;
         state = next;
         state.increment_iter();
-        if let Some(r) = solver.take_record() {
+        while let Some(r) = solver.take_record() {
             observer.observe(&r);
         }
     }

@@ -192,22 +192,47 @@ impl Problem for Counted<'_> {
 }
 
 /// One iteration (local solver) or generation (evolutionary solver).
+///
+/// Local solvers (MMFD, steepest descent) record the start design first
+/// (`iteration` 0, `step` 0, the calls of its evaluation), then the design
+/// after each iteration (`iteration` = iterations completed). A last
+/// record with the same `iteration` as the one before is the final check
+/// at the design the solver stopped at (the gradient evaluation that found
+/// nothing better): it counts calls and does not move. The last record's
+/// calls are the run's.
 #[derive(Debug, Clone, PartialEq)]
 pub struct IterRecord {
-    /// Iteration or generation number, from 0.
+    /// Iterations completed (local) or generation number from 0 (global).
     pub iteration: usize,
     /// Current (local) or best-so-far (global) design.
     pub x: Vec<f64>,
     /// Its objective.
     pub f: f64,
+    /// Its constraint values `g_j` (feasible when `<= 0`).
+    pub g: Vec<f64>,
     /// Its largest constraint value.
     pub max_g: f64,
+    /// The constraint thickness the solver applies at this design: `g_j >=
+    /// ct` is active (MMFD's CT, negative, shrinking towards −CTMIN);
+    /// `None` for solvers without an active set.
+    pub ct: Option<f64>,
     /// Step length taken in this iteration (or σ for CMA-ES).
     pub step: f64,
     /// Function evaluations so far.
     pub function_calls: usize,
     /// Gradient evaluations so far.
     pub gradient_calls: usize,
+}
+
+impl IterRecord {
+    /// Indices of the constraints active at this design (`g_j >= ct`;
+    /// none without a constraint thickness).
+    pub fn active(&self) -> Vec<usize> {
+        match self.ct {
+            Some(ct) => (0..self.g.len()).filter(|&j| self.g[j] >= ct).collect(),
+            None => Vec::new(),
+        }
+    }
 }
 
 /// Receives iteration records; CSV writers and progress bars implement it.
@@ -230,6 +255,32 @@ pub struct History(pub Vec<IterRecord>);
 impl Observer for History {
     fn observe(&mut self, record: &IterRecord) {
         self.0.push(record.clone());
+    }
+}
+
+/// An observer that keeps every record with the wall time \[s\] since the
+/// observer was made (make it just before the solver starts).
+#[derive(Debug, Clone)]
+pub struct TimedHistory {
+    started: std::time::Instant,
+    /// Records in order, each with its wall time since the start \[s\].
+    pub records: Vec<(IterRecord, f64)>,
+}
+
+impl TimedHistory {
+    /// An empty history whose clock starts now.
+    pub fn start() -> TimedHistory {
+        TimedHistory {
+            started: std::time::Instant::now(),
+            records: Vec::new(),
+        }
+    }
+}
+
+impl Observer for TimedHistory {
+    fn observe(&mut self, record: &IterRecord) {
+        let t = self.started.elapsed().as_secs_f64();
+        self.records.push((record.clone(), t));
     }
 }
 

@@ -15,7 +15,7 @@
 //! gives it back.
 
 use super::build::Scene;
-use super::spec::{FlexKind, SceneSpec};
+use super::spec::{FlexKind, OutputSpec, SceneSpec};
 use crate::error::{Error, Result};
 use crate::fe::Panel;
 use crate::integrate::SensitivityForm;
@@ -136,12 +136,40 @@ impl ScenePlan {
         Ok(self.build_profiled(laminates, sensitivities, outputs)?.0)
     }
 
+    /// The scene with panel `i` laid up as `laminates[i]`, no sensitivity
+    /// parameters and exactly the output columns `quantities` (names as in
+    /// `[scene.outputs] quantities`, whose errors name that key; no plot).
+    pub fn build_outputs(&self, laminates: &[Laminate], quantities: &[String]) -> Result<Scene> {
+        let mut spec = self.spec.clone();
+        spec.sensitivities = Vec::new();
+        spec.outputs = OutputSpec {
+            quantities: quantities.to_vec(),
+            ..Default::default()
+        };
+        Ok(self.build_spec(spec, laminates)?.0)
+    }
+
     /// [`ScenePlan::build`] with what it computed and its cost.
     pub fn build_profiled(
         &self,
         laminates: &[Laminate],
         sensitivities: &[String],
         outputs: bool,
+    ) -> Result<(Scene, BuildProfile)> {
+        let mut spec = self.spec.clone();
+        spec.sensitivities = sensitivities.to_vec();
+        if !outputs {
+            spec.outputs = Default::default();
+        }
+        self.build_spec(spec, laminates)
+    }
+
+    /// Build `spec` (this plan's scene with its sensitivities and outputs
+    /// chosen) with the panels laid up as `laminates`.
+    fn build_spec(
+        &self,
+        mut spec: SceneSpec,
+        laminates: &[Laminate],
     ) -> Result<(Scene, BuildProfile)> {
         let t0 = Instant::now();
         if laminates.len() != self.panels.len() {
@@ -151,12 +179,7 @@ impl ScenePlan {
                 format!("one laminate per [[panels]] entry ({})", self.panels.len()),
             ));
         }
-        let mut spec = self.spec.clone();
-        spec.sensitivities = sensitivities.to_vec();
         spec.prune_derivatives();
-        if !outputs {
-            spec.outputs = Default::default();
-        }
         let profile = Cell::new(BuildProfile::default());
         let bases = |name: &str, modes: usize, update: Option<ModeUpdate>| {
             let t = Instant::now();

@@ -60,6 +60,26 @@ pub enum Quantity {
     Violation,
 }
 
+/// Is the output name `name` one of the one-column forms (`energy`,
+/// `violation`, `kinetic_energy`, `<joint>.angle|rate|displacement|velocity`,
+/// `<body>.strain_energy|kinetic_energy`)? By its form only: whether the
+/// joint or body exists is known when the scene is built.
+pub fn scalar_output(name: &str) -> bool {
+    const WHOLE: [&str; 3] = ["energy", "violation", "kinetic_energy"];
+    const SUFFIXES: [&str; 6] = [
+        "angle",
+        "rate",
+        "displacement",
+        "velocity",
+        "strain_energy",
+        "kinetic_energy",
+    ];
+    WHOLE.contains(&name)
+        || name
+            .rsplit_once('.')
+            .is_some_and(|(head, what)| !head.is_empty() && SUFFIXES.contains(&what))
+}
+
 impl Quantity {
     /// CSV column headers with SI units.
     pub fn headers(&self, label: &str) -> Vec<String> {

@@ -103,7 +103,9 @@ pub struct Mmfd {
     failed_searches: usize,
     iteration: usize,
     termination: Option<Termination>,
-    record: Option<IterRecord>,
+    /// Records not yet passed on (the start's and an iteration's can be
+    /// made in one step).
+    records: std::collections::VecDeque<IterRecord>,
 }
 
 type Ap<'a> = ArgminProblem<Counted<'a>>;
@@ -196,7 +198,7 @@ impl Mmfd {
             failed_searches: 0,
             iteration: 0,
             termination: None,
-            record: None,
+            records: Default::default(),
         })
     }
 
@@ -440,7 +442,7 @@ impl Mmfd {
 
     /// Record the iteration and update the convergence counters.
     fn finish_iteration(&mut self, problem: &Ap<'_>, old: &Point, new: Point, step: f64) {
-        let o = &self.options;
+        let o = self.options.clone();
         let feasible = old.max_g() <= o.ctmin && new.max_g() <= o.ctmin;
         let df = (new.f - old.f).abs();
         if df > 0.0 {
@@ -456,19 +458,10 @@ impl Mmfd {
         } else {
             self.rel_count = 0;
         }
-        let (fc, gc) = counts(problem);
-        self.record = Some(IterRecord {
-            iteration: self.iteration,
-            x: new.x.clone(),
-            f: new.f,
-            max_g: new.max_g(),
-            step,
-            function_calls: fc,
-            gradient_calls: gc,
-        });
-        self.current = Some(new);
         self.iteration += 1;
         self.ct_now = (self.ct_now * o.ct_reduction).min(-o.ctmin);
+        self.push_record(problem, &new, step);
+        self.current = Some(new);
         if self.abs_count >= o.itrmop {
             self.termination = Some(Termination::AbsoluteChange);
         } else if self.rel_count >= o.itrmop {
@@ -560,6 +553,7 @@ impl Mmfd {
         if self.iteration == 0 && self.current.is_none() {
             self.dabobj = o.dabobj.unwrap_or((1e-4 * base.f.abs()).max(1e-10));
             self.current = Some(base.clone());
+            self.push_record(problem, &base, 0.0);
         }
         let missing = || Error::numerical("optimize::mmfd", "problem returned no gradients");
         let gf: Vec<f64> = ev
@@ -724,13 +718,21 @@ impl Mmfd {
 
     /// Record a final iteration that did not move.
     fn record_stay(&mut self, problem: &Ap<'_>, p: &Point) {
+        self.push_record(problem, p, 0.0);
+    }
+
+    /// Queue the record of design `p` reached by a scaled step `step`, with
+    /// the iterations completed, the calls so far and the current CT.
+    fn push_record(&mut self, problem: &Ap<'_>, p: &Point, step: f64) {
         let (fc, gc) = counts(problem);
-        self.record = Some(IterRecord {
+        self.records.push_back(IterRecord {
             iteration: self.iteration,
             x: p.x.clone(),
             f: p.f,
+            g: p.g.clone(),
             max_g: p.max_g(),
-            step: 0.0,
+            ct: Some(self.ct_now),
+            step,
             function_calls: fc,
             gradient_calls: gc,
         });
@@ -739,7 +741,7 @@ impl Mmfd {
 
 impl Recorded for Mmfd {
     fn take_record(&mut self) -> Option<IterRecord> {
-        self.record.take()
+        self.records.pop_front()
     }
 }
 
