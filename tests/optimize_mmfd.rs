@@ -335,3 +335,35 @@ fn infeasible_problem_is_reported() {
     assert!(o.x[0].abs() < 1e-9, "{o:?}");
     assert!(o.function_calls < 20);
 }
+
+#[test]
+fn each_record_reaches_the_observer_when_it_is_made() {
+    // An observer that times records (iterations.csv's wall column) must
+    // receive each one before the solver works on: the start's record
+    // after its one evaluation, each iteration's before the next
+    // iteration's gradient evaluation. Seen through the problem's own
+    // count of evaluations at the moment a record arrives.
+    use plyscape::optimize::{Counted, IterRecord, Observer};
+    struct AtArrival<'a> {
+        counted: &'a Counted<'a>,
+        seen: Vec<(usize, usize)>,
+    }
+    impl Observer for AtArrival<'_> {
+        fn observe(&mut self, r: &IterRecord) {
+            self.seen
+                .push((r.function_calls, self.counted.function_calls()));
+        }
+    }
+    let p = tp::hs43();
+    let counted = Counted::new(&p);
+    let mut obs = AtArrival {
+        counted: &counted,
+        seen: Vec::new(),
+    };
+    let o = mmfd::minimize(&counted, &p.x0, &MmfdOptions::default(), &mut obs).unwrap();
+    assert!(o.iterations > 2);
+    assert_eq!(obs.seen[0], (1, 1), "the start arrives alone");
+    for (made, arrived) in &obs.seen {
+        assert_eq!(made, arrived, "{:?}", obs.seen);
+    }
+}

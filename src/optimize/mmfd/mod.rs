@@ -103,8 +103,10 @@ pub struct Mmfd {
     failed_searches: usize,
     iteration: usize,
     termination: Option<Termination>,
-    /// Records not yet passed on (the start's and an iteration's can be
-    /// made in one step).
+    /// The start's evaluation (made by `init`, used by the first
+    /// iteration).
+    start_evaluation: Option<Evaluation>,
+    /// Records not yet passed on.
     records: std::collections::VecDeque<IterRecord>,
 }
 
@@ -198,6 +200,7 @@ impl Mmfd {
             failed_searches: 0,
             iteration: 0,
             termination: None,
+            start_evaluation: None,
             records: Default::default(),
         })
     }
@@ -540,21 +543,23 @@ impl Mmfd {
         let o = self.options.clone();
         let vars = variables(problem).to_vec();
         let n = vars.len();
-        let x = match &self.current {
-            Some(p) => p.x.clone(),
-            None => self.x0.clone(),
+        if self.current.is_none() {
+            self.start(problem)?;
+        }
+        let x = self
+            .current
+            .as_ref()
+            .map(|p| p.x.clone())
+            .unwrap_or_default();
+        let ev = match self.start_evaluation.take() {
+            Some(ev) => ev,
+            None => evaluate(problem, &x, true)?,
         };
-        let ev = evaluate(problem, &x, true)?;
         let base = Point {
             x,
             f: ev.f,
             g: ev.g.clone(),
         };
-        if self.iteration == 0 && self.current.is_none() {
-            self.dabobj = o.dabobj.unwrap_or((1e-4 * base.f.abs()).max(1e-10));
-            self.current = Some(base.clone());
-            self.push_record(problem, &base, 0.0);
-        }
         let missing = || Error::numerical("optimize::mmfd", "problem returned no gradients");
         let gf: Vec<f64> = ev
             .grad_f
@@ -716,6 +721,25 @@ impl Mmfd {
         Ok(())
     }
 
+    /// Evaluate the start design with gradients (kept for the first
+    /// iteration), set DABOBJ from its f and record it.
+    fn start(&mut self, problem: &mut Ap<'_>) -> Result<()> {
+        let ev = evaluate(problem, &self.x0, true)?;
+        let base = Point {
+            x: self.x0.clone(),
+            f: ev.f,
+            g: ev.g.clone(),
+        };
+        self.dabobj = self
+            .options
+            .dabobj
+            .unwrap_or((1e-4 * base.f.abs()).max(1e-10));
+        self.push_record(problem, &base, 0.0);
+        self.current = Some(base);
+        self.start_evaluation = Some(ev);
+        Ok(())
+    }
+
     /// Record a final iteration that did not move.
     fn record_stay(&mut self, problem: &Ap<'_>, p: &Point) {
         self.push_record(problem, p, 0.0);
@@ -748,6 +772,18 @@ impl Recorded for Mmfd {
 impl<'a> Solver<Counted<'a>, OptState> for Mmfd {
     fn name(&self) -> &str {
         "MMFD"
+    }
+
+    /// Evaluate and record the start (so that its record leaves before the
+    /// first iteration's work).
+    fn init(
+        &mut self,
+        problem: &mut ArgminProblem<Counted<'a>>,
+        state: OptState,
+    ) -> std::result::Result<(OptState, Option<KV>), argmin::core::Error> {
+        self.start(problem).map_err(argmin::core::Error::from)?;
+        let f = self.current.as_ref().map_or(f64::NAN, |p| p.f);
+        Ok((state.param(self.x0.clone()).cost(f), None))
     }
 
     fn next_iter(
