@@ -153,7 +153,13 @@ fn hs22_history_and_summary_are_the_runs() {
     );
     // The solver's active set at its last design (g >= its CT).
     assert_eq!(cell(&h, h.len() - 1, "active"), "g1; g2");
-    assert!(dir.join("iterations.svg").exists() && dir.join("iterations_design.svg").exists());
+    for f in [
+        "iterations.svg",
+        "iterations_constraints.svg",
+        "iterations_design.svg",
+    ] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
     let manifest = plyscape::report::read_manifest(&dir).unwrap();
     assert_eq!(manifest["commands"]["optimum_report"]["start"], 0);
     std::fs::remove_dir_all(&out).unwrap();
@@ -173,6 +179,8 @@ fn steepest_descent_history_is_the_run_too() {
     assert_eq!(cell(&s, 1, "f_start"), "170");
     assert!(float(cell(&s, 1, "f_optimum")) < 1e-12);
     assert_eq!(cell(&s, 1, "active"), "");
+    // No constraints, no constraint plot.
+    assert!(!dir.join("iterations_constraints.svg").exists());
     std::fs::remove_dir_all(&out).unwrap();
 }
 

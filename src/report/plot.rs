@@ -63,6 +63,19 @@ fn log_tick(v: &f64) -> String {
     format!("{:.0e}", 10f64.powf(*v))
 }
 
+/// Does a linear axis over `[lo, hi]` need scientific tick labels
+/// (plotters' default writes `0.0` for every tick of a range like 0 to
+/// 9e-6 J)? When its largest magnitude is below 1e-2 or above 1e5.
+fn needs_sci(lo: f64, hi: f64) -> bool {
+    let m = lo.abs().max(hi.abs());
+    m > 0.0 && !(1e-2..1e5).contains(&m)
+}
+
+/// Scientific tick label with three significant digits: `9.14e-6`.
+fn sci_tick(v: &f64) -> String {
+    format!("{v:.2e}")
+}
+
 /// The curves' points as drawn: logarithms where the axis is logarithmic,
 /// non-finite and non-positive-on-log points left out.
 fn drawn_points(curves: &[Curve], scale: Scale) -> Vec<Vec<(f64, f64)>> {
@@ -125,14 +138,14 @@ pub fn line_plot(path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()> {
     let fy: &dyn Fn(&f64) -> String = if axes.scale.log_y() {
         &log_tick
     } else {
-        &plain
+        &sci_tick
     };
     let mut mesh = chart.configure_mesh();
     mesh.x_desc(axes.x).y_desc(axes.y);
     if axes.scale.log_x() {
         mesh.x_label_formatter(fx);
     }
-    if axes.scale.log_y() {
+    if axes.scale.log_y() || needs_sci(y0, y1) {
         mesh.y_label_formatter(fy);
     }
     mesh.draw().map_err(|e| plot_err(path, e))?;
@@ -308,6 +321,37 @@ pub fn heat_map(path: &Path, map: &HeatMap) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn small_values_get_scientific_ticks() {
+        assert!(needs_sci(0.0, 9.1e-6) && needs_sci(-2e5, 0.0));
+        assert!(!needs_sci(3.09, 3.12) && !needs_sci(-0.05, 1.0) && !needs_sci(0.0, 0.0));
+        // A strain energy of a few µJ: ticks in its own values, not `0.0`.
+        let dir = std::env::temp_dir().join(format!("plyscape-plot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("u.svg");
+        let axes = Axes {
+            title: "U",
+            x: "t [s]",
+            y: "U [J]",
+            scale: Scale::Linear,
+        };
+        let points = (0..=10)
+            .map(|k| (0.1 * k as f64, 1e-6 * k as f64))
+            .collect();
+        line_plot(
+            &path,
+            &axes,
+            &[Curve {
+                label: "U".into(),
+                points,
+            }],
+        )
+        .unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(svg.contains("5.00e-6"), "{svg}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn ramp_ends() {

@@ -1,7 +1,8 @@
 //! `iterations.csv`: one row per record of the reported run (the start,
 //! each iteration, and a final check that did not move; see
-//! [`crate::optimize::IterRecord`]), with `iterations.svg` (f and every
-//! g_j against the iteration: the paper's Fig. 10 with its constraint) and
+//! [`crate::optimize::IterRecord`]), with `iterations.svg` (f against the
+//! iteration: the paper's Fig. 10), `iterations_constraints.svg` (every
+//! g_j, and the solver's CT above which a constraint is active) and
 //! `iterations_design.svg` (the design variables: Fig. 11).
 //!
 //! Columns: `iteration` (iterations completed), `record` (`start`,
@@ -88,7 +89,7 @@ fn row(records: &[(IterRecord, f64)], k: usize, labels: &Labels) -> Vec<String> 
     row
 }
 
-/// Write `iterations.csv` and, with records, its two plots into `dir`.
+/// Write `iterations.csv` and, with records, its plots into `dir`.
 pub fn write(
     dir: &Path,
     problem: &dyn Problem,
@@ -104,49 +105,87 @@ pub fn write(
     if records.is_empty() {
         return Ok(files);
     }
-    files.push(plot_values(dir, problem, labels, records)?);
+    files.push(plot_objective(dir, problem, records)?);
+    if !labels.constraints.is_empty() {
+        files.push(plot_constraints(dir, problem, labels, records)?);
+    }
     files.push(plot_design(dir, problem, labels, records)?);
     Ok(files)
 }
 
-/// `iterations.svg`: f and each g_j against the iteration.
-fn plot_values(
+/// Points `(iteration, value(record))` of the records that have a value.
+fn per_iteration(
+    records: &[(IterRecord, f64)],
+    value: &dyn Fn(&IterRecord) -> Option<f64>,
+) -> Vec<(f64, f64)> {
+    records
+        .iter()
+        .filter_map(|(r, _)| Some((r.iteration as f64, value(r)?)))
+        .collect()
+}
+
+/// Draw `curves` against the iteration into `dir/<file>`.
+fn plot(dir: &Path, file: &str, title: &str, y: &str, curves: &[Curve]) -> Result<PathBuf> {
+    let path = dir.join(file);
+    line_plot(
+        &path,
+        &Axes {
+            title,
+            x: "iterations completed [-]",
+            y,
+            scale: Scale::Linear,
+        },
+        curves,
+    )?;
+    Ok(path)
+}
+
+/// `iterations.svg`: f against the iteration.
+fn plot_objective(
+    dir: &Path,
+    problem: &dyn Problem,
+    records: &[(IterRecord, f64)],
+) -> Result<PathBuf> {
+    let curves = [Curve {
+        label: "f".into(),
+        points: per_iteration(records, &|r| Some(r.f)),
+    }];
+    let title = format!("{}: objective per iteration", problem.name());
+    plot(
+        dir,
+        "iterations.svg",
+        &title,
+        &problem.objective_label(),
+        &curves,
+    )
+}
+
+/// `iterations_constraints.svg`: each g_j, and CT, against the iteration.
+fn plot_constraints(
     dir: &Path,
     problem: &dyn Problem,
     labels: &Labels,
     records: &[(IterRecord, f64)],
 ) -> Result<PathBuf> {
-    let at = |value: &dyn Fn(&IterRecord) -> f64| -> Vec<(f64, f64)> {
-        records
-            .iter()
-            .map(|(r, _)| (r.iteration as f64, value(r)))
-            .collect()
-    };
-    let mut curves = vec![Curve {
-        label: "f".into(),
-        points: at(&|r| r.f),
-    }];
-    for (j, name) in labels.constraints.iter().enumerate() {
-        curves.push(Curve {
+    let mut curves: Vec<Curve> = labels
+        .constraints
+        .iter()
+        .enumerate()
+        .map(|(j, name)| Curve {
             label: name.clone(),
-            points: at(&|r| r.g[j]),
+            points: per_iteration(records, &|r| r.g.get(j).copied()),
+        })
+        .collect();
+    let ct = per_iteration(records, &|r| r.ct);
+    if !ct.is_empty() {
+        curves.push(Curve {
+            label: "CT (g_j >= CT: active)".into(),
+            points: ct,
         });
     }
-    let path = dir.join("iterations.svg");
-    line_plot(
-        &path,
-        &Axes {
-            title: &format!(
-                "{}: objective and constraints per iteration",
-                problem.name()
-            ),
-            x: "iterations completed [-]",
-            y: &format!("{}; g_j [-]", problem.objective_label()),
-            scale: Scale::Linear,
-        },
-        &curves,
-    )?;
-    Ok(path)
+    let title = format!("{}: constraints per iteration", problem.name());
+    let file = "iterations_constraints.svg";
+    plot(dir, file, &title, "g_j [-] (feasible <= 0)", &curves)
 }
 
 /// `iterations_design.svg`: each design variable against the iteration.
@@ -162,22 +201,10 @@ fn plot_design(
         .enumerate()
         .map(|(i, v)| Curve {
             label: v.name.clone(),
-            points: records
-                .iter()
-                .map(|(r, _)| (r.iteration as f64, r.x[i]))
-                .collect(),
+            points: per_iteration(records, &|r| r.x.get(i).copied()),
         })
         .collect();
-    let path = dir.join("iterations_design.svg");
-    line_plot(
-        &path,
-        &Axes {
-            title: &format!("{}: design variables per iteration", problem.name()),
-            x: "iterations completed [-]",
-            y: &format!("design variables [{}]", labels.x_unit),
-            scale: Scale::Linear,
-        },
-        &curves,
-    )?;
-    Ok(path)
+    let title = format!("{}: design variables per iteration", problem.name());
+    let y = format!("design variables [{}]", labels.x_unit);
+    plot(dir, "iterations_design.svg", &title, &y, &curves)
 }

@@ -2,9 +2,10 @@
 //! paper's start when it is listed first in `[multistart] points`)
 //! reported the way the paper reports its MMFD run (Neto, Ambrósio, Leal
 //! §6.3, Table 5, Figs. 10–14):
-//! - `iterations.csv`, with `iterations.svg` (f and every g_j per
-//!   iteration, Fig. 10) and `iterations_design.svg` (the design, Fig. 11):
-//!   one row per record of the run ([`history`]);
+//! - `iterations.csv`, with `iterations.svg` (f per iteration, Fig. 10),
+//!   `iterations_constraints.svg` (every g_j and the solver's CT) and
+//!   `iterations_design.svg` (the design, Fig. 11): one row per record of
+//!   the run ([`history`]);
 //! - `optimum_summary.csv`: one row like Table 5 ([`summary`]);
 //! - per listed scene output `q`, `start_optimum_<q>.csv` and `.svg`: `q(t)`
 //!   simulated at the start and at the optimum (Fig. 12 for `R3.angle`,
