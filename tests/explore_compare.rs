@@ -231,3 +231,171 @@ fn bipop_is_chosen_in_the_study_and_reported() {
     assert!(e.contains("evolve.restarts"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `[evolve] restarts = ["ipop", "bipop"]`: one comparison row per
+/// schedule, each equal to the row of a study with that schedule alone
+/// (same seed, same numbers), both on the multistart's function calls.
+#[test]
+fn listed_schedules_each_equal_their_run_alone_on_one_budget() {
+    let dir = temp_dir("cmp-both");
+    let without_wall = |p: &std::path::Path| table_without(p, &["wall_seconds"]);
+    for problem in ["hs22", "himmelblau"] {
+        let run = |name: &str, evolve: &str| {
+            let s = study(name, &text(name, problem, evolve));
+            let rows = explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+            explore::run_map(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+            (rows, dir.join(name))
+        };
+        let both = "[evolve]\nrestarts = [\"ipop\", \"bipop\"]\n";
+        let (rows, d) = run("both", both);
+        let (_, ipop) = run("ipop", "");
+        let (_, bipop) = run("bipop", "[evolve]\nrestarts = \"bipop\"\n");
+        let methods: Vec<&str> = rows.iter().map(|r| r.method.as_str()).collect();
+        assert_eq!(
+            methods,
+            ["multistart-mmfd", "cmaes", "cmaes-bipop"],
+            "{problem}"
+        );
+        // comparison.csv: the multistart and IPOP rows of the IPOP study,
+        // then the BIPOP row of the BIPOP study.
+        let t = without_wall(&d.join("comparison.csv"));
+        let (ti, tb) = (
+            without_wall(&ipop.join("comparison.csv")),
+            without_wall(&bipop.join("comparison.csv")),
+        );
+        assert_eq!(
+            t,
+            [ti[0].clone(), ti[1].clone(), ti[2].clone(), tb[2].clone()]
+        );
+        // evolution.csv: each schedule's rows, told apart by `method`,
+        // equal the table of its study alone (which has no such column).
+        let ev = table_without(&d.join("evolution.csv"), &[]);
+        assert_eq!(ev[0][0], "method");
+        for (method, alone) in [("cmaes", &ipop), ("cmaes-bipop", &bipop)] {
+            let mine: Vec<Vec<String>> = ev[1..]
+                .iter()
+                .filter(|r| r[0] == method)
+                .map(|r| r[1..].to_vec())
+                .collect();
+            let other = table_without(&alone.join("evolution.csv"), &[]);
+            assert_eq!(other[0], ev[0][1..], "{problem} {method}");
+            assert_eq!(mine, other[1..], "{problem} {method}");
+        }
+        // One budget, the multistart's function calls, that neither
+        // schedule exceeds; the manifest lists both with their calls.
+        let calls: Vec<usize> = column(&t, "function_calls")
+            .iter()
+            .map(|c| c.parse().unwrap())
+            .collect();
+        assert!(calls[1] <= calls[0] && calls[2] <= calls[0], "{calls:?}");
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("manifest.json")).unwrap())
+                .unwrap();
+        let e = &m["commands"]["evolve"];
+        assert_eq!(e["max_evaluations"].as_u64(), Some(calls[0] as u64));
+        assert_eq!(e["restarts"], serde_json::json!(["ipop", "bipop"]));
+        let sched = e["schedules"].as_array().unwrap();
+        for (k, (method, solver)) in [("cmaes", "IPOP-CMA-ES"), ("cmaes-bipop", "BIPOP-CMA-ES")]
+            .into_iter()
+            .enumerate()
+        {
+            assert_eq!(sched[k]["method"], method);
+            assert_eq!(sched[k]["solver"], solver);
+            assert_eq!(
+                sched[k]["function_calls"].as_u64(),
+                Some(calls[k + 1] as u64)
+            );
+            let spent: u64 = sched[k]["runs"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|r| r["evaluations"].as_u64().unwrap())
+                .sum();
+            assert_eq!(spent as usize, calls[k + 1], "{problem} {method}");
+        }
+        // Each schedule drawn on the convergence plot and marked on the map.
+        let svg = std::fs::read_to_string(d.join("convergence.svg")).unwrap();
+        assert!(
+            svg.contains("IPOP-CMA-ES (best so far)") && svg.contains("BIPOP-CMA-ES (best so far)"),
+            "{problem}"
+        );
+        let map = std::fs::read_to_string(d.join("map.svg")).unwrap();
+        assert!(
+            map.contains("IPOP-CMA-ES best") && map.contains("BIPOP-CMA-ES best"),
+            "{problem}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// No `[evolve]`, `restarts = "ipop"` and `restarts = ["ipop"]` are one
+/// and the same search: identical tables, no `method` column.
+#[test]
+fn the_default_schedule_is_ipop_however_written() {
+    let dir = temp_dir("cmp-default");
+    let mut tables = Vec::new();
+    for (name, evolve) in [
+        ("none", ""),
+        ("one", "[evolve]\nrestarts = \"ipop\"\n"),
+        ("list", "[evolve]\nrestarts = [\"ipop\"]\n"),
+    ] {
+        let s = study(name, &text(name, "hs22", evolve));
+        explore::run_compare(&ctx(&s, &dir, 1, DriveFlags::default())).unwrap();
+        let d = dir.join(name);
+        tables.push((
+            std::fs::read(d.join("evolution.csv")).unwrap(),
+            table_without(&d.join("comparison.csv"), &["wall_seconds"]),
+        ));
+    }
+    assert!(tables.iter().all(|t| *t == tables[0]));
+    let header = String::from_utf8(tables[0].0.clone()).unwrap();
+    assert!(header.starts_with("generation,function_calls,"), "{header}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A bad schedule list names the file, the key, the value and what is
+/// expected, and is refused before any work.
+#[test]
+fn bad_schedule_lists_are_refused_before_any_work() {
+    let dir = temp_dir("cmp-bad-list");
+    for (value, key, shown, expected) in [
+        ("[]", "evolve.restarts", "[]", "a non-empty list"),
+        ("3", "evolve.restarts", "3", "one of ipop, bipop"),
+        (
+            "[\"ipop\", \"lpop\"]",
+            "evolve.restarts[1]",
+            "\"lpop\"",
+            "one of ipop, bipop",
+        ),
+        (
+            "[\"ipop\", 2]",
+            "evolve.restarts[1]",
+            "2",
+            "one of ipop, bipop",
+        ),
+        (
+            "[\"bipop\", \"ipop\", \"bipop\"]",
+            "evolve.restarts[2]",
+            "\"bipop\"",
+            "each schedule once",
+        ),
+    ] {
+        let s = study(
+            "bad",
+            &text(
+                "bad",
+                "himmelblau",
+                &format!("[evolve]\nrestarts = {value}\n"),
+            ),
+        );
+        let e = plyscape::cli::check_study(&s).unwrap_err().to_string();
+        let want = format!("bad.toml: `{key}` = {shown}: expected");
+        assert!(e.starts_with(&want) && e.contains(expected), "{value}: {e}");
+        let e = explore::run_compare(&ctx(&s, &dir, 1, DriveFlags::default()))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with(&want), "{value}: {e}");
+        assert!(!dir.join("bad/runs.csv").exists(), "{value}: work was done");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -100,3 +100,28 @@ fn every_shipped_study_passes_the_upfront_check() {
     }
     assert!(n >= 20, "{n} studies");
 }
+
+/// `studies/sar_explore.toml` is the sar_optimize problem on the same
+/// scene, explored with the paper's start plus 63 Latin-hypercube starts,
+/// both CMA-ES schedules and a 19 x 19 map on two threads. (The study
+/// itself takes minutes of both cores and is run by hand.)
+#[test]
+fn sar_explore_is_sar_optimize_with_64_starts_and_both_schedules() {
+    use plyscape::optimize::cmaes::Restarts;
+    let s = Study::load("studies/sar_explore.toml").unwrap();
+    let o = Study::load("studies/sar_optimize.toml").unwrap();
+    for key in ["problem", "scene_problem", "scene", "panels"] {
+        assert_eq!(s.table[key], o.table[key], "{key}");
+    }
+    assert_eq!((s.meta.seed, s.meta.threads), (o.meta.seed, Some(2)));
+    let ms = plyscape::explore::multistart_section(&s).unwrap();
+    assert_eq!((ms.method.as_str(), ms.sampler.as_str()), ("mmfd", "lhs"));
+    assert_eq!(ms.points, [[55.0, -55.0]]);
+    assert_eq!(ms.points.len() + ms.starts, 64);
+    let ev = plyscape::explore::evolve_plan(&s).unwrap();
+    assert_eq!(ev.schedules, [Restarts::Ipop, Restarts::Bipop]);
+    // No budget of its own: under [compare] the multistart's calls.
+    assert_eq!(ev.section.max_evaluations, None);
+    assert!(s.has("compare"));
+    assert_eq!(plyscape::explore::map_section(&s).unwrap().resolution, 19);
+}

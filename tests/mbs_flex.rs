@@ -178,6 +178,57 @@ fn flexible_jacobian_vector_product_matches_central_differences() {
 }
 
 #[test]
+fn multi_lane_evaluations_equal_one_lane_at_a_time() {
+    // The fused sensitivity right-hand side (`rhs_lanes`: one multi-lane
+    // dual evaluation for 1, 2 or 4 lanes, chunks of 4 beyond) against
+    // the plain right-hand side and one single-lane `rhs_dir` per lane,
+    // for 1 to 5 lanes (parameters: the bodies' masses, each lane seeding
+    // its own parameter and state direction).
+    use plyscape::integrate::OdeModel;
+    use plyscape::mbs::Param;
+    let sys = System::new(load_scene(&spinup()).unwrap().model);
+    let mut y = sys.initial_state();
+    let n = y.len();
+    for (k, v) in y.iter_mut().enumerate() {
+        *v += 1e-3 * ((k as f64) * 0.37).sin();
+    }
+    sys.project(0.0, &mut y).unwrap();
+    let bodies: Vec<usize> = sys.moving.clone();
+    let mut w = sys.work(n);
+    for np in 1..=5 {
+        let names: Vec<Param> = (0..np)
+            .map(|i| Param::Mass(bodies[i % bodies.len()]))
+            .collect();
+        let p: Vec<f64> = names.iter().map(|q| sys.param_value(*q).unwrap()).collect();
+        let lanes: Vec<f64> = (0..n * np).map(|k| ((k as f64) * 0.71).cos()).collect();
+        let (mut dy, mut dl) = (vec![0.0; n], vec![0.0; n * np]);
+        let duals = sys.rhs_lanes(&mut w, 0.5, &y, (&names, &p), &lanes, &mut dy, &mut dl);
+        assert_eq!(duals, if np <= 2 { 1 } else { np.div_ceil(4) });
+        let mut f = vec![0.0; n];
+        OdeModel::rhs(&sys, &mut w, 0.5, &y, (&names, &p), &mut f);
+        let scale = f.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+        for k in 0..n {
+            assert!(
+                (dy[k] - f[k]).abs() <= 1e-12 * scale,
+                "f[{k}] with {np} lanes"
+            );
+        }
+        for i in 0..np {
+            let mut e = vec![0.0; np];
+            e[i] = 1.0;
+            let mut one = vec![0.0; n];
+            let s = &lanes[i * n..(i + 1) * n];
+            sys.rhs_dir(&mut w, 0.5, &y, (&names, &p), (Some(s), Some(&e)), &mut one);
+            let sc = one.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+            for k in 0..n {
+                let err = (dl[i * n + k] - one[k]).abs();
+                assert!(err <= 1e-12 * sc, "lane {i} of {np}, row {k}: {err:e}");
+            }
+        }
+    }
+}
+
+#[test]
 fn slow_spin_up_follows_the_quasi_static_deflection() {
     // studies/beam_spinup.toml: once the hub torque holds (t > 2 s) the
     // angular acceleration α is constant and the tip lags by the

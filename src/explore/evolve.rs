@@ -3,8 +3,9 @@
 //! The solver itself lives in `optimize::cmaes`; this driver gives it the
 //! budget and the seed, runs it inside a rayon pool of the study's thread
 //! count (so a solver that evaluates its population with rayon uses exactly
-//! those threads), and turns its per-generation [`IterRecord`]s into
-//! `evolution.csv`.
+//! those threads), and turns its per-generation [`IterRecord`]s into the
+//! rows of `evolution.csv` ([`table`]: one schedule's generations, or
+//! several schedules' one after another with a `method` column).
 //!
 //! The solver reports best-so-far `f` and σ per generation, not the mean of
 //! the population; the driver therefore records every objective value the
@@ -12,14 +13,13 @@
 //! values requested since the previous record (sorted before summing, so the
 //! mean does not depend on the order in which parallel evaluations finish).
 
-use super::tables::{num, write_atomic};
+use super::tables::num;
 use crate::error::{Error, Result};
 use crate::optimize::cmaes::Restarts;
 use crate::optimize::{
     Counted, Evaluation, GlobalOutcome, IterRecord, Observer, Problem, Variable,
 };
 use crate::report::Progress;
-use std::path::Path;
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -136,15 +136,14 @@ impl Observer for GenObserver<'_> {
     }
 }
 
-/// Run `solver` on `problem` with `threads` rayon threads; write
-/// `evolution.csv` and `convergence` data into `dir`.
+/// Run `solver` on `problem` with `threads` rayon threads (the caller
+/// writes the rows with [`table`]).
 pub fn run(
     problem: &dyn Problem,
     solver: &GlobalSolver,
     request: &Request,
     threads: usize,
     quiet: bool,
-    dir: &Path,
 ) -> Result<Report> {
     let t0 = Instant::now();
     let pool = rayon::ThreadPoolBuilder::new()
@@ -161,7 +160,11 @@ pub fn run(
         counted: &counted,
         seen: 0,
         rows: Vec::new(),
-        progress: Progress::new("evolution", request.max_evaluations as u64, quiet),
+        progress: Progress::new(
+            request.restarts.solver_name(),
+            request.max_evaluations as u64,
+            quiet,
+        ),
         budget: request.max_evaluations,
     };
     let outcome = pool.install(|| solver(&counted, request, &mut obs))?;
@@ -175,54 +178,80 @@ pub fn run(
             ),
         ));
     }
-    let report = Report {
+    Ok(Report {
         function_calls: counted.function_calls(),
         gradient_calls: counted.gradient_calls(),
         generations: std::mem::take(&mut obs.rows),
         outcome,
         wall_seconds: t0.elapsed().as_secs_f64(),
         restarts: request.restarts,
-    };
-    write_atomic(
-        &dir.join("evolution.csv"),
-        &table(problem, &report.generations),
-    )?;
-    Ok(report)
+    })
 }
 
-/// `evolution.csv`: header and one row per generation. Non-finite entries
-/// are left empty.
-pub fn table(problem: &dyn Problem, rows: &[Generation]) -> Vec<Vec<String>> {
-    let vars = problem.variables();
-    let m = problem.n_constraints();
-    let fin = |v: f64| if v.is_finite() { num(v) } else { String::new() };
-    let mut h: Vec<String> = [
-        "generation",
-        "function_calls",
-        "best_f",
-        "best_max_g",
-        "mean_f",
-        "sigma",
-    ]
-    .map(String::from)
-    .to_vec();
-    h.extend(vars.iter().map(|v| format!("best_x_{}", v.name)));
-    let mut out = vec![h];
-    for g in rows {
-        let mut r = vec![
-            g.generation.to_string(),
-            g.function_calls.to_string(),
-            fin(g.best_f),
-            if m > 0 {
-                fin(g.best_max_g)
+/// `evolution.csv`: header and one row per generation of each report, the
+/// reports one after another. With more than one report a first column
+/// `method` names each row's schedule ([`super::solvers::global_method`],
+/// as in `comparison.csv`); one report's table has no such column, as
+/// before schedules could be listed. Non-finite entries are left empty.
+pub fn table(problem: &dyn Problem, reports: &[Report]) -> Vec<Vec<String>> {
+    let tagged = reports.len() > 1;
+    let mut out = vec![header(problem, tagged)];
+    for r in reports {
+        let method = super::solvers::global_method(r.restarts);
+        for g in &r.generations {
+            let mut row = if tagged {
+                vec![method.to_string()]
             } else {
-                String::new()
-            },
-            g.mean_f.map(fin).unwrap_or_default(),
-            fin(g.sigma),
-        ];
-        r.extend(g.best_x.iter().map(|&v| fin(v)));
-        out.push(r);
+                vec![]
+            };
+            row.extend(generation_row(g, problem.n_constraints() > 0));
+            out.push(row);
+        }
     }
     out
+}
+
+fn header(problem: &dyn Problem, tagged: bool) -> Vec<String> {
+    let mut h: Vec<String> = if tagged {
+        vec!["method".into()]
+    } else {
+        vec![]
+    };
+    h.extend(
+        [
+            "generation",
+            "function_calls",
+            "best_f",
+            "best_max_g",
+            "mean_f",
+            "sigma",
+        ]
+        .map(String::from),
+    );
+    h.extend(
+        problem
+            .variables()
+            .iter()
+            .map(|v| format!("best_x_{}", v.name)),
+    );
+    h
+}
+
+/// One generation's fields (`best_max_g` empty without constraints).
+fn generation_row(g: &Generation, constrained: bool) -> Vec<String> {
+    let fin = |v: f64| if v.is_finite() { num(v) } else { String::new() };
+    let mut r = vec![
+        g.generation.to_string(),
+        g.function_calls.to_string(),
+        fin(g.best_f),
+        if constrained {
+            fin(g.best_max_g)
+        } else {
+            String::new()
+        },
+        g.mean_f.map(fin).unwrap_or_default(),
+        fin(g.sigma),
+    ];
+    r.extend(g.best_x.iter().map(|&v| fin(v)));
+    r
 }

@@ -129,26 +129,73 @@ fn default_feas_tol() -> f64 {
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct EvolveSection {
-    /// Evaluation budget. Default: under `compare`, the function calls the
-    /// multistart used; alone, 100 per start of `[multistart]`, else 10 000.
+    /// Evaluation budget of each schedule. Default: under `compare`, the
+    /// function calls the multistart used; alone, 100 per start of
+    /// `[multistart]`, else 10 000.
     pub max_evaluations: Option<usize>,
-    /// CMA-ES restart schedule: `ipop` (default) or `bipop`
-    /// ([`crate::optimize::cmaes::Restarts`]).
-    pub restarts: Option<String>,
+    /// CMA-ES restart schedule ([`crate::optimize::cmaes::Restarts`]):
+    /// `ipop` (default), `bipop`, or a list of distinct names
+    /// (`["ipop", "bipop"]`), run one after another on the same budget and
+    /// seed; read by [`schedules`].
+    pub restarts: Option<toml::Value>,
 }
 
-/// Read and check `[evolve]` (absent: defaults): the section and its
-/// restart schedule. Errors name the file and `evolve.<key>`.
-pub fn evolve_plan(study: &Study) -> Result<(EvolveSection, Restarts)> {
-    let sec: EvolveSection = study.section("evolve")?.unwrap_or_default();
-    if sec.max_evaluations == Some(0) {
+/// A checked `[evolve]`.
+#[derive(Debug, Clone)]
+pub struct EvolvePlan {
+    /// The section.
+    pub section: EvolveSection,
+    /// The restart schedules, in the order they run (at least one).
+    pub schedules: Vec<Restarts>,
+}
+
+/// Read and check `[evolve]` (absent: defaults). Errors name the file and
+/// `evolve.<key>`.
+pub fn evolve_plan(study: &Study) -> Result<EvolvePlan> {
+    let section: EvolveSection = study.section("evolve")?.unwrap_or_default();
+    if section.max_evaluations == Some(0) {
         return Err(study.error("evolve.max_evaluations", 0, "a budget >= 1"));
     }
-    let restarts = match &sec.restarts {
-        Some(name) => Restarts::parse(name).map_err(study.locate("evolve"))?,
-        None => Restarts::default(),
+    let schedules = schedules(section.restarts.as_ref()).map_err(study.locate("evolve"))?;
+    Ok(EvolvePlan { section, schedules })
+}
+
+/// The schedules of a `restarts` value: absent, IPOP; a name, that
+/// schedule; a non-empty list of distinct names, those in order. Errors
+/// name the key `restarts` (`restarts[k]` for the k-th list entry).
+pub fn schedules(value: Option<&toml::Value>) -> Result<Vec<Restarts>> {
+    let names = Restarts::NAMES;
+    let list = match value {
+        None => return Ok(vec![Restarts::default()]),
+        Some(toml::Value::String(name)) => return Ok(vec![Restarts::parse(name)?]),
+        Some(toml::Value::Array(list)) if !list.is_empty() => list,
+        Some(other) => {
+            return Err(Error::input(
+                "restarts",
+                other,
+                format!(
+                    "one of {names}, or a non-empty list of them (\"ipop\", [\"ipop\", \"bipop\"])"
+                ),
+            ))
+        }
     };
-    Ok((sec, restarts))
+    let mut out: Vec<Restarts> = Vec::new();
+    for (k, v) in list.iter().enumerate() {
+        let key = format!("restarts[{k}]");
+        let r = v
+            .as_str()
+            .and_then(|name| Restarts::parse(name).ok())
+            .ok_or_else(|| Error::input(&key, v, format!("one of {names}")))?;
+        if let Some(j) = out.iter().position(|&earlier| earlier == r) {
+            return Err(Error::input(
+                key,
+                v,
+                format!("each schedule once (it is restarts[{j}] already)"),
+            ));
+        }
+        out.push(r);
+    }
+    Ok(out)
 }
 
 /// The `[compare]` section (no keys).
@@ -456,36 +503,79 @@ fn print_optima(problem: &dyn Problem, r: &multistart::Report) {
     }
 }
 
-/// `plyscape evolve`: evolution.csv (and the outcome). `budget` overrides
-/// the study's.
-pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<evolve::Report> {
+/// `plyscape evolve`: CMA-ES with each schedule of `[evolve] restarts` on
+/// the same budget and seed, one after another; evolution.csv,
+/// convergence.svg and the manifest entry. `budget` stands in for an
+/// absent `[evolve] max_evaluations`.
+pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<Vec<evolve::Report>> {
     let problem = problem(ctx.study)?;
-    let (sec, restarts) = evolve_plan(ctx.study)?;
+    let plan = evolve_plan(ctx.study)?;
     let ms = ctx.study.section::<MultistartSection>("multistart")?;
     let starts = ms.as_ref().map(|m| m.starts + m.points.len());
     // One feasibility tolerance for both methods: the multistart's.
     let feasibility_tolerance = ms.as_ref().map_or(0.0, |m| m.feasibility_tolerance);
-    let max_evaluations = sec
+    let max_evaluations = plan
+        .section
         .max_evaluations
         .or(budget)
         .or(starts.map(|s| 100 * s.max(1)))
         .unwrap_or(10_000);
     let dir = ctx.dir()?;
-    let request = evolve::Request {
-        seed: ctx.study.meta.seed,
-        max_evaluations,
-        restarts,
-        feasibility_tolerance,
-    };
     let solver = solvers::global();
-    let report = evolve::run(
-        problem.as_ref(),
-        solver.as_ref(),
-        &request,
-        ctx.threads,
-        ctx.quiet,
-        &dir,
+    let mut reports = Vec::new();
+    for &restarts in &plan.schedules {
+        let request = evolve::Request {
+            seed: ctx.study.meta.seed,
+            max_evaluations,
+            restarts,
+            feasibility_tolerance,
+        };
+        let report = evolve::run(
+            problem.as_ref(),
+            solver.as_ref(),
+            &request,
+            ctx.threads,
+            ctx.quiet,
+        )?;
+        if !ctx.quiet {
+            print_evolution(problem.as_ref(), &report);
+        }
+        reports.push(report);
+    }
+    tables::write_atomic(
+        &dir.join("evolution.csv"),
+        &evolve::table(problem.as_ref(), &reports),
     )?;
+    ctx.manifest(&dir, "evolve", evolve_entry(max_evaluations, &reports))?;
+    convergence_plot(problem.as_ref(), &dir, None, &reports)?;
+    Ok(reports)
+}
+
+/// The manifest entry of `evolve`: the budget, and per schedule its
+/// method, solver, `restarts` name, function calls, wall time, run counts
+/// per regime and every CMA-ES run (regime, λ, σ0, evaluations,
+/// generations). One schedule's keys stand at the top of the entry (as
+/// before lists existed); several are under `schedules`, with `restarts`
+/// listing their names and `wall_seconds` their total.
+fn evolve_entry(max_evaluations: usize, reports: &[evolve::Report]) -> serde_json::Value {
+    let mut entry = serde_json::Map::new();
+    entry.insert("max_evaluations".into(), json!(max_evaluations));
+    let schedules: Vec<serde_json::Value> = reports.iter().map(schedule_entry).collect();
+    match schedules.as_slice() {
+        [serde_json::Value::Object(one)] => entry.extend(one.clone()),
+        _ => {
+            let names: Vec<&str> = reports.iter().map(|r| r.restarts.name()).collect();
+            let wall: f64 = reports.iter().map(|r| r.wall_seconds).sum();
+            entry.insert("wall_seconds".into(), json!(wall));
+            entry.insert("restarts".into(), json!(names));
+            entry.insert("schedules".into(), json!(schedules));
+        }
+    }
+    serde_json::Value::Object(entry)
+}
+
+/// One schedule's part of [`evolve_entry`].
+fn schedule_entry(report: &evolve::Report) -> serde_json::Value {
     let o = &report.outcome;
     let (large, small) = regime_counts(o);
     let runs: Vec<serde_json::Value> = o
@@ -496,22 +586,32 @@ pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<evolve::Report
                    "evaluations": r.evaluations, "generations": r.generations})
         })
         .collect();
-    ctx.manifest(
-        &dir,
-        "evolve",
-        json!({"max_evaluations": max_evaluations, "wall_seconds": report.wall_seconds,
-               "solver": restarts.solver_name(), "restarts": restarts.name(),
-               "large_runs": large, "small_runs": small, "runs": runs}),
-    )?;
-    convergence_plot(problem.as_ref(), &dir, None, Some(&report))?;
-    if !ctx.quiet {
-        println!(
-            "evolution ({}) on {}: best f = {:.8e} at x = {:?} (feasible = {}), {} evaluations, {} generations, {} restarts ({} large-population runs, {} small), {}",
-            restarts.solver_name(), problem.name(), o.f, o.x, o.feasible, report.function_calls,
-            o.generations, o.restarts, large, small, o.termination
-        );
-    }
-    Ok(report)
+    let r = report.restarts;
+    json!({"method": solvers::global_method(r), "solver": r.solver_name(),
+           "restarts": r.name(), "function_calls": report.function_calls,
+           "wall_seconds": report.wall_seconds, "large_runs": large,
+           "small_runs": small, "runs": runs})
+}
+
+/// The summary line of one evolutionary search.
+fn print_evolution(problem: &dyn Problem, report: &evolve::Report) {
+    let o = &report.outcome;
+    let (large, small) = regime_counts(o);
+    println!(
+        "evolution ({}) on {}: best f = {:.8e} at x = {:?} (feasible = {}), {} evaluations, \
+         {} generations, {} restarts ({} large-population runs, {} small), {}",
+        report.restarts.solver_name(),
+        problem.name(),
+        o.f,
+        o.x,
+        o.feasible,
+        report.function_calls,
+        o.generations,
+        o.restarts,
+        large,
+        small,
+        o.termination
+    );
 }
 
 /// Runs of the (large, small) regimes in a CMA-ES outcome.
@@ -523,7 +623,7 @@ pub fn regime_counts(o: &crate::optimize::GlobalOutcome) -> (usize, usize) {
 /// One row of the comparison table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ComparisonRow {
-    /// `multistart-<method>`, or the evolutionary method:
+    /// `multistart-<method>`, or the evolutionary method of one schedule:
     /// [`solvers::global_method`] (`cmaes` for IPOP, `cmaes-bipop`).
     pub method: String,
     /// Best objective.
@@ -550,8 +650,10 @@ pub struct ComparisonRow {
     pub p_single_start: Option<f64>,
 }
 
-/// `plyscape compare`: multistart, then CMA-ES on the same budget, then the
-/// comparison table (printed and `comparison.csv`).
+/// `plyscape compare`: multistart, then CMA-ES with each schedule of
+/// `[evolve] restarts` on the same budget (the multistart's function
+/// calls), then the comparison table (printed and `comparison.csv`): one
+/// row for the multistart and one per schedule, in the listed order.
 ///
 /// Not sharded: run the shards with `plyscape multistart --shard`, merge
 /// them, then `plyscape compare --resume` finds every run done and adds the
@@ -569,11 +671,12 @@ pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
     let problem = problem(ctx.study)?;
     let plan = multistart_plan(ctx.study, problem.as_ref())?;
     // Check [evolve] before the (possibly long) multistart.
-    let (_, restarts) = evolve_plan(ctx.study)?;
+    evolve_plan(ctx.study)?;
     let ms = multistart_with(ctx, problem.as_ref(), &plan)?;
     let budget = ms.function_calls + plan.starts.filter_evaluations;
-    let ev = run_evolve(ctx, Some(budget))?;
+    let evs = run_evolve(ctx, Some(budget))?;
     let dir = ctx.dir()?;
+    let tolerance = plan.tolerances.feasibility;
     let mut rows = Vec::new();
     if let Some(best) = ms.optima.first() {
         rows.push(ComparisonRow {
@@ -582,7 +685,7 @@ pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
             best_x: best.x.clone(),
             max_g: best.g.iter().copied().reduce(f64::max),
             feasible: best.feasible,
-            feasibility_tolerance: plan.tolerances.feasibility,
+            feasibility_tolerance: tolerance,
             function_calls: budget,
             gradient_calls: ms.gradient_calls,
             wall_seconds: ms.wall_seconds,
@@ -590,27 +693,33 @@ pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
             p_single_start: ms.p_best(),
         });
     }
+    rows.extend(evs.iter().map(|ev| evolution_row(ev, tolerance)));
+    let table = comparison_table(problem.as_ref(), &rows);
+    tables::write_atomic(&dir.join("comparison.csv"), &table)?;
+    convergence_plot(problem.as_ref(), &dir, Some(&ms), &evs)?;
+    if !ctx.quiet {
+        print_table(&table);
+    }
+    Ok(rows)
+}
+
+/// The comparison row of one evolutionary search; feasible when every
+/// constraint at its best design is `<= tolerance` (the multistart's).
+fn evolution_row(ev: &evolve::Report, tolerance: f64) -> ComparisonRow {
     let o = &ev.outcome;
-    rows.push(ComparisonRow {
-        method: solvers::global_method(restarts).into(),
+    ComparisonRow {
+        method: solvers::global_method(ev.restarts).into(),
         best_f: o.f,
         best_x: o.x.clone(),
         max_g: o.g.iter().copied().reduce(f64::max),
-        feasible: o.g.iter().all(|&g| g <= plan.tolerances.feasibility),
-        feasibility_tolerance: plan.tolerances.feasibility,
+        feasible: o.g.iter().all(|&g| g <= tolerance),
+        feasibility_tolerance: tolerance,
         function_calls: ev.function_calls,
         gradient_calls: ev.gradient_calls,
         wall_seconds: ev.wall_seconds,
         distinct_optima: None,
         p_single_start: None,
-    });
-    let table = comparison_table(problem.as_ref(), &rows);
-    tables::write_atomic(&dir.join("comparison.csv"), &table)?;
-    convergence_plot(problem.as_ref(), &dir, Some(&ms), Some(&ev))?;
-    if !ctx.quiet {
-        print_table(&table);
     }
-    Ok(rows)
 }
 
 /// `comparison.csv`: header and rows.
@@ -662,12 +771,12 @@ fn print_table(rows: &[Vec<String>]) {
 }
 
 /// `convergence.svg`: multistart best-so-far over cumulative function calls
-/// (runs in start order) and the evolution's best-so-far per generation.
+/// (runs in start order) and each evolution's best-so-far per generation.
 fn convergence_plot(
     problem: &dyn Problem,
     dir: &Path,
     ms: Option<&multistart::Report>,
-    ev: Option<&evolve::Report>,
+    evs: &[evolve::Report],
 ) -> Result<()> {
     let mut curves = Vec::new();
     if let Some(ms) = ms {
@@ -687,13 +796,15 @@ fn convergence_plot(
             points: pts,
         });
     }
-    if let Some(ev) = ev {
-        let label = match ev.restarts {
-            Restarts::Ipop => "CMA-ES (best so far)",
-            Restarts::Bipop => "BIPOP-CMA-ES (best so far)",
+    for ev in evs {
+        // One schedule keeps the labels it always had (IPOP as plain
+        // CMA-ES); several are named in full.
+        let name = match ev.restarts {
+            Restarts::Ipop if evs.len() == 1 => "CMA-ES",
+            r => r.solver_name(),
         };
         curves.push(crate::report::Curve {
-            label: label.into(),
+            label: format!("{name} (best so far)"),
             points: ev
                 .generations
                 .iter()
@@ -702,7 +813,7 @@ fn convergence_plot(
                 .collect(),
         });
     }
-    // Log–log: the gap of each best-so-far to the lowest f either method
+    // Log–log: the gap of each best-so-far to the lowest f any method
     // found, with a floor so that the final point of the winner shows.
     let lowest = curves
         .iter()
@@ -734,7 +845,7 @@ fn convergence_plot(
 }
 
 /// `plyscape map`: the grid(s), marked with the optima in `optima.csv` and
-/// the evolution's best in `evolution.csv` when those exist in the study's
+/// each evolution's best in `evolution.csv` when those exist in the study's
 /// output directory.
 pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
     let problem = problem(ctx.study)?;
@@ -758,7 +869,10 @@ pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
         None => (0..n / 2).map(|k| (2 * k, 2 * k + 1)).collect(),
     };
     let dir = ctx.dir()?;
-    let optima = read_points(&dir.join("optima.csv"), "x_", vars)?;
+    let optima: Vec<Vec<f64>> = read_points(&dir.join("optima.csv"), "x_", vars)?
+        .into_iter()
+        .map(|(_, x)| x)
+        .collect();
     let evo = read_points(&dir.join("evolution.csv"), "best_x_", vars)?;
     let base = optima
         .first()
@@ -768,9 +882,7 @@ pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
     if !optima.is_empty() {
         marks.push(("local optima".to_string(), optima));
     }
-    if let Some(best) = evo.last() {
-        marks.push(("CMA-ES best".to_string(), vec![best.clone()]));
-    }
+    marks.extend(evolution_marks(evo));
     let req = map::MapRequest {
         resolution: sec.resolution,
         pairs,
@@ -829,12 +941,37 @@ pub fn check(study: &Study, key: &str) -> Result<()> {
     }
 }
 
-/// Designs from the `<prefix><name>` columns of a CSV, if the file exists.
+/// The marks of the evolutions' bests: the last row (best so far) of each
+/// method of `evolution.csv` rows from [`read_points`], labelled
+/// `CMA-ES best` for a table of one schedule and `<solver> best`
+/// (`IPOP-CMA-ES best`, `BIPOP-CMA-ES best`) for each schedule of a table
+/// with a `method` column.
+fn evolution_marks(rows: Vec<(String, Vec<f64>)>) -> Vec<(String, Vec<Vec<f64>>)> {
+    let mut out: Vec<(String, Vec<Vec<f64>>)> = Vec::new();
+    for (method, x) in rows {
+        let label = if method.is_empty() {
+            "CMA-ES best".to_string()
+        } else {
+            match solvers::global_schedule(&method) {
+                Some(r) => format!("{} best", r.solver_name()),
+                None => format!("{method} best"),
+            }
+        };
+        match out.iter_mut().find(|(l, _)| *l == label) {
+            Some(mark) => mark.1 = vec![x],
+            None => out.push((label, vec![x])),
+        }
+    }
+    out
+}
+
+/// Designs from the `<prefix><name>` columns of a CSV, if the file exists,
+/// each with its `method` field (empty when there is no such column).
 fn read_points(
     path: &Path,
     prefix: &str,
     vars: &[crate::optimize::Variable],
-) -> Result<Vec<Vec<f64>>> {
+) -> Result<Vec<(String, Vec<f64>)>> {
     if !path.exists() {
         return Ok(vec![]);
     }
@@ -849,12 +986,14 @@ fn read_points(
         })
         .collect();
     let Some(cols) = cols else { return Ok(vec![]) };
+    let method = headers.iter().position(|h| h == "method");
     let mut out = Vec::new();
     for r in rd.records() {
         let r = r.map_err(|e| Error::csv(path, e))?;
         let x: Option<Vec<f64>> = cols.iter().map(|&c| r.get(c)?.parse().ok()).collect();
+        let tag = method.and_then(|c| r.get(c)).unwrap_or_default();
         if let Some(x) = x {
-            out.push(x);
+            out.push((tag.to_string(), x));
         }
     }
     Ok(out)

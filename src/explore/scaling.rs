@@ -47,17 +47,6 @@ pub struct ScalingRow {
     pub load_average: Option<f64>,
 }
 
-/// The machine's 1-minute load average (Linux `/proc/loadavg`), if
-/// readable.
-pub fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
-
 /// Run `[scaling]`: the study's multistart once per thread count, each in
 /// `out/<study>/threads-<t>/`, and `scaling.csv` in `out/<study>/`.
 pub fn run_scaling(ctx: &Context) -> Result<Vec<ScalingRow>> {
@@ -90,7 +79,7 @@ pub fn run_scaling(ctx: &Context) -> Result<Vec<ScalingRow>> {
             function_calls: r.function_calls,
             wall_seconds: r.wall_seconds,
             run_seconds: r.runs.iter().map(|x| x.wall_seconds).sum(),
-            load_average: load_average(),
+            load_average: crate::report::clock::load_average(),
         });
     }
     let w1 = rows.iter().find(|r| r.threads == 1).map(|r| r.wall_seconds);

@@ -12,7 +12,7 @@
 //!   iterations. `P` wraps periodic variables and clamps the others.
 //!
 //! The evolutionary solver is `optimize::cmaes`, with IPOP (default) or
-//! BIPOP restarts (`[evolve] restarts`).
+//! BIPOP restarts, or both one after another (`[evolve] restarts`).
 
 use super::evolve::{GlobalSolver, Request};
 use super::multistart::LocalSolver;
@@ -128,6 +128,14 @@ pub fn global_method(restarts: Restarts) -> &'static str {
         Restarts::Ipop => "cmaes",
         Restarts::Bipop => "cmaes-bipop",
     }
+}
+
+/// The restart schedule of an evolutionary method name of
+/// [`global_method`] (`None`: not such a name).
+pub fn global_schedule(method: &str) -> Option<Restarts> {
+    [Restarts::Ipop, Restarts::Bipop]
+        .into_iter()
+        .find(|&r| global_method(r) == method)
 }
 
 /// The record of a steepest-descent design (no constraints, no active

@@ -1,11 +1,13 @@
 //! Forward sensitivities in the fused form, for explicit methods: the
 //! sensitivities ride in the state, `z = [y; s_1; ..; s_np]`, and
-//! `ż = [f; J s_1 + ∂f/∂p_1; ..]`, where each lane's `J s_i + ∂f/∂p_i` is
-//! one directional derivative with the state seeded by `s_i` and the
-//! parameter `p_i` seeded by 1 at once ([`OdeModel::rhs_dir`]): one
-//! dual-number evaluation per lane and stage, where the staggered form
+//! `ż = [f; J s_1 + ∂f/∂p_1; ..]`, where lane `i` is the directional
+//! derivative with the state seeded by `s_i` and parameter `p_i` seeded
+//! by one. The model gives `f` and every lane at once
+//! ([`OdeModel::rhs_lanes`]; the multibody system from one multi-lane
+//! dual-number evaluation per stage), where the staggered form
 //! ([`super::integrate_sens`] through diffsol's sensitivity equations)
-//! makes two (`J s_i` and `∂f/∂p_i` separately). As in the staggered
+//! makes two single-lane evaluations per lane and stage (`J s_i` and
+//! `∂f/∂p_i` separately) besides `f`. As in the staggered
 //! form, only the states are error-controlled (the lanes weigh nothing in
 //! the norm and the states' tolerances are rescaled so that the norm is
 //! the plain one): the steps are those of an integration without
@@ -36,9 +38,8 @@ pub(super) fn integrate_fused<M: OdeModel>(
     let work = RefCell::new(model.work(n));
     model.freeze(&ev.borrow(), &mut work.borrow_mut());
     let (rhs_calls, jvps) = (Cell::new(0u64), Cell::new(0u64));
-    // Start of the current leg: state and lanes; unit parameter seeds.
+    // Start of the current leg: state and lanes.
     let start_z = RefCell::new([y0, &vec![0.0; n * np]].concat());
-    let unit = RefCell::new(vec![0.0; np]);
     // Error control of the states alone, as in the staggered form: the
     // lanes get an absolute tolerance so large that they weigh nothing,
     // and the states' tolerances are divided by √(1 + np), so that the
@@ -57,14 +58,8 @@ pub(super) fn integrate_fused<M: OdeModel>(
             let (y, lanes) = z.split_at(n);
             let (dy, dlanes) = dz.split_at_mut(n);
             rhs_calls.set(rhs_calls.get() + 1);
-            model.rhs(&mut w, t, y, (params, p0), dy);
-            let mut e = unit.borrow_mut();
-            for (i, (s, ds)) in lanes.chunks(n).zip(dlanes.chunks_mut(n)).enumerate() {
-                jvps.set(jvps.get() + 1);
-                e[i] = 1.0;
-                model.rhs_dir(&mut w, t, y, (params, p0), (Some(s), Some(&e)), ds);
-                e[i] = 0.0;
-            }
+            let duals = model.rhs_lanes(&mut w, t, y, (params, p0), lanes, dy, dlanes);
+            jvps.set(jvps.get() + duals as u64);
         })
         .init(
             |_p: &[f64], _t: f64, z: &mut [f64]| z.copy_from_slice(&start_z.borrow()),

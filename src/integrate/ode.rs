@@ -40,6 +40,34 @@ pub trait OdeModel {
         seeds: (Option<&[f64]>, Option<&[f64]>),
         out: &mut [f64],
     );
+    /// The fused sensitivity right-hand side at one point: `dy = f(t, y)`
+    /// and, for each lane `i`, `dlanes_i = J s_i + ∂f/∂p_i`, with the state
+    /// seed `s_i = lanes[i·n..(i+1)·n]` and the unit seed on parameter `i`
+    /// of `params.0` (lane-major like `lanes`). Returns the number of
+    /// dual-number evaluations made. The default makes one
+    /// [`OdeModel::rhs`] and one [`OdeModel::rhs_dir`] per lane; a model
+    /// may give them all from one multi-lane evaluation.
+    #[allow(clippy::too_many_arguments)]
+    fn rhs_lanes(
+        &self,
+        w: &mut Self::Work,
+        t: f64,
+        y: &[f64],
+        params: (&[Self::Param], &[f64]),
+        lanes: &[f64],
+        dy: &mut [f64],
+        dlanes: &mut [f64],
+    ) -> usize {
+        let n = y.len();
+        self.rhs(w, t, y, params, dy);
+        let mut e = vec![0.0; params.0.len()];
+        for (i, (s, ds)) in lanes.chunks(n).zip(dlanes.chunks_mut(n)).enumerate() {
+            e[i] = 1.0;
+            self.rhs_dir(w, t, y, params, (Some(s), Some(&e)), ds);
+            e[i] = 0.0;
+        }
+        params.0.len()
+    }
     /// The event state at `y0` (every piece frozen where `y0` is); with
     /// `enabled = false`, no root function is active.
     fn events(&self, enabled: bool, y0: &[f64]) -> Self::Events;

@@ -403,7 +403,7 @@ impl<T: Scalar> Workspace<T> {
             mjac: Vec::new(),
             mfac: Vec::new(),
             inv: Vec::new(),
-            inv_seeded: Vec::new(),
+            inv_seeds: Vec::new(),
             kinetic: Vec::new(),
             inv_order: Vec::new(),
             spd: Default::default(),

@@ -463,17 +463,16 @@ impl System {
         ws.rows = rows;
     }
 
-    /// The invariants of flexible slot `s` in `T` (cached when no design
-    /// seed is active).
+    /// The invariants of flexible slot `s` in `T`, lifted again only when
+    /// the design seeds differ from those of the cached copy.
     fn invariants<T: Scalar>(&self, s: usize, ws: &mut Workspace<T>) {
         let flex = self.model.bodies[self.moving[s]].flex.as_ref();
         let Some(flex) = flex else { return };
         ws.inv.resize_with(self.nb(), || None);
-        ws.inv_seeded.resize(self.nb(), false);
-        let seeded = !ws.kin[s].design.is_empty();
-        if seeded || ws.inv_seeded[s] || ws.inv[s].is_none() {
+        ws.inv_seeds.resize_with(self.nb(), Vec::new);
+        if ws.inv[s].is_none() || ws.inv_seeds[s] != ws.kin[s].design {
             ws.inv[s] = Some(InvT::lift(flex, &ws.kin[s].design));
-            ws.inv_seeded[s] = seeded;
+            ws.inv_seeds[s].clone_from(&ws.kin[s].design);
         }
     }
 

@@ -99,117 +99,290 @@ impl Scalar for f64 {
     }
 }
 
-impl Scalar for num_dual::Dual64 {
+/// A dual number with `L` derivative lanes, as the solves of [`Scalar`]
+/// see it: a real part and `L` dual parts, read and written by lane.
+/// `num_dual::Dual64` has one lane; `num_dual::DualSVec64<N>` has `N`
+/// (one multi-lane evaluation gives a value and `N` directional
+/// derivatives at once).
+pub trait Lanes: Copy {
+    /// Number of dual parts.
+    const L: usize;
+    /// The real part.
+    fn re(&self) -> f64;
+    /// Dual part `k` (0 when the number carries none).
+    fn lane(&self, k: usize) -> f64;
+    /// The number with real part `re` and dual parts `lanes` (length `L`).
+    fn with(re: f64, lanes: &[f64]) -> Self;
+    /// Replace the real part (the dual parts are kept).
+    fn set_re(&mut self, re: f64);
+    /// Scale every dual part by `c`.
+    fn scale_lanes(&mut self, c: f64);
+    /// Whether every component is exactly zero.
+    fn all_zero(&self) -> bool {
+        self.re() == 0.0 && (0..Self::L).all(|k| self.lane(k) == 0.0)
+    }
+}
+
+impl Lanes for num_dual::Dual64 {
+    const L: usize = 1;
     #[inline]
-    fn is_exact_zero(&self) -> bool {
-        self.re == 0.0 && self.eps == 0.0
+    fn re(&self) -> f64 {
+        self.re
     }
-    fn spd_factor(
-        a: &mut [Self],
-        m: usize,
-        scale: &mut Vec<Self>,
-        tols: (f64, f64),
-        sc: &mut SpdScratch,
-    ) -> Factored {
-        sc.re.clear();
-        sc.re.extend(a.iter().map(|v| v.re));
-        let f = ordered_cholesky(&mut sc.re, m, &mut sc.scale, tols, &mut sc.col, &mut sc.nz);
-        for k in 0..m {
-            // The regularised system is (A + reg·diag(A)) x = b.
-            a[k * m + k].eps *= 1.0 + tols.1;
+    #[inline]
+    fn lane(&self, _k: usize) -> f64 {
+        self.eps
+    }
+    #[inline]
+    fn with(re: f64, lanes: &[f64]) -> Self {
+        Self::new(re, lanes[0])
+    }
+    #[inline]
+    fn set_re(&mut self, re: f64) {
+        self.re = re;
+    }
+    #[inline]
+    fn scale_lanes(&mut self, c: f64) {
+        self.eps *= c;
+    }
+}
+
+impl<const N: usize> Lanes for num_dual::DualSVec64<N> {
+    const L: usize = N;
+    #[inline]
+    fn re(&self) -> f64 {
+        self.re
+    }
+    #[inline]
+    fn lane(&self, k: usize) -> f64 {
+        self.eps.0.as_ref().map_or(0.0, |e| e[k])
+    }
+    #[inline]
+    fn with(re: f64, lanes: &[f64]) -> Self {
+        // No dual part when every lane is zero: constants stay cheap.
+        if lanes.iter().all(|v| *v == 0.0) {
+            return Self::from_re(re);
         }
-        // The real factor and scaling stay in the scratch for `spd_solve`;
-        // `a` keeps A' in its dual parts.
-        scale.clear();
-        f
+        let e = nalgebra::SVector::<f64, N>::from_column_slice(lanes);
+        Self::new(re, num_dual::Derivative::some(e))
     }
-    fn spd_solve(
-        a: &[Self],
-        m: usize,
-        _scale: &[Self],
-        f: Factored,
-        b: &mut [Self],
-        sc: &mut SpdScratch,
-    ) {
-        // `sc.re` and `sc.scale` hold the real factor of the preceding
-        // `spd_factor` of `a`.
-        debug_assert_eq!(sc.re.len(), a.len());
-        sc.x.clear();
-        sc.x.extend(b.iter().map(|v| v.re));
-        cholesky_solve(&sc.re, m, &sc.scale, f.accepted, &mut sc.x, &mut sc.tmp);
-        // r = b' − A' x (A' symmetric, lower triangle stored).
-        sc.r.clear();
-        sc.r.extend(b.iter().map(|v| v.eps));
-        for i in 0..m {
-            for j in 0..=i {
-                let e = a[i * m + j].eps;
-                if e != 0.0 {
-                    sc.r[i] -= e * sc.x[j];
+    #[inline]
+    fn set_re(&mut self, re: f64) {
+        self.re = re;
+    }
+    #[inline]
+    fn scale_lanes(&mut self, c: f64) {
+        if let Some(e) = self.eps.0.as_mut() {
+            *e *= c;
+        }
+    }
+}
+
+/// [`Scalar::spd_factor`] for dual numbers: the real factor and scaling go
+/// to the scratch; the dual parts of `a` keep `A' + reg·diag(A')`.
+fn lanes_spd_factor<D: Lanes>(
+    a: &mut [D],
+    m: usize,
+    tols: (f64, f64),
+    sc: &mut SpdScratch,
+) -> Factored {
+    sc.re.clear();
+    sc.re.extend(a.iter().map(|v| v.re()));
+    let f = ordered_cholesky(&mut sc.re, m, &mut sc.scale, tols, &mut sc.col, &mut sc.nz);
+    for k in 0..m {
+        // The regularised system is (A + reg·diag(A)) x = b.
+        a[k * m + k].scale_lanes(1.0 + tols.1);
+    }
+    f
+}
+
+/// [`Scalar::spd_solve`] for dual numbers: `x = A⁻¹b` on the real parts,
+/// then per lane `x'_l = A⁻¹(b'_l − A'_l x)` with the same real factor
+/// (`a` symmetric, lower triangle stored). `sc.r` holds the lanes
+/// lane-major.
+fn lanes_spd_solve<D: Lanes>(a: &[D], m: usize, f: Factored, b: &mut [D], sc: &mut SpdScratch) {
+    debug_assert_eq!(sc.re.len(), a.len());
+    let nl = D::L;
+    sc.x.clear();
+    sc.x.extend(b.iter().map(|v| v.re()));
+    cholesky_solve(&sc.re, m, &sc.scale, f.accepted, &mut sc.x, &mut sc.tmp);
+    sc.r.clear();
+    sc.r.resize(m * nl, 0.0);
+    for (i, v) in b.iter().enumerate() {
+        for l in 0..nl {
+            sc.r[l * m + i] = v.lane(l);
+        }
+    }
+    for i in 0..m {
+        for j in 0..=i {
+            let e = &a[i * m + j];
+            for l in 0..nl {
+                let el = e.lane(l);
+                if el != 0.0 {
+                    sc.r[l * m + i] -= el * sc.x[j];
                     if i != j {
-                        sc.r[j] -= e * sc.x[i];
+                        sc.r[l * m + j] -= el * sc.x[i];
                     }
                 }
             }
         }
-        cholesky_solve(&sc.re, m, &sc.scale, f.accepted, &mut sc.r, &mut sc.tmp);
-        for (v, (x, r)) in b.iter_mut().zip(sc.x.iter().zip(&sc.r)) {
-            *v = Self::new(*x, *r);
+    }
+    for l in 0..nl {
+        let r = &mut sc.r[l * m..(l + 1) * m];
+        cholesky_solve(&sc.re, m, &sc.scale, f.accepted, r, &mut sc.tmp);
+    }
+    let mut lanes = [0.0f64; 8];
+    let mut lv = Vec::new();
+    let buf: &mut [f64] = if nl <= 8 {
+        &mut lanes[..nl]
+    } else {
+        lv.resize(nl, 0.0);
+        &mut lv
+    };
+    for (i, v) in b.iter_mut().enumerate() {
+        for (l, u) in buf.iter_mut().enumerate() {
+            *u = sc.r[l * m + i];
+        }
+        *v = D::with(sc.x[i], buf);
+    }
+}
+
+/// [`Scalar::dense_factor`] for dual numbers: the real parts become the
+/// explicit inverse `A⁻¹` (both triangles, from the Cholesky factor of
+/// the real matrix: `n` solves, about `n³` flops, once per evaluation),
+/// the dual parts keep `A'`. Every later solve is then matrix–vector
+/// products with independent sums instead of triangular solves, whose
+/// sequential divisions dominate at the flexible bodies' `n` ≈ 20 (one
+/// solve per constraint row touching the body and lane).
+fn lanes_dense_factor<D: Lanes>(a: &mut [D], n: usize) -> bool {
+    let mut l: Vec<f64> = a.iter().map(|v| v.re()).collect();
+    let ok = dense_cholesky(&mut l, n);
+    // X = L⁻¹ row by row (row k = (e_k − Σ_{j<k} L_kj X_j) / L_kk, lower
+    // triangular), each row update a vector operation over the columns.
+    let mut x = vec![0.0; n * n];
+    for k in 0..n {
+        let (done, rest) = x.split_at_mut(k * n);
+        let row = &mut rest[..n];
+        row[k] = 1.0;
+        for j in 0..k {
+            let c = l[k * n + j];
+            if c != 0.0 {
+                for (r, v) in row[..=j].iter_mut().zip(&done[j * n..j * n + j + 1]) {
+                    *r -= c * v;
+                }
+            }
+        }
+        let inv = 1.0 / l[k * n + k];
+        for r in row[..=k].iter_mut() {
+            *r *= inv;
         }
     }
-    fn dense_factor(a: &mut [Self], n: usize) -> bool {
-        let mut re: Vec<f64> = a.iter().map(|v| v.re).collect();
-        let ok = dense_cholesky(&mut re, n);
-        for (v, r) in a.iter_mut().zip(&re) {
-            v.re = *r;
+    // A⁻¹ = Xᵀ X: (A⁻¹)_ij = Σ_{k ≥ max(i, j)} X_ki X_kj.
+    let mut inv = vec![0.0; n * n];
+    for k in 0..n {
+        let xk = &x[k * n..k * n + k + 1];
+        for (i, xi) in xk.iter().enumerate() {
+            let out = &mut inv[i * n..i * n + k + 1];
+            for (o, xj) in out.iter_mut().zip(xk) {
+                *o += xi * xj;
+            }
         }
-        ok
     }
-    fn dense_solve(a: &[Self], n: usize, x: &mut [Self]) {
-        // L Lᵀ x = b on the real parts of `a` (no copies; stack buffers
-        // for the flexible bodies' 6 + modes ≤ 64 unknowns).
-        let solve = |b: &mut [f64]| {
-            for k in 0..n {
-                let mut s = b[k];
-                for j in 0..k {
-                    s -= a[k * n + j].re * b[j];
-                }
-                b[k] = s / a[k * n + k].re;
-            }
-            for k in (0..n).rev() {
-                let mut s = b[k];
-                for r in k + 1..n {
-                    s -= a[r * n + k].re * b[r];
-                }
-                b[k] = s / a[k * n + k].re;
-            }
-        };
-        let (mut xs, mut rs) = ([0.0f64; 64], [0.0f64; 64]);
-        let (mut xv, mut rv) = (Vec::new(), Vec::new());
-        let (xr, r): (&mut [f64], &mut [f64]) = if n <= 64 {
-            (&mut xs[..n], &mut rs[..n])
-        } else {
-            xv.resize(n, 0.0);
-            rv.resize(n, 0.0);
-            (&mut xv[..], &mut rv[..])
-        };
-        for k in 0..n {
-            xr[k] = x[k].re;
+    for (v, m) in a.iter_mut().zip(&inv) {
+        v.set_re(*m);
+    }
+    ok
+}
+
+/// [`Scalar::dense_solve`] for dual numbers with the inverse of
+/// [`lanes_dense_factor`]: `x = A⁻¹b` on the real parts, then per lane
+/// `x'_l = A⁻¹(b'_l − A'_l x)`, where `A'_l` is the full matrix in the
+/// dual parts of `a`.
+fn lanes_dense_solve<D: Lanes>(a: &[D], n: usize, x: &mut [D]) {
+    thread_local! {
+        // Per thread: the real solution, the lanes' right-hand sides and
+        // solutions, and one number's lanes.
+        static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+    }
+    let nl = D::L;
+    let inv_times = |v: &[f64], out: &mut [f64]| {
+        for (i, o) in out.iter_mut().enumerate() {
+            let row = &a[i * n..(i + 1) * n];
+            *o = row.iter().zip(v).map(|(e, w)| e.re() * w).sum();
         }
-        solve(xr);
+    };
+    SCRATCH.with_borrow_mut(|buf| {
+        buf.resize(2 * n + 2 * n * nl + nl, 0.0);
+        let (b, rest) = buf.split_at_mut(n);
+        let (xr, rest) = rest.split_at_mut(n);
+        let (r, rest) = rest.split_at_mut(n * nl);
+        let (xl, lanes) = rest.split_at_mut(n * nl);
+        for (bk, v) in b.iter_mut().zip(x.iter()) {
+            *bk = v.re();
+        }
+        inv_times(b, xr);
         for i in 0..n {
             let row = &a[i * n..(i + 1) * n];
-            r[i] = x[i].eps
-                - row
-                    .iter()
-                    .zip(xr.iter())
-                    .map(|(e, v)| e.eps * v)
-                    .sum::<f64>();
+            for q in 0..nl {
+                let ax: f64 = row.iter().zip(xr.iter()).map(|(e, v)| e.lane(q) * v).sum();
+                r[q * n + i] = x[i].lane(q) - ax;
+            }
         }
-        solve(r);
+        for q in 0..nl {
+            inv_times(&r[q * n..(q + 1) * n], &mut xl[q * n..(q + 1) * n]);
+        }
         for k in 0..n {
-            x[k] = Self::new(xr[k], r[k]);
+            for (q, v) in lanes.iter_mut().enumerate() {
+                *v = xl[q * n + k];
+            }
+            x[k] = D::with(xr[k], lanes);
         }
-    }
+    })
+}
+
+/// [`Scalar`] for a dual-number type through its [`Lanes`].
+macro_rules! lanes_scalar {
+    () => {
+        #[inline]
+        fn is_exact_zero(&self) -> bool {
+            self.all_zero()
+        }
+        fn spd_factor(
+            a: &mut [Self],
+            m: usize,
+            scale: &mut Vec<Self>,
+            tols: (f64, f64),
+            sc: &mut SpdScratch,
+        ) -> Factored {
+            // The real factor and scaling stay in the scratch.
+            scale.clear();
+            lanes_spd_factor(a, m, tols, sc)
+        }
+        fn spd_solve(
+            a: &[Self],
+            m: usize,
+            _scale: &[Self],
+            f: Factored,
+            b: &mut [Self],
+            sc: &mut SpdScratch,
+        ) {
+            lanes_spd_solve(a, m, f, b, sc)
+        }
+        fn dense_factor(a: &mut [Self], n: usize) -> bool {
+            lanes_dense_factor(a, n)
+        }
+        fn dense_solve(a: &[Self], n: usize, x: &mut [Self]) {
+            lanes_dense_solve(a, n, x)
+        }
+    };
+}
+
+impl Scalar for num_dual::Dual64 {
+    lanes_scalar!();
+}
+
+impl<const N: usize> Scalar for num_dual::DualSVec64<N> {
+    lanes_scalar!();
 }
 
 /// `f64` constant converted into the scalar type `T`.
@@ -636,6 +809,122 @@ mod tests {
         for i in 0..n {
             let r: f64 = (0..n).map(|j| a0[i * n + j] * x[j]).sum::<f64>() - rhs[i];
             assert!(r.abs() < 1e-12);
+        }
+    }
+
+    /// An SPD matrix `A(ε) = B Bᵀ + I + ε₁ C₁ + ε₂ C₂` (`C_q` symmetric)
+    /// and a right-hand side `b(ε)`, for the dual solves.
+    fn perturbed_system(n: usize, e: [f64; 2]) -> (Vec<f64>, Vec<f64>) {
+        let b: Vec<f64> = (0..n * n)
+            .map(|k| ((k * 7 % 11) as f64 - 5.0) / 3.0)
+            .collect();
+        let c = |q: usize, i: usize, j: usize| (((i + j + q) * 5 % 7) as f64 - 3.0) / 10.0;
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                a[i * n + j] = (0..n).map(|k| b[i * n + k] * b[j * n + k]).sum::<f64>()
+                    + if i == j { 1.0 } else { 0.0 }
+                    + e[0] * c(0, i, j)
+                    + e[1] * c(1, i, j);
+            }
+        }
+        let rhs = (0..n)
+            .map(|k| k as f64 - 1.5 + e[0] * (k as f64).sin() + e[1] * (k as f64).cos())
+            .collect();
+        (a, rhs)
+    }
+
+    #[test]
+    #[allow(clippy::needless_range_loop)] // lanes and rows index the formulas
+    fn multi_lane_dual_solves_match_central_differences() {
+        // Independent check of the lanes x'_q = A⁻¹(b'_q − A'_q x): central
+        // differences of plain f64 solves of A(ε) x = b(ε) in each ε_q.
+        use num_dual::{Dual64, DualSVec64};
+        let n = 6;
+        let solve_f64 = |e: [f64; 2]| {
+            let (mut a, mut x) = perturbed_system(n, e);
+            assert!(dense_cholesky(&mut a, n));
+            dense_cholesky_solve(&a, n, &mut x);
+            x
+        };
+        let h = 1e-5;
+        let fd: Vec<Vec<f64>> = (0..2)
+            .map(|q| {
+                let mut ep = [0.0; 2];
+                ep[q] = h;
+                let xp = solve_f64(ep);
+                ep[q] = -h;
+                let xm = solve_f64(ep);
+                xp.iter()
+                    .zip(&xm)
+                    .map(|(p, m)| (p - m) / (2.0 * h))
+                    .collect()
+            })
+            .collect();
+        let (a0, b0) = perturbed_system(n, [0.0; 2]);
+        let (a1, b1) = perturbed_system(n, [1.0, 0.0]);
+        let (a2, b2) = perturbed_system(n, [0.0, 1.0]);
+        let lanes = |v0: &[f64], v1: &[f64], v2: &[f64], k: usize| [v1[k] - v0[k], v2[k] - v0[k]];
+        let mut a: Vec<DualSVec64<2>> = (0..n * n)
+            .map(|k| DualSVec64::<2>::with(a0[k], &lanes(&a0, &a1, &a2, k)))
+            .collect();
+        let mut x: Vec<DualSVec64<2>> = (0..n)
+            .map(|k| DualSVec64::<2>::with(b0[k], &lanes(&b0, &b1, &b2, k)))
+            .collect();
+        assert!(<DualSVec64<2> as Scalar>::dense_factor(&mut a, n));
+        <DualSVec64<2> as Scalar>::dense_solve(&a, n, &mut x);
+        let plain = solve_f64([0.0; 2]);
+        for k in 0..n {
+            assert!((x[k].re - plain[k]).abs() < 1e-12 * (1.0 + plain[k].abs()));
+            for q in 0..2 {
+                let err = (x[k].lane(q) - fd[q][k]).abs();
+                assert!(
+                    err < 1e-7 * (1.0 + fd[q][k].abs()),
+                    "lane {q} row {k}: {err}"
+                );
+            }
+        }
+        // The one-lane type gives lane 0 alike (same formula).
+        let mut a: Vec<Dual64> = (0..n * n)
+            .map(|k| Dual64::new(a0[k], a1[k] - a0[k]))
+            .collect();
+        let mut x1: Vec<Dual64> = (0..n).map(|k| Dual64::new(b0[k], b1[k] - b0[k])).collect();
+        assert!(<Dual64 as Scalar>::dense_factor(&mut a, n));
+        <Dual64 as Scalar>::dense_solve(&a, n, &mut x1);
+        for k in 0..n {
+            assert!((x1[k].eps - x[k].lane(0)).abs() < 1e-12 * (1.0 + x1[k].eps.abs()));
+        }
+        // The constraint-space solve (lower triangle, regularised) with
+        // the same lanes; the shift makes it A + reg·diag(A).
+        let reg = 1e-12;
+        let mut al: Vec<DualSVec64<2>> = (0..n * n)
+            .map(|k| {
+                let (i, j) = (k / n, k % n);
+                let v = DualSVec64::<2>::with(a0[k], &lanes(&a0, &a1, &a2, k));
+                if j <= i {
+                    v
+                } else {
+                    DualSVec64::<2>::from_re(0.0)
+                }
+            })
+            .collect();
+        let mut xs: Vec<DualSVec64<2>> = (0..n)
+            .map(|k| DualSVec64::<2>::with(b0[k], &lanes(&b0, &b1, &b2, k)))
+            .collect();
+        let mut sc = SpdScratch::default();
+        let mut scale = Vec::new();
+        let f =
+            <DualSVec64<2> as Scalar>::spd_factor(&mut al, n, &mut scale, (1e-14, reg), &mut sc);
+        assert_eq!(f.rank, n);
+        <DualSVec64<2> as Scalar>::spd_solve(&al, n, &scale, f, &mut xs, &mut sc);
+        for k in 0..n {
+            for q in 0..2 {
+                let err = (xs[k].lane(q) - fd[q][k]).abs();
+                assert!(
+                    err < 1e-7 * (1.0 + fd[q][k].abs()),
+                    "spd lane {q} row {k}: {err}"
+                );
+            }
         }
     }
 }

@@ -201,6 +201,23 @@ impl JointKind {
             JointKind::Driven(_) | JointKind::Fixed => 6,
         }
     }
+    /// Names of the constraint equations, in the order
+    /// [`super::rows::joint_rows`] assembles them: `x`, `y`, `z` the
+    /// global components of `x_i − x_j` (coincident points); `xi.zj`,
+    /// `yi.zj`, `xi.yj` the dot products of marker axes (parallel axes,
+    /// no twist); `angle` the prescribed `θ − f(t)`; `xi.d`, `yi.d` the
+    /// offsets `x_i·(x_j − x_i)`, `y_i·(x_j − x_i)` of point j from marker
+    /// i's z line. As many names as [`JointKind::equations`].
+    pub fn row_names(&self) -> &'static [&'static str] {
+        match self {
+            JointKind::Spherical => &["x", "y", "z"],
+            JointKind::Revolute => &["x", "y", "z", "xi.zj", "yi.zj"],
+            JointKind::Driven(_) => &["x", "y", "z", "xi.zj", "yi.zj", "angle"],
+            JointKind::Fixed => &["x", "y", "z", "xi.zj", "yi.zj", "xi.yj"],
+            JointKind::Cylindrical => &["xi.d", "yi.d", "xi.zj", "yi.zj"],
+            JointKind::Prismatic => &["xi.d", "yi.d", "xi.zj", "yi.zj", "xi.yj"],
+        }
+    }
     /// Whether the joint has a relative rotation angle about z.
     pub fn has_angle(&self) -> bool {
         matches!(
@@ -568,6 +585,21 @@ impl Model {
     pub fn equations(&self) -> usize {
         self.joints.iter().map(|j| j.kind.equations()).sum()
     }
+    /// Label of constraint row `r` (rows are assembled joint by joint in
+    /// the order of [`Model::joints`]): `<joint>.<equation>` with the
+    /// equation named by [`JointKind::row_names`], e.g. `S3.z`; `None`
+    /// past the last row.
+    pub fn row_label(&self, r: usize) -> Option<String> {
+        let mut first = 0;
+        for j in &self.joints {
+            let names = j.kind.row_names();
+            if r < first + names.len() {
+                return Some(format!("{}.{}", j.name, names[r - first]));
+            }
+            first += names.len();
+        }
+        None
+    }
 }
 
 /// An orthonormal frame whose z axis is the unit `axis` (x chosen
@@ -603,5 +635,41 @@ mod tests {
         assert!((f - 2.75).abs() < 1e-15);
         assert!((df - 5.0).abs() < 1e-15);
         assert!((ddf - 6.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn row_names_match_the_equation_counts_and_label_rows_in_joint_order() {
+        let kinds = [
+            JointKind::Spherical,
+            JointKind::Revolute,
+            JointKind::Driven(Drive {
+                coefficients: vec![0.0],
+            }),
+            JointKind::Fixed,
+            JointKind::Cylindrical,
+            JointKind::Prismatic,
+        ];
+        for k in &kinds {
+            assert_eq!(k.row_names().len(), k.equations(), "{k:?}");
+        }
+        let joint = |name: &str, kind: JointKind| Joint {
+            name: name.into(),
+            kind,
+            i: 0,
+            j: 0,
+        };
+        let model = Model {
+            joints: vec![
+                joint("R", JointKind::Revolute),
+                joint("S", JointKind::Spherical),
+            ],
+            ..Model::default()
+        };
+        let labels: Vec<Option<String>> = (0..9).map(|r| model.row_label(r)).collect();
+        assert_eq!(labels[0].as_deref(), Some("R.x"));
+        assert_eq!(labels[4].as_deref(), Some("R.yi.zj"));
+        assert_eq!(labels[5].as_deref(), Some("S.x"));
+        assert_eq!(labels[7].as_deref(), Some("S.z"));
+        assert_eq!(labels[8], None);
     }
 }

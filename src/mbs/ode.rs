@@ -2,22 +2,99 @@
 //! right-hand sides in `f64` and exact directional derivatives from one
 //! dual-number evaluation of the same generic right-hand side, with the
 //! Eq. 32 segment switching of [`super::segments`] as the model's events.
+//!
+//! Fused sensitivities ([`OdeModel::rhs_lanes`]) take one multi-lane
+//! evaluation per stage: with `np` lanes the state is `y + Σ_i ε_i s_i`
+//! and parameter `i` is `p_i + ε_i`, on `num_dual::DualSVec64<N>` numbers
+//! (`N` = 1, 2 or 4; more lanes go in chunks of 4). The real part of the
+//! result is `f` itself and dual part `i` is `J s_i + ∂f/∂p_i`, so no
+//! separate `f64` evaluation is made; the real parts are computed by the
+//! same operations as the `f64` right-hand side.
 
 use super::dynamics::System;
+use super::linalg::{Lanes, Scalar};
 use super::model::Param;
 use super::segments::{Crossing, Events};
 use super::workspace::{BodyKin, Workspace};
 use crate::integrate::OdeModel;
-use num_dual::Dual64;
+use num_dual::{Dual64, DualSVec64};
 
-/// Scratch of one integration: workspaces for `f64` and dual evaluations,
-/// dual state buffers and body kinematics for the root functions.
+/// Scratch of dual-number evaluations with `D`: workspace and state
+/// buffers.
+pub struct LaneWork<D: Scalar> {
+    ws: Workspace<D>,
+    y: Vec<D>,
+    dy: Vec<D>,
+}
+
+impl<D: Scalar + Lanes> LaneWork<D> {
+    fn new(n: usize) -> LaneWork<D> {
+        LaneWork {
+            ws: Workspace::empty(),
+            y: vec![D::with(0.0, &[0.0; 8][..D::L.min(8)]); n],
+            dy: vec![D::with(0.0, &[0.0; 8][..D::L.min(8)]); n],
+        }
+    }
+}
+
+/// Scratch of one integration: workspaces for `f64` and dual evaluations
+/// (one lane, and 2 or 4 lanes for fused sensitivities), and body
+/// kinematics for the root functions.
 pub struct SystemWork {
     ws: Workspace<f64>,
-    wsd: Workspace<Dual64>,
-    yd: Vec<Dual64>,
-    dyd: Vec<Dual64>,
+    d1: LaneWork<Dual64>,
+    d2: LaneWork<DualSVec64<2>>,
+    d4: LaneWork<DualSVec64<4>>,
     kin: Vec<BodyKin<f64>>,
+}
+
+impl System {
+    /// One evaluation on `D` numbers of the lanes `first..first + k`
+    /// (`k ≤ D::L`, `k = lanes.len() / n`; padding lanes are zero): the
+    /// value into `dy` (when asked) and dual part `l` into lane `first + l`
+    /// of `dlanes`.
+    #[allow(clippy::too_many_arguments)]
+    fn eval_lanes<D: Scalar + Lanes>(
+        &self,
+        lw: &mut LaneWork<D>,
+        t: f64,
+        y: &[f64],
+        (names, p): (&[Param], &[f64]),
+        (first, lanes): (usize, &[f64]),
+        dy: Option<&mut [f64]>,
+        dlanes: &mut [f64],
+    ) {
+        let n = y.len();
+        let k = lanes.len() / n;
+        let mut buf = [0.0f64; 8];
+        let buf = &mut buf[..D::L];
+        lw.ws.params.clear();
+        for (j, par) in names.iter().enumerate() {
+            buf.fill(0.0);
+            if (first..first + k).contains(&j) {
+                buf[j - first] = 1.0;
+            }
+            lw.ws.params.push((*par, D::with(p[j], buf)));
+        }
+        for (c, yc) in y.iter().enumerate() {
+            for (l, b) in buf.iter_mut().enumerate() {
+                *b = if l < k { lanes[l * n + c] } else { 0.0 };
+            }
+            lw.y[c] = D::with(*yc, buf);
+        }
+        self.rhs(t, &lw.y, &mut lw.dy, &mut lw.ws);
+        if let Some(dy) = dy {
+            for (o, d) in dy.iter_mut().zip(&lw.dy) {
+                *o = d.re();
+            }
+        }
+        for l in 0..k {
+            let out = &mut dlanes[(first + l) * n..(first + l + 1) * n];
+            for (o, d) in out.iter_mut().zip(&lw.dy) {
+                *o = d.lane(l);
+            }
+        }
+    }
 }
 
 impl OdeModel for System {
@@ -29,9 +106,9 @@ impl OdeModel for System {
     fn work(&self, n: usize) -> SystemWork {
         SystemWork {
             ws: Workspace::empty(),
-            wsd: Workspace::empty(),
-            yd: vec![Dual64::from(0.0); n],
-            dyd: vec![Dual64::from(0.0); n],
+            d1: LaneWork::new(n),
+            d2: LaneWork::new(n),
+            d4: LaneWork::new(n),
             kin: Vec::new(),
         }
     }
@@ -65,18 +142,54 @@ impl OdeModel for System {
         out: &mut [f64],
     ) {
         let ((names, p), (vy, vp)) = (params, seeds);
-        w.wsd.params.clear();
+        let d = &mut w.d1;
+        d.ws.params.clear();
         for (k, par) in names.iter().enumerate() {
-            w.wsd
-                .params
+            d.ws.params
                 .push((*par, Dual64::new(p[k], vp.map_or(0.0, |v| v[k]))));
         }
         for k in 0..y.len() {
-            w.yd[k] = Dual64::new(y[k], vy.map_or(0.0, |v| v[k]));
+            d.y[k] = Dual64::new(y[k], vy.map_or(0.0, |v| v[k]));
         }
-        self.rhs(t, &w.yd, &mut w.dyd, &mut w.wsd);
-        for (o, d) in out.iter_mut().zip(&w.dyd) {
+        self.rhs(t, &d.y, &mut d.dy, &mut d.ws);
+        for (o, d) in out.iter_mut().zip(&d.dy) {
             *o = d.eps;
+        }
+    }
+
+    fn rhs_lanes(
+        &self,
+        w: &mut SystemWork,
+        t: f64,
+        y: &[f64],
+        params: (&[Param], &[f64]),
+        lanes: &[f64],
+        dy: &mut [f64],
+        dlanes: &mut [f64],
+    ) -> usize {
+        let n = y.len();
+        let np = lanes.len() / n.max(1);
+        match np {
+            0 => {
+                OdeModel::rhs(self, w, t, y, params, dy);
+                0
+            }
+            1 => {
+                self.eval_lanes(&mut w.d1, t, y, params, (0, lanes), Some(dy), dlanes);
+                1
+            }
+            2 => {
+                self.eval_lanes(&mut w.d2, t, y, params, (0, lanes), Some(dy), dlanes);
+                1
+            }
+            _ => {
+                let mut dy = Some(dy);
+                for (c, chunk) in lanes.chunks(4 * n).enumerate() {
+                    let lanes = (4 * c, chunk);
+                    self.eval_lanes(&mut w.d4, t, y, params, lanes, dy.take(), dlanes);
+                }
+                np.div_ceil(4)
+            }
         }
     }
 
@@ -89,7 +202,9 @@ impl OdeModel for System {
     fn freeze(&self, ev: &Events, w: &mut SystemWork) {
         let segs = ev.segments();
         w.ws.segments = segs.clone();
-        w.wsd.segments = segs;
+        w.d1.ws.segments = segs.clone();
+        w.d2.ws.segments = segs.clone();
+        w.d4.ws.segments = segs;
     }
 
     fn nroots(&self, ev: &Events) -> usize {

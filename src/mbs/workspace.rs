@@ -71,12 +71,13 @@ pub struct Workspace<T: Scalar> {
     /// Per moving body: the Cholesky factor of a flexible body's mass
     /// matrix (empty for rigid bodies).
     pub(crate) mfac: Vec<Vec<T>>,
-    /// Per moving body: its invariants in `T` (flexible bodies), rebuilt
-    /// when design seeds are active.
+    /// Per moving body: its invariants in `T` (flexible bodies), lifted
+    /// with the design seeds in `inv_seeds`.
     pub(crate) inv: Vec<Option<InvT<T>>>,
-    /// Whether `inv[s]` carries design seeds (then it is rebuilt at the
-    /// next evaluation).
-    pub(crate) inv_seeded: Vec<bool>,
+    /// The design seeds `inv[s]` was lifted with; the invariants are
+    /// lifted again only when an evaluation's seeds differ (fused
+    /// sensitivities seed the same unit lanes at every stage).
+    pub(crate) inv_seeds: Vec<Vec<(usize, T)>>,
     /// Per moving body: the kinetic energy `½ vᵀMv` of a flexible body,
     /// from its mass matrix before the factorization (zero for rigid
     /// bodies, whose energy [`super::energy`] computes directly).

@@ -1,5 +1,6 @@
 //! Wall-clock time as text: UTC timestamps for manifests and for the names
-//! of kept tables. No time-zone database is needed: the civil date follows
+//! of kept tables; and what the machine says about the time a benchmark
+//! gets (the load average, a thread's own CPU time). No time-zone database is needed: the civil date follows
 //! from the days since 1970-01-01 by the proleptic Gregorian calendar
 //! (400-year cycles of 146 097 days, years from March so the leap day is
 //! last).
@@ -43,6 +44,24 @@ pub fn iso_utc(t: SystemTime) -> String {
 /// `20261125T122839Z` for `t`: the same, safe in a file name.
 pub fn compact_utc(t: SystemTime) -> String {
     iso_utc(t).replace(['-', ':'], "")
+}
+
+/// The 1-minute load average (Linux `/proc/loadavg`), if readable: other
+/// processes distort wall-clock timings.
+pub fn load_average() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
+    text.split_whitespace().next()?.parse().ok()
+}
+
+/// CPU time the calling thread has run so far \[s\] (Linux
+/// `/proc/thread-self/schedstat`, nanoseconds on the CPU), if readable.
+/// Unlike wall time it leaves out the time the thread waited while other
+/// processes ran, so a benchmark on a busy machine still measures its own
+/// work (cache and memory contention remain).
+pub fn thread_cpu_seconds() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = text.split_whitespace().next()?.parse().ok()?;
+    Some(ns * 1e-9)
 }
 
 #[cfg(test)]

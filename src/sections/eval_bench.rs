@@ -11,9 +11,15 @@
 //! with mode derivatives) and their time, the rest of the scene build, the
 //! integration (states and, for `f+g`, the sensitivity lanes), the output
 //! and response evaluation, the total, the integrator's steps,
-//! right-hand-side calls and Jacobian-vector products and the integration
-//! time per right-hand-side call. The problem's set-up (plan, start
-//! design and normalization evaluations) is timed once.
+//! right-hand-side calls and Jacobian-vector products (for fused
+//! sensitivities: multi-lane dual evaluations) and the integration time
+//! per right-hand-side call. Wall times are what a user waits; `cpu [ms]`
+//! is the evaluating thread's own CPU time (Linux; empty elsewhere), which
+//! stays close to the wall time on an idle machine and keeps measuring
+//! the work when other processes share the cores (`load_1min`, read at
+//! the start of each case, says how busy the machine was). The problem's
+//! set-up (plan, start design and normalization evaluations) is timed
+//! once.
 //!
 //! Output: `eval_bench.csv` in the study's output folder (columns in
 //! [`HEADERS`]).
@@ -23,6 +29,7 @@ use crate::error::Result;
 use crate::explore::scene_problem::{EvalProfile, SceneProblem};
 use crate::integrate::SensitivityForm;
 use crate::optimize::Problem;
+use crate::report::clock::{load_average, thread_cpu_seconds};
 use crate::report::csv::Table;
 use crate::study::Study;
 use serde::Deserialize;
@@ -48,7 +55,7 @@ pub struct EvalBenchSpec {
 }
 
 /// Column headers of `eval_bench.csv`.
-pub const HEADERS: [&str; 17] = [
+pub const HEADERS: [&str; 19] = [
     "problem",
     "design [deg]",
     "mode",
@@ -65,14 +72,31 @@ pub const HEADERS: [&str; 17] = [
     "rhs_calls",
     "jvp_calls",
     "integrate_per_rhs [us]",
+    "cpu [ms]",
+    "load_1min",
     "repeats",
 ];
 
+/// One timed evaluation: its profile and the thread's CPU seconds (NaN
+/// where the platform does not say).
+struct Timed {
+    profile: EvalProfile,
+    cpu: f64,
+}
+
 /// The medians of one case.
-fn row(name: &str, x: &[f64], mode: &str, setup: f64, runs: &[EvalProfile]) -> Vec<String> {
-    let med = |f: &dyn Fn(&EvalProfile) -> f64| median(runs.iter().map(f).collect());
+fn row(
+    name: &str,
+    x: &[f64],
+    (mode, load): (&str, Option<f64>),
+    setup: f64,
+    timed: &[Timed],
+) -> Vec<String> {
+    let runs: Vec<&EvalProfile> = timed.iter().map(|t| &t.profile).collect();
+    let med = |f: &dyn Fn(&EvalProfile) -> f64| median(runs.iter().map(|r| f(r)).collect());
     let ms = |f: &dyn Fn(&EvalProfile) -> f64| format!("{:.3}", 1e3 * med(f));
-    let p = &runs[0];
+    let p = runs[0];
+    let cpu = median(timed.iter().map(|t| t.cpu).collect());
     let design: Vec<String> = x.iter().map(|v| v.to_string()).collect();
     let per_rhs = med(&|r| r.integrate_seconds / r.rhs_calls.max(1) as f64);
     vec![
@@ -92,6 +116,12 @@ fn row(name: &str, x: &[f64], mode: &str, setup: f64, runs: &[EvalProfile]) -> V
         p.rhs_calls.to_string(),
         p.jvp_calls.to_string(),
         format!("{:.2}", 1e6 * per_rhs),
+        if cpu.is_finite() {
+            format!("{:.3}", 1e3 * cpu)
+        } else {
+            String::new()
+        },
+        load.map_or(String::new(), |l| format!("{l:.2}")),
         runs.len().to_string(),
     ]
 }
@@ -141,10 +171,17 @@ pub fn run_eval_bench(
                     problem.set_sensitivity_form(form);
                 }
                 problem.evaluate_profiled(x, gradients)?;
+                let load = load_average();
+                let cpu = || thread_cpu_seconds().unwrap_or(f64::NAN);
                 let runs = (0..spec.repeats)
-                    .map(|_| Ok(problem.evaluate_profiled(x, gradients)?.1))
+                    .map(|_| {
+                        let c0 = cpu();
+                        let profile = problem.evaluate_profiled(x, gradients)?.1;
+                        let cpu = cpu() - c0;
+                        Ok(Timed { profile, cpu })
+                    })
                     .collect::<Result<Vec<_>>>()?;
-                let r = row(&inner.name(), x, &mode, setup, &runs);
+                let r = row(&inner.name(), x, (&mode, load), setup, &runs);
                 progress(&r);
                 rows.push(r);
             }

@@ -112,12 +112,6 @@ fn time_case(scene: &Scene, form: &str, repeats: usize) -> Result<Timed> {
     })
 }
 
-/// The 1-minute load average (Linux `/proc/loadavg`), if readable.
-fn load_average() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
-    text.split_whitespace().next()?.parse().ok()
-}
-
 /// One CSV row of `case`, with ratios to `plain`.
 fn record(scene: &Scene, case: &Timed, plain: &Timed, repeats: usize) -> Vec<String> {
     let ms = |s: f64| format!("{:.3}", 1e3 * s);
@@ -135,7 +129,7 @@ fn record(scene: &Scene, case: &Timed, plain: &Timed, repeats: usize) -> Vec<Str
         s.steps.to_string(),
         s.rhs_calls.to_string(),
         s.jvp_calls.to_string(),
-        load_average().map_or(String::new(), |l| format!("{l:.2}")),
+        crate::report::clock::load_average().map_or(String::new(), |l| format!("{l:.2}")),
     ];
     match &case.response {
         Some(r) => {

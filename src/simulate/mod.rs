@@ -30,6 +30,12 @@ pub struct Simulation {
     pub energy_error: Option<f64>,
     /// Redundant equations (equations − rank) at the start.
     pub redundant: usize,
+    /// The rows the kernel found dependent at the start and leaves out of
+    /// the solve ([`Projection::dependent`]), labelled `<joint>.<equation>`
+    /// ([`crate::mbs::Model::row_label`]). Which rows of a redundant set
+    /// are named depends on the elimination order; their number and the
+    /// motion do not.
+    pub redundant_rows: Vec<String>,
     pub equations: usize,
     /// Headers of the output sensitivities (`t` first); only `t` when the
     /// scene asks for none.
@@ -142,6 +148,11 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         rows,
         y_end,
         redundant: projection.equations - projection.rank,
+        redundant_rows: projection
+            .dependent
+            .iter()
+            .map(|&r| sys.model.row_label(r).unwrap_or_else(|| format!("row {r}")))
+            .collect(),
         equations: projection.equations,
         projection,
         stats,
@@ -425,6 +436,7 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
         ("output_wall_time_s", format!("{:.6e}", s.observer_wall)),
         ("equations", sim.equations.to_string()),
         ("redundant_equations", sim.redundant.to_string()),
+        ("redundant_rows", redundant_rows(sim)),
         ("initial_violation", format!("{:.3e}", p.phi_before)),
         (
             "position_correction",
@@ -584,15 +596,26 @@ pub fn rigid_summary(scene: &Scene) -> (Vec<String>, Vec<String>) {
     (lines, warnings)
 }
 
+/// The dependent rows as one table cell: labels separated by spaces, or
+/// `none`.
+fn redundant_rows(sim: &Simulation) -> String {
+    if sim.redundant_rows.is_empty() {
+        "none".into()
+    } else {
+        sim.redundant_rows.join(" ")
+    }
+}
+
 /// One-paragraph summary for the terminal.
 pub fn summary(sim: &Simulation) -> String {
     let s = &sim.stats;
     let mut text = format!(
-        "constraints: {} equations, {} redundant; initial |Φ| {:.2e} (position correction {:.2e}, velocity {:.2e})\n\
+        "constraints: {} equations, {} redundant ({}); initial |Φ| {:.2e} (position correction {:.2e}, velocity {:.2e})\n\
          max constraint violation {:.2e}; energy error {}\n\
          integrator: {} steps, {} rhs calls, {} Jacobian-vector products, {} Jacobians, {} error-test failures, {} segment events ({} restarts); wall {:.3} ms (+ {:.3} ms outputs)",
         sim.equations,
         sim.redundant,
+        redundant_rows(sim),
         sim.projection.phi_before,
         sim.projection.position_correction,
         sim.projection.velocity_correction,

@@ -243,7 +243,7 @@ impl Prepared {
             f_start: history.records.first().map(|(r, _)| r.f),
             tolerance: plan.tolerances.feasibility,
             threads: ctx.threads,
-            load: super::scaling::load_average(),
+            load: crate::report::clock::load_average(),
         };
         files.push(summary::write(dir, problem, &self.labels, run, &facts)?);
         if let (Some((p, at_start)), Some(res)) = (&self.scene, &run.result) {
