@@ -399,3 +399,46 @@ fn bad_schedule_lists_are_refused_before_any_work() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn tol_fun_is_read_from_the_study_and_ends_runs_earlier() {
+    // `[evolve] tol_fun`: a run restarts once its recent best values and
+    // current values lie within that range. On Himmelblau (exact
+    // objective, 4 global minima at f = 0) with 3000 evaluations, a range
+    // of 1e-3 ends each run long before 1e-12 does, so more runs fit the
+    // same budget; the value is recorded, and a bad one is refused.
+    let dir = temp_dir("cmp-tolfun");
+    let runs = |name: &str, extra: &str| {
+        let s = study(
+            name,
+            &text(
+                name,
+                "himmelblau",
+                &format!("[evolve]\nmax_evaluations = 3000\n{extra}"),
+            ),
+        );
+        explore::run_evolve(&ctx(&s, &dir, 1, DriveFlags::default()), None).unwrap();
+        let m: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.join(format!("{name}/manifest.json"))).unwrap(),
+        )
+        .unwrap();
+        let ev = &m["commands"]["evolve"];
+        (
+            ev["runs"].as_array().unwrap().len(),
+            ev["tol_fun"].as_f64().unwrap(),
+        )
+    };
+    let (tight, t1) = runs("t", "");
+    let (loose, t2) = runs("l", "tol_fun = 1e-3\n");
+    assert_eq!((t1, t2), (1e-12, 1e-3));
+    assert!(loose > tight, "runs: {loose} with 1e-3, {tight} with 1e-12");
+    let bad = study("x", &text("x", "himmelblau", "[evolve]\ntol_fun = -1.0\n"));
+    let e = explore::run_evolve(&ctx(&bad, &dir, 1, DriveFlags::default()), None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("x.toml") && e.contains("evolve.tol_fun") && e.contains(">= 0"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -35,6 +35,9 @@ pub struct Request {
     /// A constraint is met when `g <= feasibility_tolerance` (the
     /// multistart's tolerance, so both methods search the same set).
     pub feasibility_tolerance: f64,
+    /// A run restarts when its recent best values and current values of f
+    /// lie within this range (CMA-ES TolFun).
+    pub tol_fun: f64,
 }
 
 /// An evolutionary solver: CMA-ES in the binary, anything in tests.

@@ -138,6 +138,13 @@ pub struct EvolveSection {
     /// (`["ipop", "bipop"]`), run one after another on the same budget and
     /// seed; read by [`schedules`].
     pub restarts: Option<toml::Value>,
+    /// CMA-ES TolFun: a run restarts when its best f of the recent
+    /// generations and every f of the current one lie within this range.
+    /// Default 1e-12, for exact objectives; an objective from a simulation
+    /// carries the integrator's noise (adaptive steps: about 1e-8 of f at
+    /// rtol 1e-6), below which no progress is real, and a run whose f
+    /// never settles within 1e-12 never restarts: set it above the noise.
+    pub tol_fun: Option<f64>,
 }
 
 /// A checked `[evolve]`.
@@ -155,6 +162,11 @@ pub fn evolve_plan(study: &Study) -> Result<EvolvePlan> {
     let section: EvolveSection = study.section("evolve")?.unwrap_or_default();
     if section.max_evaluations == Some(0) {
         return Err(study.error("evolve.max_evaluations", 0, "a budget >= 1"));
+    }
+    if let Some(t) = section.tol_fun {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(study.error("evolve.tol_fun", t, "a finite range >= 0"));
+        }
     }
     let schedules = schedules(section.restarts.as_ref()).map_err(study.locate("evolve"))?;
     Ok(EvolvePlan { section, schedules })
@@ -529,6 +541,7 @@ pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<Vec<evolve::Re
             max_evaluations,
             restarts,
             feasibility_tolerance,
+            tol_fun: plan.section.tol_fun.unwrap_or(1e-12),
         };
         let report = evolve::run(
             problem.as_ref(),
@@ -546,7 +559,12 @@ pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<Vec<evolve::Re
         &dir.join("evolution.csv"),
         &evolve::table(problem.as_ref(), &reports),
     )?;
-    ctx.manifest(&dir, "evolve", evolve_entry(max_evaluations, &reports))?;
+    let tol_fun = plan.section.tol_fun.unwrap_or(1e-12);
+    ctx.manifest(
+        &dir,
+        "evolve",
+        evolve_entry((max_evaluations, tol_fun), &reports),
+    )?;
     convergence_plot(problem.as_ref(), &dir, None, &reports)?;
     Ok(reports)
 }
@@ -557,9 +575,13 @@ pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<Vec<evolve::Re
 /// generations). One schedule's keys stand at the top of the entry (as
 /// before lists existed); several are under `schedules`, with `restarts`
 /// listing their names and `wall_seconds` their total.
-fn evolve_entry(max_evaluations: usize, reports: &[evolve::Report]) -> serde_json::Value {
+fn evolve_entry(
+    (max_evaluations, tol_fun): (usize, f64),
+    reports: &[evolve::Report],
+) -> serde_json::Value {
     let mut entry = serde_json::Map::new();
     entry.insert("max_evaluations".into(), json!(max_evaluations));
+    entry.insert("tol_fun".into(), json!(tol_fun));
     let schedules: Vec<serde_json::Value> = reports.iter().map(schedule_entry).collect();
     match schedules.as_slice() {
         [serde_json::Value::Object(one)] => entry.extend(one.clone()),

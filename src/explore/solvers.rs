@@ -114,6 +114,7 @@ pub fn global() -> Box<GlobalSolver<'static>> {
                 max_evaluations: r.max_evaluations,
                 restarts: r.restarts,
                 feasibility_tolerance: r.feasibility_tolerance,
+                tol_fun: r.tol_fun,
                 ..Default::default()
             };
             crate::optimize::cmaes::minimize(p, &options, obs)
