@@ -10,9 +10,12 @@
 
 mod explore_common;
 
+mod sar_common;
+
 use explore_common::{column, ctx, study, table_without, temp_dir};
 use plyscape::explore::DriveFlags;
 use plyscape::study::Study;
+use sar_common::replace;
 use std::path::Path;
 
 const HS22: &str = "[study]\nname = \"rep_hs22\"\nseed = 7\n\
@@ -224,12 +227,6 @@ fn bad_sections_are_refused_before_any_work() {
 
 /// The `quantities` line of studies/sar_optimize.toml.
 const QUANTITIES: &str = "quantities = [\"R3.angle\", \"B2.strain_energy\", \"B3.strain_energy\"]";
-
-/// Replace every occurrence of `from`, requiring `count` of them.
-fn replace(text: &str, from: &str, to: &str, count: usize) -> String {
-    assert_eq!(text.matches(from).count(), count, "{from:?}");
-    text.replace(from, to)
-}
 
 /// studies/sar_optimize.toml, coarse (8 divisions, 4 modes, 0–0.5 s),
 /// with one sampled start besides the paper's, the staggered sensitivity

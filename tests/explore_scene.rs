@@ -5,33 +5,19 @@
 //! gradients against central finite differences of its own `evaluate`,
 //! its 180° periodicity, and input errors that name the key.
 
+mod sar_common;
+
 use plyscape::explore;
 use plyscape::optimize::Problem;
 use plyscape::study::Study;
+use sar_common::{coarse_sar, replace};
 use std::time::Instant;
 
 const STUDY: &str = include_str!("../studies/sar_optimize.toml");
 
-/// Replace every occurrence of `from`, requiring `count` of them (a change
-/// of the study file cannot silently void a test).
-fn replace(text: &str, from: &str, to: &str, count: usize) -> String {
-    assert_eq!(
-        text.matches(from).count(),
-        count,
-        "expected {count} × {from:?} in the study"
-    );
-    text.replace(from, to)
-}
-
 /// The coarse study text.
 fn coarse() -> String {
-    let mut t = STUDY.to_string();
-    t = replace(&t, "divisions = 32", "divisions = 8", 2);
-    t = replace(&t, "modes = 14", "modes = 4", 2);
-    t = replace(&t, "t_end = 3.0", "t_end = 0.5", 1);
-    t = replace(&t, "dt_out = 0.01", "dt_out = 0.005", 1);
-    t = replace(&t, "rtol = 1e-6", "rtol = 1e-10", 1);
-    replace(&t, "atol = 1e-8", "atol = 1e-12", 1)
+    coarse_sar(STUDY, 8, 4)
 }
 
 fn build(text: &str) -> plyscape::Result<Box<dyn Problem>> {

@@ -9,36 +9,22 @@
 //! gradient of panel 2's part of Ψ₀ matches central differences of whole
 //! simulations.
 
+mod sar_common;
+
 use nalgebra::DMatrix;
 use plyscape::mbs::{Force, System, Workspace};
 use plyscape::scene::{load_scene, Scene};
 use plyscape::simulate::{simulate, Simulation};
 use plyscape::study::Study;
+use sar_common::{coarse_sar, replace};
 
 const STUDY: &str = include_str!("../studies/sar_phase1_holddown.toml");
-
-/// Replace every occurrence of `from` in `text`, requiring `count` of them
-/// (so that a change of the study file cannot silently void the test).
-fn replace(text: &str, from: &str, to: &str, count: usize) -> String {
-    assert_eq!(
-        text.matches(from).count(),
-        count,
-        "expected {count} × {from:?} in the study"
-    );
-    text.replace(from, to)
-}
 
 /// The coarse scene: 16 divisions, 6 modes, 0–0.5 s at rtol 1e-10; panel
 /// 2's outer plies (1 and 4) at `theta_deg`; `sens` = with the one
 /// sensitivity lane B2.design.theta_1_4.
 fn coarse(theta_deg: f64, sens: bool) -> Scene {
-    let mut t = STUDY.to_string();
-    t = replace(&t, "divisions = 32", "divisions = 16", 2);
-    t = replace(&t, "modes = 14", "modes = 6", 2);
-    t = replace(&t, "t_end = 3.0", "t_end = 0.5", 1);
-    t = replace(&t, "dt_out = 0.01", "dt_out = 0.005", 1);
-    t = replace(&t, "rtol = 1e-6", "rtol = 1e-10", 1);
-    t = replace(&t, "atol = 1e-8", "atol = 1e-12", 1);
+    let mut t = coarse_sar(STUDY, 16, 6);
     let lanes = "sensitivities = [\"B3.design.theta_1_4\", \"B3.design.theta_2_3\", \
                  \"B2.design.theta_1_4\", \"B2.design.theta_2_3\"]";
     let lane = if sens {

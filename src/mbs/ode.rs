@@ -31,8 +31,8 @@ impl<D: Scalar + Lanes> LaneWork<D> {
     fn new(n: usize) -> LaneWork<D> {
         LaneWork {
             ws: Workspace::empty(),
-            y: vec![D::with(0.0, &[0.0; 8][..D::L.min(8)]); n],
-            dy: vec![D::with(0.0, &[0.0; 8][..D::L.min(8)]); n],
+            y: vec![D::with(0.0, &vec![0.0; D::L]); n],
+            dy: vec![D::with(0.0, &vec![0.0; D::L]); n],
         }
     }
 }

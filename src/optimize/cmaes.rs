@@ -610,11 +610,7 @@ impl Cmaes {
                 evaluate_batch(c, &xs).map_err(argmin::core::Error::from)
             })
             .map_err(driver::from_argmin)?;
-        let m = problem
-            .problem
-            .as_ref()
-            .map(|c| c.n_constraints())
-            .unwrap_or(0);
+        let m = driver::constraint_count(problem);
         let mut samples: Vec<Sample> = Vec::with_capacity(lambda);
         for (k, ev) in evals.into_iter().enumerate() {
             driver::check_evaluation(&ev, &xs[k], m, false, "optimize::cmaes")?;

@@ -8,7 +8,7 @@
 //! iteration counter like the executor does. The solvers hold the last
 //! [`IterRecord`]; only this loop passes it on.
 
-use super::{Counted, Evaluation, IterRecord, Observer};
+use super::{Counted, Evaluation, IterRecord, Observer, Problem};
 use crate::error::{Error, Result};
 use argmin::core::{IterState, Problem as ArgminProblem, Solver, State};
 
@@ -29,6 +29,12 @@ pub fn from_argmin(e: argmin::core::Error) -> Error {
         Ok(err) => err,
         Err(other) => Error::numerical("optimize (argmin)", other.to_string()),
     }
+}
+
+/// The number of constraints of the problem an argmin solver is given (0
+/// when argmin holds none).
+pub fn constraint_count(problem: &ArgminProblem<Counted<'_>>) -> usize {
+    problem.problem.as_ref().map_or(0, |c| c.n_constraints())
 }
 
 /// Check that an evaluation has the sizes the problem declared and finite

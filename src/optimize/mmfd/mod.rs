@@ -129,11 +129,7 @@ fn evaluate(problem: &mut Ap<'_>, x: &[f64], gradients: bool) -> Result<Evaluati
             c.evaluate(x, gradients).map_err(argmin::core::Error::from)
         })
         .map_err(driver::from_argmin)?;
-    let m = problem
-        .problem
-        .as_ref()
-        .map(|c| c.n_constraints())
-        .unwrap_or(0);
+    let m = driver::constraint_count(problem);
     driver::check_evaluation(&ev, x, m, gradients, "optimize::mmfd")?;
     Ok(ev)
 }
