@@ -40,7 +40,9 @@
 
 use super::energy::quadratic_form;
 use super::flexdyn::{flex_terms, FlexEffects, FlexState, InvT};
-use super::linalg::{cst, euler_rate, rotation, rotation_tangent, rotation_vector, Scalar};
+use super::linalg::{
+    cst, euler_rate, rotation, rotation_tangent, rotation_vector, spd_inverse, sym_times, Scalar,
+};
 use super::model::{Model, Param};
 use super::rows::joint_rows;
 pub use super::rows::{angle_of, slide_of};
@@ -383,14 +385,32 @@ impl System {
 
     /// Kinematics of every marker into `ws.mk`, and their node shapes
     /// into `ws.shapes` (from `ws.kin`).
+    /// The node shapes depend on the design seeds alone, not on the
+    /// state: they are built again only when a body's seeds differ from
+    /// those they were built with (fused sensitivities seed the same unit
+    /// lanes at every stage).
     pub fn markers_kin<T: Scalar>(&self, ws: &mut Workspace<T>) {
+        let nm = self.model.markers.len();
         ws.mk.clear();
-        ws.shapes.clear();
-        for m in 0..self.model.markers.len() {
-            let shapes = self.marker_shapes(&ws.kin, m);
-            let k = self.marker_kin_with(&ws.kin, m, &shapes);
+        ws.shapes.resize_with(nm, || (Vec::new(), Vec::new()));
+        ws.shape_seeds.resize_with(nm, || None);
+        for m in 0..nm {
+            let mk = &self.model.markers[m];
+            let seeds = match (mk.node, mk.body.and_then(|b| self.slot[b])) {
+                (Some(_), Some(s)) if !ws.kin[s].q.is_empty() => Some(&ws.kin[s].design),
+                _ => None,
+            };
+            let fresh = match (&ws.shape_seeds[m], seeds) {
+                (Some(old), Some(new)) => same_seeds(old, new),
+                (None, None) => ws.shapes[m].0.is_empty(),
+                _ => false,
+            };
+            if !fresh {
+                ws.shapes[m] = self.marker_shapes(&ws.kin, m);
+                ws.shape_seeds[m] = seeds.cloned();
+            }
+            let k = self.marker_kin_with(&ws.kin, m, &ws.shapes[m]);
             ws.mk.push(k);
-            ws.shapes.push(shapes);
         }
     }
 
@@ -470,7 +490,7 @@ impl System {
         let Some(flex) = flex else { return };
         ws.inv.resize_with(self.nb(), || None);
         ws.inv_seeds.resize_with(self.nb(), Vec::new);
-        if ws.inv[s].is_none() || ws.inv_seeds[s] != ws.kin[s].design {
+        if ws.inv[s].is_none() || !same_seeds(&ws.inv_seeds[s], &ws.kin[s].design) {
             ws.inv[s] = Some(InvT::lift(flex, &ws.kin[s].design));
             ws.inv_seeds[s].clone_from(&ws.kin[s].design);
         }
@@ -540,16 +560,17 @@ impl System {
         self.flex_bodies(ws, false);
     }
 
-    /// `M v` of flexible slot `s` from its factor (`M = L Lᵀ`).
+    /// `M v` of flexible slot `s` from its factor, which holds `M⁻¹`
+    /// ([`Scalar::dense_factor`]): `M` is that inverse inverted again (a
+    /// diagnostic, used for the angular momentum; `M` is well conditioned,
+    /// so the round trip costs a few ulps).
     pub(crate) fn flex_mass_times(&self, s: usize, ws: &Workspace<f64>, v: &[f64]) -> Vec<f64> {
         let d = self.dof(s);
-        let l = &ws.mfac[s];
-        let ltv: Vec<f64> = (0..d)
-            .map(|c| (c..d).map(|r| l[r * d + c] * v[r]).sum())
-            .collect();
-        (0..d)
-            .map(|r| (0..=r).map(|c| l[r * d + c] * ltv[c]).sum())
-            .collect()
+        let mut m = ws.mfac[s].clone();
+        spd_inverse(&mut m, d);
+        let mut out = vec![0.0; d];
+        sym_times(&m, d, v, &mut out);
+        out
     }
 
     /// Kinematics (bodies and markers) of `y` into `ws`.
@@ -592,6 +613,16 @@ impl System {
             dy[io + i] = v * cst::<T>(integral.scale);
         }
     }
+}
+
+/// Whether two lists of design seeds `(variable, δ)` are the same, every
+/// dual component compared (`PartialEq` of num-dual's numbers compares the
+/// real parts alone, which are zero for every seed).
+pub(crate) fn same_seeds<T: Scalar>(a: &[(usize, T)], b: &[(usize, T)]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|((i, x), (j, y))| i == j && (*x - *y).is_exact_zero())
 }
 
 /// The value of parameter `which`: the override in `params` if present,

@@ -147,22 +147,25 @@ pub fn flex_terms<T: Scalar>(
     let d = 6 + n;
     let (a, wb, w, wd) = (st.a, st.wb, st.w, st.wd);
     let s = inv.first_moment(w);
-    // Second moment E and J_tr = tr(E) I − E.
+    // H_j = P_j + Σ_i w_i Q_ji, then the second moment
+    // E = e0 + Σ_j w_j (P_j + P_jᵀ) + Σ_j w_j (H_j − P_j) (the double sum
+    // Σ_ij w_i w_j Q_ij once, through the H_j the quadratic-velocity
+    // forces use too) and J_tr = tr(E) I − E.
+    let mut h = Vec::with_capacity(n);
     let mut e = inv.e0;
     for j in 0..n {
         let pj = Matrix3::from_fn(|r, c| inv.p[j * 9 + 3 * r + c]);
-        e += (pj + pj.transpose()) * w[j];
-    }
-    for i in 0..n {
-        for j in 0..n {
-            let wij = w[i] * w[j];
-            let o = (i * n + j) * 9;
+        let mut qw = Matrix3::<T>::zeros();
+        for i in 0..n {
+            let o = (j * n + i) * 9;
             for r in 0..3 {
                 for c in 0..3 {
-                    e[(r, c)] += inv.q[o + 3 * r + c] * wij;
+                    qw[(r, c)] += inv.q[o + 3 * r + c] * w[i];
                 }
             }
         }
+        e += (pj + pj.transpose() + qw) * w[j];
+        h.push(pj + qw);
     }
     let j_tr = Matrix3::identity() * e.trace() - e;
     // M_ωw columns: ls_j + Σ_i w_i V_ij + c_rot_j.
@@ -230,16 +233,7 @@ pub fn flex_terms<T: Scalar>(
     // H_j and G = Σ ẇ_j H_j.
     let mut g = Matrix3::<T>::zeros();
     let mut crot = Vector3::<T>::zeros();
-    for j in 0..n {
-        let mut h = Matrix3::from_fn(|r, c| inv.p[j * 9 + 3 * r + c]);
-        for i in 0..n {
-            let o = (j * n + i) * 9;
-            for r in 0..3 {
-                for c in 0..3 {
-                    h[(r, c)] += inv.q[o + 3 * r + c] * w[i];
-                }
-            }
-        }
+    for (j, h) in h.iter().enumerate() {
         g += h * wd[j];
         // Σ_i ẇ_i V_ij.
         let mut vs = Vector3::<T>::zeros();

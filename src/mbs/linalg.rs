@@ -49,10 +49,21 @@ pub trait Scalar: RealField + Copy {
 
     /// Factor a dense SPD matrix (row-major `n × n`, both triangles) in
     /// place for [`Scalar::dense_solve`]; `false` at a non-positive pivot.
+    /// The real parts become the explicit inverse `A⁻¹` ([`spd_inverse`]):
+    /// every later solve is a matrix–vector product of independent sums
+    /// instead of a pair of triangular solves, whose sequential
+    /// divisions dominate at the flexible bodies' `n` ≈ 20 (one solve per
+    /// constraint row touching the body).
     fn dense_factor(a: &mut [Self], n: usize) -> bool;
 
-    /// Solve with the factor of [`Scalar::dense_factor`] (`x` overwritten).
-    fn dense_solve(a: &[Self], n: usize, x: &mut [Self]);
+    /// One body's block of the constraint-space matrix: for the
+    /// `k = rows.len() / n` vectors `b_i` (row-major `k × n`: the body's
+    /// constraint rows and its applied force) and the factor of
+    /// [`Scalar::dense_factor`], `w_i = A⁻¹ b_i` into `w` (`k × n`) and
+    /// the Gram block `g_ij = b_i · w_j`, `j ≤ i`, into `g` (row-major
+    /// `k × k`, lower triangle). Dual numbers do every lane with real
+    /// matrix–vector products ([`lanes_gram_rows`]).
+    fn gram_rows(fac: &[Self], n: usize, rows: &[Self], w: &mut Vec<Self>, g: &mut Vec<Self>);
 }
 
 /// Real scratch storage of [`Scalar::spd_factor`] / [`Scalar::spd_solve`].
@@ -92,11 +103,40 @@ impl Scalar for f64 {
         cholesky_solve(a, m, scale, f.accepted, b, &mut sc.tmp);
     }
     fn dense_factor(a: &mut [f64], n: usize) -> bool {
-        dense_cholesky(a, n)
+        spd_inverse(a, n)
     }
-    fn dense_solve(a: &[f64], n: usize, x: &mut [f64]) {
-        dense_cholesky_solve(a, n, x);
+    fn gram_rows(fac: &[f64], n: usize, rows: &[f64], w: &mut Vec<f64>, g: &mut Vec<f64>) {
+        let k = rows.len() / n;
+        w.clear();
+        w.resize(k * n, 0.0);
+        for (b, wi) in rows.chunks_exact(n).zip(w.chunks_exact_mut(n)) {
+            sym_times(fac, n, b, wi);
+        }
+        g.clear();
+        g.resize(k * k, 0.0);
+        for i in 0..k {
+            let bi = &rows[i * n..(i + 1) * n];
+            for j in 0..=i {
+                g[i * k + j] = fdot(bi, &w[j * n..(j + 1) * n]);
+            }
+        }
     }
+}
+
+/// `a · b` with four partial sums (independent additions the compiler
+/// can keep in vector registers).
+#[inline]
+pub fn fdot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for q in 0..4 {
+            acc[q] += x[q] * y[q];
+        }
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 /// A dual number with `L` derivative lanes, as the solves of [`Scalar`]
@@ -255,87 +295,161 @@ fn lanes_spd_solve<D: Lanes>(a: &[D], m: usize, f: Factored, b: &mut [D], sc: &m
 /// sequential divisions dominate at the flexible bodies' `n` ≈ 20 (one
 /// solve per constraint row touching the body and lane).
 fn lanes_dense_factor<D: Lanes>(a: &mut [D], n: usize) -> bool {
-    let mut l: Vec<f64> = a.iter().map(|v| v.re()).collect();
-    let ok = dense_cholesky(&mut l, n);
-    // X = L⁻¹ row by row (row k = (e_k − Σ_{j<k} L_kj X_j) / L_kk, lower
-    // triangular), each row update a vector operation over the columns.
-    let mut x = vec![0.0; n * n];
-    for k in 0..n {
-        let (done, rest) = x.split_at_mut(k * n);
-        let row = &mut rest[..n];
-        row[k] = 1.0;
-        for j in 0..k {
-            let c = l[k * n + j];
-            if c != 0.0 {
-                for (r, v) in row[..=j].iter_mut().zip(&done[j * n..j * n + j + 1]) {
-                    *r -= c * v;
-                }
-            }
-        }
-        let inv = 1.0 / l[k * n + k];
-        for r in row[..=k].iter_mut() {
-            *r *= inv;
-        }
-    }
-    // A⁻¹ = Xᵀ X: (A⁻¹)_ij = Σ_{k ≥ max(i, j)} X_ki X_kj.
-    let mut inv = vec![0.0; n * n];
-    for k in 0..n {
-        let xk = &x[k * n..k * n + k + 1];
-        for (i, xi) in xk.iter().enumerate() {
-            let out = &mut inv[i * n..i * n + k + 1];
-            for (o, xj) in out.iter_mut().zip(xk) {
-                *o += xi * xj;
-            }
-        }
-    }
+    let mut inv: Vec<f64> = a.iter().map(|v| v.re()).collect();
+    let ok = spd_inverse(&mut inv, n);
     for (v, m) in a.iter_mut().zip(&inv) {
         v.set_re(*m);
     }
     ok
 }
 
-/// [`Scalar::dense_solve`] for dual numbers with the inverse of
-/// [`lanes_dense_factor`]: `x = A⁻¹b` on the real parts, then per lane
-/// `x'_l = A⁻¹(b'_l − A'_l x)`, where `A'_l` is the full matrix in the
-/// dual parts of `a`.
-fn lanes_dense_solve<D: Lanes>(a: &[D], n: usize, x: &mut [D]) {
+/// In-place explicit inverse of a dense symmetric positive definite
+/// matrix (row-major `n × n`, lower triangle read, both triangles
+/// written): the Cholesky factor `A = L Lᵀ` ([`dense_cholesky`]), then
+/// `X = L⁻¹` and `A⁻¹ = Xᵀ X`, about `n³/2` multiply–adds, each loop an
+/// independent vector update. `false` at a non-positive pivot (the
+/// contents are then unspecified).
+pub fn spd_inverse(a: &mut [f64], n: usize) -> bool {
+    if !dense_cholesky(a, n) {
+        return false;
+    }
     thread_local! {
-        // Per thread: the real solution, the lanes' right-hand sides and
-        // solutions, and one number's lanes.
+        static X: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+    }
+    X.with_borrow_mut(|x| {
+        x.clear();
+        x.resize(n * n, 0.0);
+        // X = L⁻¹ row by row (row k = (e_k − Σ_{j<k} L_kj X_j) / L_kk,
+        // lower triangular), each row update a vector operation.
+        for k in 0..n {
+            let (done, rest) = x.split_at_mut(k * n);
+            let row = &mut rest[..n];
+            row[k] = 1.0;
+            for j in 0..k {
+                let c = a[k * n + j];
+                if c != 0.0 {
+                    for (r, v) in row[..=j].iter_mut().zip(&done[j * n..j * n + j + 1]) {
+                        *r -= c * v;
+                    }
+                }
+            }
+            let inv = 1.0 / a[k * n + k];
+            for r in row[..=k].iter_mut() {
+                *r *= inv;
+            }
+        }
+        // A⁻¹ = Xᵀ X: (A⁻¹)_ij = Σ_{k ≥ max(i, j)} X_ki X_kj.
+        a.fill(0.0);
+        for k in 0..n {
+            let xk = &x[k * n..k * n + k + 1];
+            for (i, xi) in xk.iter().enumerate() {
+                let out = &mut a[i * n..i * n + k + 1];
+                for (o, xj) in out.iter_mut().zip(xk) {
+                    *o += xi * xj;
+                }
+            }
+        }
+    });
+    true
+}
+
+/// `out = S x` for a symmetric row-major `n × n` matrix `S`, as a sum of
+/// its rows scaled by the entries of `x` (row `j` = column `j`): vector
+/// updates, and nothing done for the zero entries of `x` (the rigid
+/// part of a constraint row on a flexible body has zero modal entries).
+#[inline]
+pub fn sym_times(s: &[f64], n: usize, x: &[f64], out: &mut [f64]) {
+    out.fill(0.0);
+    for (j, &xj) in x.iter().enumerate() {
+        if xj != 0.0 {
+            for (o, v) in out.iter_mut().zip(&s[j * n..(j + 1) * n]) {
+                *o += xj * v;
+            }
+        }
+    }
+}
+
+/// [`Scalar::gram_rows`] for dual numbers with the inverse of
+/// [`lanes_dense_factor`] (real parts `S = A⁻¹`, dual parts `A'_l`, the
+/// full matrix). With `b_i = β_i + Σ_l ε_l β'_il`:
+/// - `w_i = S β_i`, and per lane `w'_il = S(β'_il − A'_l w_i)` (from
+///   `A w = b`: `A w' = b' − A' w`);
+/// - `g_ij = β_i·w_j`, and per lane `g'_ijl = β'_il·w_j + β_i·w'_jl`.
+///
+/// The matrices and vectors are split once into real planes, so every
+/// product is an `f64` vector operation (no dual arithmetic, and the
+/// inverse and `A'_l` are read out once per body instead of once per
+/// vector).
+fn lanes_gram_rows<D: Lanes>(fac: &[D], n: usize, rows: &[D], w: &mut Vec<D>, g: &mut Vec<D>) {
+    thread_local! {
         static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
     }
     let nl = D::L;
-    let inv_times = |v: &[f64], out: &mut [f64]| {
-        for (i, o) in out.iter_mut().enumerate() {
-            let row = &a[i * n..(i + 1) * n];
-            *o = row.iter().zip(v).map(|(e, w)| e.re() * w).sum();
-        }
-    };
+    let k = rows.len() / n;
+    let (nn, kn) = (n * n, k * n);
     SCRATCH.with_borrow_mut(|buf| {
-        buf.resize(2 * n + 2 * n * nl + nl, 0.0);
-        let (b, rest) = buf.split_at_mut(n);
-        let (xr, rest) = rest.split_at_mut(n);
-        let (r, rest) = rest.split_at_mut(n * nl);
-        let (xl, lanes) = rest.split_at_mut(n * nl);
-        for (bk, v) in b.iter_mut().zip(x.iter()) {
-            *bk = v.re();
-        }
-        inv_times(b, xr);
-        for i in 0..n {
-            let row = &a[i * n..(i + 1) * n];
-            for q in 0..nl {
-                let ax: f64 = row.iter().zip(xr.iter()).map(|(e, v)| e.lane(q) * v).sum();
-                r[q * n + i] = x[i].lane(q) - ax;
+        buf.clear();
+        buf.resize(
+            nn * (1 + nl) + 2 * kn * (1 + nl) + n + k * k * (1 + nl) + nl,
+            0.0,
+        );
+        let (sm, rest) = buf.split_at_mut(nn);
+        let (ap, rest) = rest.split_at_mut(nn * nl);
+        let (bp, rest) = rest.split_at_mut(kn * (1 + nl));
+        let (wp, rest) = rest.split_at_mut(kn * (1 + nl));
+        let (tmp, rest) = rest.split_at_mut(n);
+        let (gp, lanes) = rest.split_at_mut(k * k * (1 + nl));
+        for (i, v) in fac.iter().enumerate() {
+            sm[i] = v.re();
+            for l in 0..nl {
+                ap[l * nn + i] = v.lane(l);
             }
         }
-        for q in 0..nl {
-            inv_times(&r[q * n..(q + 1) * n], &mut xl[q * n..(q + 1) * n]);
-        }
-        for k in 0..n {
-            for (q, v) in lanes.iter_mut().enumerate() {
-                *v = xl[q * n + k];
+        for (i, v) in rows.iter().enumerate() {
+            bp[i] = v.re();
+            for l in 0..nl {
+                bp[(1 + l) * kn + i] = v.lane(l);
             }
-            x[k] = D::with(xr[k], lanes);
+        }
+        let (w_re, w_lanes) = wp.split_at_mut(kn);
+        for i in 0..k {
+            let r = i * n..(i + 1) * n;
+            sym_times(sm, n, &bp[r.clone()], &mut w_re[r.clone()]);
+            for l in 0..nl {
+                sym_times(&ap[l * nn..(l + 1) * nn], n, &w_re[r.clone()], tmp);
+                let bl = &bp[(1 + l) * kn..][r.clone()];
+                for (t, b) in tmp.iter_mut().zip(bl) {
+                    *t = b - *t;
+                }
+                sym_times(sm, n, tmp, &mut w_lanes[l * kn..][r.clone()]);
+            }
+        }
+        let (b_re, b_lanes) = bp.split_at(kn);
+        for i in 0..k {
+            let bi = &b_re[i * n..(i + 1) * n];
+            for j in 0..=i {
+                let wj = &w_re[j * n..(j + 1) * n];
+                gp[i * k + j] = fdot(bi, wj);
+                for l in 0..nl {
+                    let bil = &b_lanes[l * kn + i * n..l * kn + (i + 1) * n];
+                    let wjl = &w_lanes[l * kn + j * n..l * kn + (j + 1) * n];
+                    gp[(1 + l) * k * k + i * k + j] = fdot(bil, wj) + fdot(bi, wjl);
+                }
+            }
+        }
+        w.clear();
+        for i in 0..kn {
+            for (l, u) in lanes.iter_mut().enumerate() {
+                *u = w_lanes[l * kn + i];
+            }
+            w.push(D::with(w_re[i], lanes));
+        }
+        g.clear();
+        for i in 0..k * k {
+            for (l, u) in lanes.iter_mut().enumerate() {
+                *u = gp[(1 + l) * k * k + i];
+            }
+            g.push(D::with(gp[i], lanes));
         }
     })
 }
@@ -371,8 +485,8 @@ macro_rules! lanes_scalar {
         fn dense_factor(a: &mut [Self], n: usize) -> bool {
             lanes_dense_factor(a, n)
         }
-        fn dense_solve(a: &[Self], n: usize, x: &mut [Self]) {
-            lanes_dense_solve(a, n, x)
+        fn gram_rows(fac: &[Self], n: usize, rows: &[Self], w: &mut Vec<Self>, g: &mut Vec<Self>) {
+            lanes_gram_rows(fac, n, rows, w, g)
         }
     };
 }
@@ -872,7 +986,26 @@ mod tests {
             .map(|k| DualSVec64::<2>::with(b0[k], &lanes(&b0, &b1, &b2, k)))
             .collect();
         assert!(<DualSVec64<2> as Scalar>::dense_factor(&mut a, n));
-        <DualSVec64<2> as Scalar>::dense_solve(&a, n, &mut x);
+        // Two vectors in one Gram block: b and 2b, so w = (x, 2x) and
+        // g = (b·x, 2b·x; ·, 4b·x).
+        let rows: Vec<DualSVec64<2>> = x.iter().chain(x.iter()).copied().collect();
+        let mut rows2 = rows.clone();
+        for v in rows2[n..].iter_mut() {
+            *v *= DualSVec64::<2>::from(2.0);
+        }
+        let (mut w, mut g) = (Vec::new(), Vec::new());
+        <DualSVec64<2> as Scalar>::gram_rows(&a, n, &rows2, &mut w, &mut g);
+        let bx = (0..n).fold(DualSVec64::<2>::from(0.0), |s, k| s + rows[k] * w[k]);
+        for (got, want) in [(g[0], bx), (g[2], bx * 2.0), (g[3], bx * 4.0)] {
+            assert!((got.re - want.re).abs() < 1e-12 * (1.0 + want.re.abs()));
+            for q in 0..2 {
+                assert!((got.lane(q) - want.lane(q)).abs() < 1e-11 * (1.0 + want.lane(q).abs()));
+            }
+        }
+        for k in 0..n {
+            assert!((w[n + k] - w[k] * 2.0).re.abs() < 1e-12 * (1.0 + w[k].re.abs()));
+        }
+        x.copy_from_slice(&w[..n]);
         let plain = solve_f64([0.0; 2]);
         for k in 0..n {
             assert!((x[k].re - plain[k]).abs() < 1e-12 * (1.0 + plain[k].abs()));
@@ -890,7 +1023,18 @@ mod tests {
             .collect();
         let mut x1: Vec<Dual64> = (0..n).map(|k| Dual64::new(b0[k], b1[k] - b0[k])).collect();
         assert!(<Dual64 as Scalar>::dense_factor(&mut a, n));
-        <Dual64 as Scalar>::dense_solve(&a, n, &mut x1);
+        let (mut w1, mut g1) = (Vec::new(), Vec::new());
+        <Dual64 as Scalar>::gram_rows(&a, n, &x1, &mut w1, &mut g1);
+        x1.copy_from_slice(&w1);
+        // The plain f64 form gives the real parts alike.
+        let mut af: Vec<f64> = a0.clone();
+        assert!(<f64 as Scalar>::dense_factor(&mut af, n));
+        let (mut wf, mut gf) = (Vec::new(), Vec::new());
+        <f64 as Scalar>::gram_rows(&af, n, &b0, &mut wf, &mut gf);
+        for k in 0..n {
+            assert!((wf[k] - plain[k]).abs() < 1e-12 * (1.0 + plain[k].abs()));
+        }
+        assert!((gf[0] - g1[0].re).abs() < 1e-12 * (1.0 + gf[0].abs()));
         for k in 0..n {
             assert!((x1[k].eps - x[k].lane(0)).abs() < 1e-12 * (1.0 + x1[k].eps.abs()));
         }

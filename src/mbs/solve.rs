@@ -5,21 +5,12 @@
 use super::dynamics::{pval, System, Workspace, RANK_REG, RANK_TOL, RIGID};
 use super::linalg::{cst, min_degree_order, Scalar};
 use super::model::Param;
+use super::workspace::BodyBlock;
 use nalgebra::Vector3;
 
 impl System {
-    /// `M⁻¹ x` for slot `s` (in place).
-    fn apply_minv<T: Scalar>(
-        &self,
-        ws_mfac: &[Vec<T>],
-        params: &[(Param, T)],
-        s: usize,
-        x: &mut [T],
-    ) {
-        if self.modes[s] > 0 {
-            T::dense_solve(&ws_mfac[s], self.dof(s), x);
-            return;
-        }
+    /// `M⁻¹ x` for rigid slot `s` (in place): `diag(1/m, J'⁻¹)`.
+    fn rigid_minv<T: Scalar>(&self, params: &[(Param, T)], s: usize, x: &mut [T]) {
         let b = self.moving[s];
         let body = &self.model.bodies[b];
         let im = T::one() / pval(params, Param::Mass(b), body.mass);
@@ -30,56 +21,87 @@ impl System {
         }
     }
 
-    /// Solve for the multipliers and accelerations with the rows, applied
-    /// forces and mass factors in `ws`. Returns `v̇` (velocity layout);
-    /// `ws.rhs` = λ.
-    pub(crate) fn solve<T: Scalar>(&self, ws: &mut Workspace<T>) -> Vec<T> {
-        let m = ws.rows.len();
+    /// Gather every body's block: the rows touching it (`d`: the row's
+    /// `[∂/∂ṙ, ∂/∂ω', ∂/∂ẇ]` entries of that body) and, last, its applied
+    /// force `Q`; then `w = M⁻¹d`, `M⁻¹Q` and the Gram block `d_i·M⁻¹d_j`
+    /// of each body ([`Scalar::gram_rows`] for flexible bodies).
+    fn body_blocks<T: Scalar>(&self, ws: &mut Workspace<T>) {
         let nb = self.nb();
-        let mut mq = ws.q.clone();
-        for s in 0..nb {
-            let o = self.vel_local(s);
-            self.apply_minv(&ws.mfac, &ws.params, s, &mut mq[o..o + self.dof(s)]);
+        let mut blocks = std::mem::take(&mut ws.blocks);
+        blocks.resize_with(nb, BodyBlock::default);
+        for bb in blocks.iter_mut() {
+            bb.rows.clear();
+            bb.b.clear();
         }
-        // Rows touching each body, with d and M⁻¹d in the arena.
-        let mut by_body = std::mem::take(&mut ws.by_body);
-        by_body.resize_with(nb, Vec::new);
-        for list in by_body.iter_mut() {
-            list.clear();
-        }
-        let mut arena = std::mem::take(&mut ws.arena);
-        arena.clear();
-        ws.rhs.clear();
         for (r, row) in ws.rows.iter().enumerate() {
-            let mut b = row.gamma;
             for (side, (slot, blk)) in row.blocks.iter().enumerate() {
                 let Some(s) = *slot else { continue };
                 let d = self.dof(s);
-                let off = arena.len();
-                arena.extend_from_slice(blk);
+                let bb = &mut blocks[s];
+                bb.b.extend_from_slice(blk);
                 if d > 6 {
                     let mo = row.modal[side];
                     if mo == RIGID {
-                        arena.extend(std::iter::repeat_n(T::zero(), d - 6));
+                        bb.b.extend(std::iter::repeat_n(T::zero(), d - 6));
                     } else {
-                        arena.extend_from_slice(&ws.mjac[mo..mo + d - 6]);
+                        bb.b.extend_from_slice(&ws.mjac[mo..mo + d - 6]);
                     }
                 }
-                arena.extend_from_within(off..off + d);
-                self.apply_minv(&ws.mfac, &ws.params, s, &mut arena[off + d..off + 2 * d]);
-                let o = self.vel_local(s);
-                b -= dot(&arena[off..off + d], &mq[o..o + d]);
-                by_body[s].push((r, off));
+                bb.rows.push(r);
             }
-            ws.rhs.push(b);
+        }
+        for (s, bb) in blocks.iter_mut().enumerate() {
+            let (o, d) = (self.vel_local(s), self.dof(s));
+            bb.b.extend_from_slice(&ws.q[o..o + d]);
+            if self.modes[s] > 0 {
+                T::gram_rows(&ws.mfac[s], d, &bb.b, &mut bb.w, &mut bb.g);
+                continue;
+            }
+            bb.w.clone_from(&bb.b);
+            for x in bb.w.chunks_exact_mut(d) {
+                self.rigid_minv(&ws.params, s, x);
+            }
+            let k = bb.rows.len() + 1;
+            bb.g.clear();
+            bb.g.resize(k * k, T::zero());
+            for i in 0..k {
+                for j in 0..=i {
+                    bb.g[i * k + j] = dot(&bb.b[i * d..(i + 1) * d], &bb.w[j * d..(j + 1) * d]);
+                }
+            }
+        }
+        ws.blocks = blocks;
+    }
+
+    /// Solve for the multipliers and accelerations with the rows, applied
+    /// forces and mass factors in `ws`. Returns `v̇` (velocity layout);
+    /// `ws.rhs` = λ.
+    ///
+    /// Structure: `G M⁻¹ Gᵀ = Σ_bodies G_b M_b⁻¹ G_bᵀ`, each body's term a
+    /// Gram block of the few rows that touch it ([`System::body_blocks`]);
+    /// the matrix is scattered into a fill-reducing order computed once
+    /// per workspace (the rows touching each body never change) and
+    /// factored by the rank-counting Cholesky of [`super::linalg`].
+    pub(crate) fn solve<T: Scalar>(&self, ws: &mut Workspace<T>) -> Vec<T> {
+        let m = ws.rows.len();
+        self.body_blocks(ws);
+        // λ's right-hand side γ − G M⁻¹ Q: the force is each block's last
+        // vector, so d_i·M⁻¹Q is the block's last Gram row.
+        ws.rhs.clear();
+        ws.rhs.extend(ws.rows.iter().map(|row| row.gamma));
+        for bb in &ws.blocks {
+            let k = bb.rows.len() + 1;
+            for (i, &r) in bb.rows.iter().enumerate() {
+                ws.rhs[r] -= bb.g[(k - 1) * k + i];
+            }
         }
         // Fill-reducing order, computed once per workspace (the row
         // structure of a system never changes).
         if ws.inv_order.len() != m {
             let mut edges = Vec::new();
-            for list in &by_body {
-                for (x, (r, _)) in list.iter().enumerate() {
-                    for (c, _) in list.iter().take(x) {
+            for bb in &ws.blocks {
+                for (x, r) in bb.rows.iter().enumerate() {
+                    for c in &bb.rows[..x] {
                         edges.push((*r, *c));
                     }
                 }
@@ -93,13 +115,13 @@ impl System {
         let inv = &ws.inv_order;
         ws.a.clear();
         ws.a.resize(m * m, T::zero());
-        for (s, list) in by_body.iter().enumerate() {
-            let d = self.dof(s);
-            for (x, (r, od)) in list.iter().enumerate() {
-                for (c, ow) in list.iter().take(x + 1) {
-                    let (pr, pc) = (inv[*r], inv[*c]);
+        for bb in &ws.blocks {
+            let k = bb.rows.len() + 1;
+            for (x, r) in bb.rows.iter().enumerate() {
+                for (c, q) in bb.rows[..=x].iter().enumerate() {
+                    let (pr, pc) = (inv[*r], inv[*q]);
                     let (hi, lo) = if pr >= pc { (pr, pc) } else { (pc, pr) };
-                    ws.a[hi * m + lo] += dot(&arena[*od..*od + d], &arena[ow + d..ow + 2 * d]);
+                    ws.a[hi * m + lo] += bb.g[x * k + c];
                 }
             }
         }
@@ -135,20 +157,21 @@ impl System {
         ws.tmp.clear();
         ws.tmp.extend((0..m).map(|r| lam[inv[r]]));
         std::mem::swap(&mut lam, &mut ws.tmp);
-        let mut acc = mq;
-        for (s, list) in by_body.iter().enumerate() {
-            let d = self.dof(s);
-            let o = self.vel_local(s);
-            for (r, off) in list {
-                let w = &arena[off + d..off + 2 * d];
+        // v̇ = M⁻¹Q + Σ_rows (M⁻¹d) λ.
+        let mut acc = vec![T::zero(); self.nvel()];
+        for (s, bb) in ws.blocks.iter().enumerate() {
+            let (o, d) = (self.vel_local(s), self.dof(s));
+            let k = bb.rows.len();
+            let out = &mut acc[o..o + d];
+            out.copy_from_slice(&bb.w[k * d..(k + 1) * d]);
+            for (i, r) in bb.rows.iter().enumerate() {
+                let w = &bb.w[i * d..(i + 1) * d];
                 for c in 0..d {
-                    acc[o + c] += w[c] * lam[*r];
+                    out[c] += w[c] * lam[*r];
                 }
             }
         }
         ws.rhs = lam;
-        ws.by_body = by_body;
-        ws.arena = arena;
         acc
     }
 }

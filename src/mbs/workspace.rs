@@ -57,10 +57,12 @@ pub struct Workspace<T: Scalar> {
     /// per evaluation for the kinematics, the constraint rows and the
     /// forces.
     pub(crate) shapes: Vec<NodeShapes<T>>,
-    /// Per moving body: the rows touching it as `(row, offset)`; the
-    /// arena holds `d` then `M⁻¹d` (each `dof` long) at the offset.
-    pub(crate) by_body: Vec<Vec<(usize, usize)>>,
-    pub(crate) arena: Vec<T>,
+    /// The design seeds each marker's `shapes` were built with (`None`
+    /// for markers not on a flexible node).
+    pub(crate) shape_seeds: Vec<Option<Vec<(usize, T)>>>,
+    /// Per moving body: the constraint rows touching it and their
+    /// products with its inverse mass ([`BodyBlock`]).
+    pub(crate) blocks: Vec<BodyBlock<T>>,
     /// Modal Jacobian entries of the rows' flexible sides.
     pub mjac: Vec<T>,
     /// Position of each row in the fill-reducing order.
@@ -93,6 +95,29 @@ pub struct Workspace<T: Scalar> {
     /// right-hand side is smooth. Empty (or an out-of-range entry): the
     /// segment is picked by the value of θ.
     pub segments: Vec<usize>,
+}
+
+/// One body's share of the constraint-space matrix: the rows touching
+/// the body, their entries `d_i` for its `dof` velocities followed by its
+/// applied force `Q` (`b`, `(k + 1) × dof`), `w = M⁻¹ b` alike, and the
+/// Gram block `g_ij = b_i · w_j` (`(k + 1)²`, lower triangle).
+#[derive(Debug, Clone)]
+pub struct BodyBlock<T> {
+    pub(crate) rows: Vec<usize>,
+    pub(crate) b: Vec<T>,
+    pub(crate) w: Vec<T>,
+    pub(crate) g: Vec<T>,
+}
+
+impl<T> Default for BodyBlock<T> {
+    fn default() -> Self {
+        BodyBlock {
+            rows: Vec::new(),
+            b: Vec::new(),
+            w: Vec::new(),
+            g: Vec::new(),
+        }
+    }
 }
 
 /// Translational and rotational mode-shape rows of a node (n columns each).
