@@ -14,18 +14,20 @@
 //! and the constraints imposed at acceleration level with Baumgarte
 //! stabilisation: `G v̇ = γ − 2αΦ̇ − α²Φ`. Because `M` is block diagonal,
 //! `v̇ = M⁻¹(Q + Gᵀλ)` and `λ` solves the constraint-space system
-//! `(G M⁻¹ Gᵀ) λ = γ − 2αΦ̇ − α²Φ − G M⁻¹ Q`, which is formed from the
-//! sparse rows of `G` (each row touches at most two bodies), permuted once
-//! into a minimum-degree order (the SAR factor keeps 595 of 2145 entries)
+//! `(G M⁻¹ Gᵀ) λ = γ − 2αΦ̇ − α²Φ − G M⁻¹ Q`, which is formed body by
+//! body from the sparse rows of `G` (each row touches at most two bodies:
+//! `G M⁻¹ Gᵀ = Σ_b G_b M_b⁻¹ G_bᵀ`, one Gram block per body,
+//! [`super::solve`]), permuted once into a minimum-degree order (the SAR
+//! factor keeps 595 of 2145 entries)
 //! and factored by Cholesky after unit-diagonal scaling and a `1e-12`
 //! Tikhonov shift ([`RANK_REG`]). Redundant equations give pivots at the
 //! shift level and are counted ([`RANK_TOL`]); their multipliers take the
 //! minimum-norm split, and the accelerations, which do not depend on that
-//! split, stay unique. One factorization per evaluation (plus one small
-//! Cholesky per flexible body). A dual-number evaluation factors only the
+//! split, stay unique. One factorization per evaluation (plus the explicit
+//! inverse of each flexible body's mass). A dual-number evaluation factors only the
 //! real parts and differentiates each solve analytically with that same
 //! factor, `x' = A⁻¹(b' − A'x)` ([`Scalar::spd_solve`],
-//! [`Scalar::dense_solve`]): no dual arithmetic inside the factorizations,
+//! [`Scalar::gram_rows`]): no dual arithmetic inside the factorizations,
 //! no finite differences.
 //!
 //! Markers on nodes of flexible bodies move with the modes

@@ -3,7 +3,7 @@
 //! the method in [`super::dynamics`]).
 
 use super::dynamics::{pval, System, Workspace, RANK_REG, RANK_TOL, RIGID};
-use super::linalg::{cst, min_degree_order, Scalar};
+use super::linalg::{cst, min_degree_order, CholPattern, Scalar};
 use super::model::Param;
 use super::workspace::BodyBlock;
 use nalgebra::Vector3;
@@ -79,9 +79,10 @@ impl System {
     ///
     /// Structure: `G M⁻¹ Gᵀ = Σ_bodies G_b M_b⁻¹ G_bᵀ`, each body's term a
     /// Gram block of the few rows that touch it ([`System::body_blocks`]);
-    /// the matrix is scattered into a fill-reducing order computed once
-    /// per workspace (the rows touching each body never change) and
-    /// factored by the rank-counting Cholesky of [`super::linalg`].
+    /// the matrix is scattered into a fill-reducing order, whose symbolic
+    /// factorization ([`CholPattern`]) is computed once per workspace (the
+    /// rows touching each body never change), and factored on that
+    /// pattern by the rank-counting Cholesky of [`super::linalg`].
     pub(crate) fn solve<T: Scalar>(&self, ws: &mut Workspace<T>) -> Vec<T> {
         let m = ws.rows.len();
         self.body_blocks(ws);
@@ -111,6 +112,10 @@ impl System {
             for (k, &r) in order.iter().enumerate() {
                 ws.inv_order[r] = k;
             }
+            let inv = &ws.inv_order;
+            let permuted: Vec<(usize, usize)> =
+                edges.iter().map(|&(r, c)| (inv[r], inv[c])).collect();
+            ws.spd.set_pattern(CholPattern::new(m, &permuted));
         }
         let inv = &ws.inv_order;
         ws.a.clear();
