@@ -229,6 +229,71 @@ fn multi_lane_evaluations_equal_one_lane_at_a_time() {
 }
 
 #[test]
+fn design_seeds_with_the_same_variables_but_new_values_lift_the_basis_again() {
+    // Regression: the lifted invariants and node shapes are cached while
+    // a body's design seeds stay the same. num-dual's `==` compares real
+    // parts only (zero for every seed), so two directions seeding the same
+    // design variables with other values compared equal and the second
+    // evaluation used the first one's lifted basis. Here one workspace
+    // takes direction (0.3, 0.7) and then (0.5, -0.2) in the plies
+    // (θ₁₄, θ₂₃): the second result must equal a fresh workspace's, and,
+    // the product being linear in the direction, 0.5 e₁ − 0.2 e₂.
+    use plyscape::integrate::OdeModel;
+    let text = panel_scene(30.0).replace(
+        "sensitivities = [\"panel.design.theta_1_4\"]",
+        "sensitivities = [\"panel.design.theta_1_4\", \"panel.design.theta_2_3\"]",
+    );
+    let scene = load_scene(&study(&text)).unwrap();
+    let names: Vec<_> = scene.params.iter().map(|(_, p)| *p).collect();
+    assert_eq!(names.len(), 2);
+    let sys = System::new(scene.model);
+    let mut y = sys.initial_state();
+    let n = y.len();
+    for (k, v) in y.iter_mut().enumerate() {
+        *v += 1e-3 * ((k as f64) * 0.37).sin();
+    }
+    sys.project(0.0, &mut y).unwrap();
+    let p: Vec<f64> = names.iter().map(|q| sys.param_value(*q).unwrap()).collect();
+    let dir = |w: &mut _, vp: [f64; 2]| {
+        let mut out = vec![0.0; n];
+        sys.rhs_dir(w, 0.2, &y, (&names, &p), (None, Some(&vp)), &mut out);
+        out
+    };
+    let mut reused = sys.work(n);
+    let first = dir(&mut reused, [0.3, 0.7]);
+    let second = dir(&mut reused, [0.5, -0.2]);
+    let fresh = dir(&mut sys.work(n), [0.5, -0.2]);
+    let e1 = dir(&mut sys.work(n), [1.0, 0.0]);
+    let e2 = dir(&mut sys.work(n), [0.0, 1.0]);
+    let scale = fresh.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(scale > 0.0, "the design seeds move the right-hand side");
+    let moved = first
+        .iter()
+        .zip(&fresh)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        moved > 1e-3 * scale,
+        "the two directions give different products"
+    );
+    for k in 0..n {
+        assert!(
+            (second[k] - fresh[k]).abs() <= 1e-13 * scale,
+            "row {k}: reused workspace {:e}, fresh {:e}",
+            second[k],
+            fresh[k]
+        );
+        let lin = 0.5 * e1[k] - 0.2 * e2[k];
+        // Linear to the rounding of the regularised constraint-space
+        // solve (measured 5e-12 of the largest entry).
+        assert!(
+            (fresh[k] - lin).abs() <= 1e-10 * scale,
+            "row {k}: {:e} against 0.5 e1 - 0.2 e2 = {lin:e}",
+            fresh[k]
+        );
+    }
+}
+
+#[test]
 fn slow_spin_up_follows_the_quasi_static_deflection() {
     // studies/beam_spinup.toml: once the hub torque holds (t > 2 s) the
     // angular acceleration α is constant and the tip lags by the
