@@ -10,72 +10,47 @@
 
 use nalgebra::{Matrix3, RealField, Vector3};
 
-/// The scalar types of the kernel: `f64` and `num_dual::Dual64`.
-/// `is_exact_zero` is true only when every component is exactly zero: the
-/// factorization skips structural zeros of sparse matrices by value without
-/// ever dropping a derivative.
+/// The scalar types of the kernel: `f64`, and dual numbers with `NL`
+/// derivative lanes (`num_dual::Dual64`, `num_dual::DualSVec64<N>`).
+/// `is_exact_zero` is true only when every component is exactly zero.
 ///
 /// The two symmetric positive definite solves of a right-hand side (the
-/// constraint-space matrix and the dense mass of a flexible body) go
-/// through this trait so that a dual-number evaluation differentiates them
-/// analytically, reusing one real factorization, instead of running the
-/// factorization in dual arithmetic (docs/numerics.md): for `A x = b`,
-/// `x' = A⁻¹(b' − A' x)` with the factor of the real part of `A`.
+/// constraint-space matrix and the dense mass of a flexible body) are not
+/// run in dual arithmetic: the solve is real, and a dual evaluation adds
+/// its tangent with the same factorizations ([`super::solve`],
+/// docs/numerics.md); the parts accessors below split a number into its
+/// real part and lanes for that.
 pub trait Scalar: RealField + Copy {
+    /// Number of derivative lanes (0 for `f64`).
+    const NL: usize;
+
     fn is_exact_zero(&self) -> bool;
 
-    /// Factor the constraint-space matrix `a` (lower triangle, row-major
-    /// `m × m`) in place as [`ordered_cholesky`] does; for dual numbers
-    /// the factor of the real matrix goes to `scratch` and the dual parts
-    /// of `a` keep `A' + reg·diag(A')`, for [`Scalar::spd_solve`] with the
-    /// same scratch.
-    fn spd_factor(
-        a: &mut [Self],
-        m: usize,
-        scale: &mut Vec<Self>,
-        tols: (f64, f64),
-        scratch: &mut SpdScratch,
-    ) -> Factored;
+    /// The real part.
+    fn re_part(&self) -> f64;
 
-    /// Solve with the factor of [`Scalar::spd_factor`] (`b` overwritten).
-    fn spd_solve(
-        a: &[Self],
-        m: usize,
-        scale: &[Self],
-        f: Factored,
-        b: &mut [Self],
-        scratch: &mut SpdScratch,
-    );
+    /// Derivative lane `l < NL`.
+    fn lane_part(&self, l: usize) -> f64;
+
+    /// The number with real part `re` and lanes `lanes` (length `NL`).
+    fn from_parts(re: f64, lanes: &[f64]) -> Self;
 
     /// Factor a dense SPD matrix (row-major `n × n`, both triangles) in
-    /// place for [`Scalar::gram_rows`]; `false` at a non-positive pivot.
-    /// The real parts become the explicit inverse `A⁻¹` ([`spd_inverse`]):
-    /// every later solve is a matrix–vector product of independent sums
-    /// instead of a pair of triangular solves, whose sequential
-    /// divisions dominate at the flexible bodies' `n` ≈ 20 (one solve per
-    /// constraint row touching the body).
+    /// place; `false` at a non-positive pivot. The real parts become the
+    /// explicit inverse `A⁻¹` ([`spd_inverse`]), so that every later solve
+    /// is a matrix–vector product of independent sums instead of a pair
+    /// of triangular solves, whose sequential divisions dominate at the
+    /// flexible bodies' `n` ≈ 20 (one solve per constraint row touching
+    /// the body); the lanes of a dual number keep `A'`.
     fn dense_factor(a: &mut [Self], n: usize) -> bool;
-
-    /// One body's block of the constraint-space matrix: for the
-    /// `k = rows.len() / n` vectors `b_i` (row-major `k × n`: the body's
-    /// constraint rows and its applied force) and the factor of
-    /// [`Scalar::dense_factor`], `w_i = A⁻¹ b_i` into `w` (`k × n`) and
-    /// the Gram block `g_ij = b_i · w_j`, `j ≤ i`, into `g` (row-major
-    /// `k × k`, lower triangle). Dual numbers do every lane with real
-    /// matrix–vector products ([`lanes_gram_rows`]).
-    fn gram_rows(fac: &[Self], n: usize, rows: &[Self], w: &mut Vec<Self>, g: &mut Vec<Self>);
 }
 
-/// Real scratch storage of [`Scalar::spd_factor`] / [`Scalar::spd_solve`],
+/// Real scratch storage of [`spd_factor`] / [`spd_solve`],
 /// with the symbolic factorization they follow ([`SpdScratch::set_pattern`];
 /// a dense pattern when none of the matrix's size was set).
 #[derive(Debug, Clone, Default)]
 pub struct SpdScratch {
     pattern: CholPattern,
-    scale: Vec<f64>,
-    re: Vec<f64>,
-    x: Vec<f64>,
-    r: Vec<f64>,
     tmp: Vec<f64>,
 }
 
@@ -158,47 +133,72 @@ impl CholPattern {
 }
 
 impl Scalar for f64 {
+    const NL: usize = 0;
     #[inline]
     fn is_exact_zero(&self) -> bool {
         *self == 0.0
     }
-    fn spd_factor(
-        a: &mut [f64],
-        m: usize,
-        scale: &mut Vec<f64>,
-        tols: (f64, f64),
-        sc: &mut SpdScratch,
-    ) -> Factored {
-        ordered_cholesky(a, m, scale, tols, sc.pattern(m))
+    #[inline]
+    fn re_part(&self) -> f64 {
+        *self
     }
-    fn spd_solve(
-        a: &[f64],
-        m: usize,
-        scale: &[f64],
-        f: Factored,
-        b: &mut [f64],
-        sc: &mut SpdScratch,
-    ) {
-        sc.pattern(m);
-        cholesky_solve(a, (scale, &sc.pattern), f.accepted, b, &mut sc.tmp);
+    #[inline]
+    fn lane_part(&self, _l: usize) -> f64 {
+        0.0
+    }
+    #[inline]
+    fn from_parts(re: f64, _lanes: &[f64]) -> f64 {
+        re
     }
     fn dense_factor(a: &mut [f64], n: usize) -> bool {
         spd_inverse(a, n)
     }
-    fn gram_rows(fac: &[f64], n: usize, rows: &[f64], w: &mut Vec<f64>, g: &mut Vec<f64>) {
-        let k = rows.len() / n;
-        w.clear();
-        w.resize(k * n, 0.0);
-        for (b, wi) in rows.chunks_exact(n).zip(w.chunks_exact_mut(n)) {
-            sym_times(fac, n, b, wi);
-        }
-        g.clear();
-        g.resize(k * k, 0.0);
-        for i in 0..k {
-            let bi = &rows[i * n..(i + 1) * n];
-            for j in 0..=i {
-                g[i * k + j] = fdot(bi, &w[j * n..(j + 1) * n]);
-            }
+}
+
+/// Factor the constraint-space matrix `a` (lower triangle, row-major
+/// `m × m`) in place by [`ordered_cholesky`] on the pattern of `sc`.
+pub fn spd_factor(
+    a: &mut [f64],
+    m: usize,
+    scale: &mut Vec<f64>,
+    tols: (f64, f64),
+    sc: &mut SpdScratch,
+) -> Factored {
+    ordered_cholesky(a, m, scale, tols, sc.pattern(m))
+}
+
+/// Solve with the factor of [`spd_factor`] (`b` overwritten).
+pub fn spd_solve(
+    a: &[f64],
+    m: usize,
+    scale: &[f64],
+    f: Factored,
+    b: &mut [f64],
+    sc: &mut SpdScratch,
+) {
+    sc.pattern(m);
+    cholesky_solve(a, (scale, &sc.pattern), f.accepted, b, &mut sc.tmp);
+}
+
+/// One body's block of the constraint-space matrix: for the
+/// `k = rows.len() / n` vectors `b_i` (row-major `k × n`: the body's
+/// constraint rows and its applied force) and the inverse mass `minv`
+/// (`n × n`, symmetric), `w_i = M⁻¹ b_i` into `w` (`k × n`) and the Gram
+/// block `g_ij = b_i · w_j`, `j ≤ i`, into `g` (row-major `k × k`, lower
+/// triangle).
+pub fn gram_rows(minv: &[f64], n: usize, rows: &[f64], w: &mut Vec<f64>, g: &mut Vec<f64>) {
+    let k = rows.len() / n;
+    w.clear();
+    w.resize(k * n, 0.0);
+    for (b, wi) in rows.chunks_exact(n).zip(w.chunks_exact_mut(n)) {
+        sym_times(minv, n, b, wi);
+    }
+    g.clear();
+    g.resize(k * k, 0.0);
+    for i in 0..k {
+        let bi = &rows[i * n..(i + 1) * n];
+        for j in 0..=i {
+            g[i * k + j] = fdot(bi, &w[j * n..(j + 1) * n]);
         }
     }
 }
@@ -235,8 +235,6 @@ pub trait Lanes: Copy {
     fn with(re: f64, lanes: &[f64]) -> Self;
     /// Replace the real part (the dual parts are kept).
     fn set_re(&mut self, re: f64);
-    /// Scale every dual part by `c`.
-    fn scale_lanes(&mut self, c: f64);
     /// Whether every component is exactly zero.
     fn all_zero(&self) -> bool {
         self.re() == 0.0 && (0..Self::L).all(|k| self.lane(k) == 0.0)
@@ -260,10 +258,6 @@ impl Lanes for num_dual::Dual64 {
     #[inline]
     fn set_re(&mut self, re: f64) {
         self.re = re;
-    }
-    #[inline]
-    fn scale_lanes(&mut self, c: f64) {
-        self.eps *= c;
     }
 }
 
@@ -291,92 +285,12 @@ impl<const N: usize> Lanes for num_dual::DualSVec64<N> {
     fn set_re(&mut self, re: f64) {
         self.re = re;
     }
-    #[inline]
-    fn scale_lanes(&mut self, c: f64) {
-        if let Some(e) = self.eps.0.as_mut() {
-            *e *= c;
-        }
-    }
-}
-
-/// [`Scalar::spd_factor`] for dual numbers: the real factor and scaling go
-/// to the scratch; the dual parts of `a` keep `A' + reg·diag(A')`.
-fn lanes_spd_factor<D: Lanes>(
-    a: &mut [D],
-    m: usize,
-    tols: (f64, f64),
-    sc: &mut SpdScratch,
-) -> Factored {
-    sc.re.clear();
-    sc.re.extend(a.iter().map(|v| v.re()));
-    sc.pattern(m);
-    let f = ordered_cholesky(&mut sc.re, m, &mut sc.scale, tols, &sc.pattern);
-    for k in 0..m {
-        // The regularised system is (A + reg·diag(A)) x = b.
-        a[k * m + k].scale_lanes(1.0 + tols.1);
-    }
-    f
-}
-
-/// [`Scalar::spd_solve`] for dual numbers: `x = A⁻¹b` on the real parts,
-/// then per lane `x'_l = A⁻¹(b'_l − A'_l x)` with the same real factor
-/// (`a` symmetric, lower triangle stored). `sc.r` holds the lanes
-/// lane-major.
-fn lanes_spd_solve<D: Lanes>(a: &[D], m: usize, f: Factored, b: &mut [D], sc: &mut SpdScratch) {
-    debug_assert_eq!(sc.re.len(), a.len());
-    let nl = D::L;
-    sc.x.clear();
-    sc.x.extend(b.iter().map(|v| v.re()));
-    let pat = &sc.pattern;
-    cholesky_solve(&sc.re, (&sc.scale, pat), f.accepted, &mut sc.x, &mut sc.tmp);
-    sc.r.clear();
-    sc.r.resize(m * nl, 0.0);
-    for (i, v) in b.iter().enumerate() {
-        for l in 0..nl {
-            sc.r[l * m + i] = v.lane(l);
-        }
-    }
-    for i in 0..m {
-        for &j in pat.row_cols[i].iter().chain(std::iter::once(&i)) {
-            let e = &a[i * m + j];
-            for l in 0..nl {
-                let el = e.lane(l);
-                if el != 0.0 {
-                    sc.r[l * m + i] -= el * sc.x[j];
-                    if i != j {
-                        sc.r[l * m + j] -= el * sc.x[i];
-                    }
-                }
-            }
-        }
-    }
-    for l in 0..nl {
-        let r = &mut sc.r[l * m..(l + 1) * m];
-        cholesky_solve(&sc.re, (&sc.scale, pat), f.accepted, r, &mut sc.tmp);
-    }
-    let mut lanes = [0.0f64; 8];
-    let mut lv = Vec::new();
-    let buf: &mut [f64] = if nl <= 8 {
-        &mut lanes[..nl]
-    } else {
-        lv.resize(nl, 0.0);
-        &mut lv
-    };
-    for (i, v) in b.iter_mut().enumerate() {
-        for (l, u) in buf.iter_mut().enumerate() {
-            *u = sc.r[l * m + i];
-        }
-        *v = D::with(sc.x[i], buf);
-    }
 }
 
 /// [`Scalar::dense_factor`] for dual numbers: the real parts become the
-/// explicit inverse `A⁻¹` (both triangles, from the Cholesky factor of
-/// the real matrix: `n` solves, about `n³` flops, once per evaluation),
-/// the dual parts keep `A'`. Every later solve is then matrix–vector
-/// products with independent sums instead of triangular solves, whose
-/// sequential divisions dominate at the flexible bodies' `n` ≈ 20 (one
-/// solve per constraint row touching the body and lane).
+/// explicit inverse `A⁻¹` of the real matrix ([`spd_inverse`]), the dual
+/// parts keep `A'`, which the tangent of the constraint-space solve reads
+/// (`super::solve`).
 fn lanes_dense_factor<D: Lanes>(a: &mut [D], n: usize) -> bool {
     let mut inv: Vec<f64> = a.iter().map(|v| v.re()).collect();
     let ok = spd_inverse(&mut inv, n);
@@ -452,124 +366,28 @@ pub fn sym_times(s: &[f64], n: usize, x: &[f64], out: &mut [f64]) {
     }
 }
 
-/// [`Scalar::gram_rows`] for dual numbers with the inverse of
-/// [`lanes_dense_factor`] (real parts `S = A⁻¹`, dual parts `A'_l`, the
-/// full matrix). With `b_i = β_i + Σ_l ε_l β'_il`:
-/// - `w_i = S β_i`, and per lane `w'_il = S(β'_il − A'_l w_i)` (from
-///   `A w = b`: `A w' = b' − A' w`);
-/// - `g_ij = β_i·w_j`, and per lane `g'_ijl = β'_il·w_j + β_i·w'_jl`.
-///
-/// The matrices and vectors are split once into real planes, so every
-/// product is an `f64` vector operation (no dual arithmetic, and the
-/// inverse and `A'_l` are read out once per body instead of once per
-/// vector).
-fn lanes_gram_rows<D: Lanes>(fac: &[D], n: usize, rows: &[D], w: &mut Vec<D>, g: &mut Vec<D>) {
-    thread_local! {
-        static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
-    }
-    let nl = D::L;
-    let k = rows.len() / n;
-    let (nn, kn) = (n * n, k * n);
-    SCRATCH.with_borrow_mut(|buf| {
-        buf.clear();
-        buf.resize(
-            nn * (1 + nl) + 2 * kn * (1 + nl) + n + k * k * (1 + nl) + nl,
-            0.0,
-        );
-        let (sm, rest) = buf.split_at_mut(nn);
-        let (ap, rest) = rest.split_at_mut(nn * nl);
-        let (bp, rest) = rest.split_at_mut(kn * (1 + nl));
-        let (wp, rest) = rest.split_at_mut(kn * (1 + nl));
-        let (tmp, rest) = rest.split_at_mut(n);
-        let (gp, lanes) = rest.split_at_mut(k * k * (1 + nl));
-        for (i, v) in fac.iter().enumerate() {
-            sm[i] = v.re();
-            for l in 0..nl {
-                ap[l * nn + i] = v.lane(l);
-            }
-        }
-        for (i, v) in rows.iter().enumerate() {
-            bp[i] = v.re();
-            for l in 0..nl {
-                bp[(1 + l) * kn + i] = v.lane(l);
-            }
-        }
-        let (w_re, w_lanes) = wp.split_at_mut(kn);
-        for i in 0..k {
-            let r = i * n..(i + 1) * n;
-            sym_times(sm, n, &bp[r.clone()], &mut w_re[r.clone()]);
-            for l in 0..nl {
-                sym_times(&ap[l * nn..(l + 1) * nn], n, &w_re[r.clone()], tmp);
-                let bl = &bp[(1 + l) * kn..][r.clone()];
-                for (t, b) in tmp.iter_mut().zip(bl) {
-                    *t = b - *t;
-                }
-                sym_times(sm, n, tmp, &mut w_lanes[l * kn..][r.clone()]);
-            }
-        }
-        let (b_re, b_lanes) = bp.split_at(kn);
-        for i in 0..k {
-            let bi = &b_re[i * n..(i + 1) * n];
-            for j in 0..=i {
-                let wj = &w_re[j * n..(j + 1) * n];
-                gp[i * k + j] = fdot(bi, wj);
-                for l in 0..nl {
-                    let bil = &b_lanes[l * kn + i * n..l * kn + (i + 1) * n];
-                    let wjl = &w_lanes[l * kn + j * n..l * kn + (j + 1) * n];
-                    gp[(1 + l) * k * k + i * k + j] = fdot(bil, wj) + fdot(bi, wjl);
-                }
-            }
-        }
-        w.clear();
-        for i in 0..kn {
-            for (l, u) in lanes.iter_mut().enumerate() {
-                *u = w_lanes[l * kn + i];
-            }
-            w.push(D::with(w_re[i], lanes));
-        }
-        g.clear();
-        for i in 0..k * k {
-            for (l, u) in lanes.iter_mut().enumerate() {
-                *u = gp[(1 + l) * k * k + i];
-            }
-            g.push(D::with(gp[i], lanes));
-        }
-    })
-}
-
 /// [`Scalar`] for a dual-number type through its [`Lanes`].
 macro_rules! lanes_scalar {
     () => {
+        const NL: usize = <Self as Lanes>::L;
         #[inline]
         fn is_exact_zero(&self) -> bool {
             self.all_zero()
         }
-        fn spd_factor(
-            a: &mut [Self],
-            m: usize,
-            scale: &mut Vec<Self>,
-            tols: (f64, f64),
-            sc: &mut SpdScratch,
-        ) -> Factored {
-            // The real factor and scaling stay in the scratch.
-            scale.clear();
-            lanes_spd_factor(a, m, tols, sc)
+        #[inline]
+        fn re_part(&self) -> f64 {
+            self.re()
         }
-        fn spd_solve(
-            a: &[Self],
-            m: usize,
-            _scale: &[Self],
-            f: Factored,
-            b: &mut [Self],
-            sc: &mut SpdScratch,
-        ) {
-            lanes_spd_solve(a, m, f, b, sc)
+        #[inline]
+        fn lane_part(&self, l: usize) -> f64 {
+            self.lane(l)
+        }
+        #[inline]
+        fn from_parts(re: f64, lanes: &[f64]) -> Self {
+            Self::with(re, lanes)
         }
         fn dense_factor(a: &mut [Self], n: usize) -> bool {
             lanes_dense_factor(a, n)
-        }
-        fn gram_rows(fac: &[Self], n: usize, rows: &[Self], w: &mut Vec<Self>, g: &mut Vec<Self>) {
-            lanes_gram_rows(fac, n, rows, w, g)
         }
     };
 }
@@ -1079,126 +897,55 @@ mod tests {
     }
 
     #[test]
-    #[allow(clippy::needless_range_loop)] // lanes and rows index the formulas
-    fn multi_lane_dual_solves_match_central_differences() {
-        // Independent check of the lanes x'_q = A⁻¹(b'_q − A'_q x): central
-        // differences of plain f64 solves of A(ε) x = b(ε) in each ε_q.
-        use num_dual::{Dual64, DualSVec64};
+    fn inverse_mass_and_gram_blocks() {
+        // The explicit inverse of dense_factor against A·A⁻¹ = I, the Gram
+        // block of gram_rows against triangular solves (dense_cholesky)
+        // and plain dot products, and the dual form: real parts the
+        // inverse of the real matrix, lanes the matrix's derivative A'
+        // (what the tangent of the constraint-space solve reads).
+        use num_dual::DualSVec64;
         let n = 6;
-        let solve_f64 = |e: [f64; 2]| {
-            let (mut a, mut x) = perturbed_system(n, e);
-            assert!(dense_cholesky(&mut a, n));
-            dense_cholesky_solve(&a, n, &mut x);
-            x
-        };
-        let h = 1e-5;
-        let fd: Vec<Vec<f64>> = (0..2)
-            .map(|q| {
-                let mut ep = [0.0; 2];
-                ep[q] = h;
-                let xp = solve_f64(ep);
-                ep[q] = -h;
-                let xm = solve_f64(ep);
-                xp.iter()
-                    .zip(&xm)
-                    .map(|(p, m)| (p - m) / (2.0 * h))
-                    .collect()
-            })
-            .collect();
         let (a0, b0) = perturbed_system(n, [0.0; 2]);
-        let (a1, b1) = perturbed_system(n, [1.0, 0.0]);
-        let (a2, b2) = perturbed_system(n, [0.0, 1.0]);
-        let lanes = |v0: &[f64], v1: &[f64], v2: &[f64], k: usize| [v1[k] - v0[k], v2[k] - v0[k]];
-        let mut a: Vec<DualSVec64<2>> = (0..n * n)
-            .map(|k| DualSVec64::<2>::with(a0[k], &lanes(&a0, &a1, &a2, k)))
-            .collect();
-        let mut x: Vec<DualSVec64<2>> = (0..n)
-            .map(|k| DualSVec64::<2>::with(b0[k], &lanes(&b0, &b1, &b2, k)))
-            .collect();
-        assert!(<DualSVec64<2> as Scalar>::dense_factor(&mut a, n));
-        // Two vectors in one Gram block: b and 2b, so w = (x, 2x) and
-        // g = (b·x, 2b·x; ·, 4b·x).
-        let rows: Vec<DualSVec64<2>> = x.iter().chain(x.iter()).copied().collect();
-        let mut rows2 = rows.clone();
-        for v in rows2[n..].iter_mut() {
-            *v *= DualSVec64::<2>::from(2.0);
+        let (a1, _) = perturbed_system(n, [1.0, 0.0]);
+        let (a2, _) = perturbed_system(n, [0.0, 1.0]);
+        let mut inv = a0.clone();
+        assert!(<f64 as Scalar>::dense_factor(&mut inv, n));
+        for i in 0..n {
+            for j in 0..n {
+                let p: f64 = (0..n).map(|k| a0[i * n + k] * inv[k * n + j]).sum();
+                let e = if i == j { 1.0 } else { 0.0 };
+                assert!((p - e).abs() < 1e-12, "(A A⁻¹)[{i}][{j}] = {p}");
+            }
         }
+        // Two vectors b and 2b: w = (x, 2x), g = (b·x; 2b·x, 4b·x).
+        let mut l = a0.clone();
+        assert!(dense_cholesky(&mut l, n));
+        let mut x = b0.clone();
+        dense_cholesky_solve(&l, n, &mut x);
+        let rows: Vec<f64> = b0
+            .iter()
+            .chain(b0.iter())
+            .enumerate()
+            .map(|(k, v)| if k < n { *v } else { 2.0 * v })
+            .collect();
         let (mut w, mut g) = (Vec::new(), Vec::new());
-        <DualSVec64<2> as Scalar>::gram_rows(&a, n, &rows2, &mut w, &mut g);
-        let bx = (0..n).fold(DualSVec64::<2>::from(0.0), |s, k| s + rows[k] * w[k]);
-        for (got, want) in [(g[0], bx), (g[2], bx * 2.0), (g[3], bx * 4.0)] {
-            assert!((got.re - want.re).abs() < 1e-12 * (1.0 + want.re.abs()));
-            for q in 0..2 {
-                assert!((got.lane(q) - want.lane(q)).abs() < 1e-11 * (1.0 + want.lane(q).abs()));
-            }
-        }
+        gram_rows(&inv, n, &rows, &mut w, &mut g);
+        let bx: f64 = (0..n).map(|k| b0[k] * x[k]).sum();
         for k in 0..n {
-            assert!((w[n + k] - w[k] * 2.0).re.abs() < 1e-12 * (1.0 + w[k].re.abs()));
+            assert!((w[k] - x[k]).abs() < 1e-12 * (1.0 + x[k].abs()));
+            assert!((w[n + k] - 2.0 * x[k]).abs() < 1e-12 * (1.0 + x[k].abs()));
         }
-        x.copy_from_slice(&w[..n]);
-        let plain = solve_f64([0.0; 2]);
-        for k in 0..n {
-            assert!((x[k].re - plain[k]).abs() < 1e-12 * (1.0 + plain[k].abs()));
-            for q in 0..2 {
-                let err = (x[k].lane(q) - fd[q][k]).abs();
-                assert!(
-                    err < 1e-7 * (1.0 + fd[q][k].abs()),
-                    "lane {q} row {k}: {err}"
-                );
-            }
+        for (got, want) in [(g[0], bx), (g[2], 2.0 * bx), (g[3], 4.0 * bx)] {
+            assert!((got - want).abs() < 1e-12 * (1.0 + want.abs()));
         }
-        // The one-lane type gives lane 0 alike (same formula).
-        let mut a: Vec<Dual64> = (0..n * n)
-            .map(|k| Dual64::new(a0[k], a1[k] - a0[k]))
+        let mut ad: Vec<DualSVec64<2>> = (0..n * n)
+            .map(|k| DualSVec64::<2>::with(a0[k], &[a1[k] - a0[k], a2[k] - a0[k]]))
             .collect();
-        let mut x1: Vec<Dual64> = (0..n).map(|k| Dual64::new(b0[k], b1[k] - b0[k])).collect();
-        assert!(<Dual64 as Scalar>::dense_factor(&mut a, n));
-        let (mut w1, mut g1) = (Vec::new(), Vec::new());
-        <Dual64 as Scalar>::gram_rows(&a, n, &x1, &mut w1, &mut g1);
-        x1.copy_from_slice(&w1);
-        // The plain f64 form gives the real parts alike.
-        let mut af: Vec<f64> = a0.clone();
-        assert!(<f64 as Scalar>::dense_factor(&mut af, n));
-        let (mut wf, mut gf) = (Vec::new(), Vec::new());
-        <f64 as Scalar>::gram_rows(&af, n, &b0, &mut wf, &mut gf);
-        for k in 0..n {
-            assert!((wf[k] - plain[k]).abs() < 1e-12 * (1.0 + plain[k].abs()));
-        }
-        assert!((gf[0] - g1[0].re).abs() < 1e-12 * (1.0 + gf[0].abs()));
-        for k in 0..n {
-            assert!((x1[k].eps - x[k].lane(0)).abs() < 1e-12 * (1.0 + x1[k].eps.abs()));
-        }
-        // The constraint-space solve (lower triangle, regularised) with
-        // the same lanes; the shift makes it A + reg·diag(A).
-        let reg = 1e-12;
-        let mut al: Vec<DualSVec64<2>> = (0..n * n)
-            .map(|k| {
-                let (i, j) = (k / n, k % n);
-                let v = DualSVec64::<2>::with(a0[k], &lanes(&a0, &a1, &a2, k));
-                if j <= i {
-                    v
-                } else {
-                    DualSVec64::<2>::from_re(0.0)
-                }
-            })
-            .collect();
-        let mut xs: Vec<DualSVec64<2>> = (0..n)
-            .map(|k| DualSVec64::<2>::with(b0[k], &lanes(&b0, &b1, &b2, k)))
-            .collect();
-        let mut sc = SpdScratch::default();
-        let mut scale = Vec::new();
-        let f =
-            <DualSVec64<2> as Scalar>::spd_factor(&mut al, n, &mut scale, (1e-14, reg), &mut sc);
-        assert_eq!(f.rank, n);
-        <DualSVec64<2> as Scalar>::spd_solve(&al, n, &scale, f, &mut xs, &mut sc);
-        for k in 0..n {
-            for q in 0..2 {
-                let err = (xs[k].lane(q) - fd[q][k]).abs();
-                assert!(
-                    err < 1e-7 * (1.0 + fd[q][k].abs()),
-                    "spd lane {q} row {k}: {err}"
-                );
-            }
+        assert!(<DualSVec64<2> as Scalar>::dense_factor(&mut ad, n));
+        for k in 0..n * n {
+            assert!((ad[k].re - inv[k]).abs() < 1e-14 * (1.0 + inv[k].abs()));
+            assert_eq!(ad[k].lane(0), a1[k] - a0[k]);
+            assert_eq!(ad[k].lane(1), a2[k] - a0[k]);
         }
     }
 }

@@ -1,125 +1,176 @@
-//! The per-evaluation linear algebra of [`System`]: `M⁻¹` per body and
-//! the constraint-space solve for the multipliers and accelerations (see
-//! the method in [`super::dynamics`]).
+//! The per-evaluation linear algebra of [`System`]: the constraint-space
+//! solve for the multipliers and accelerations, body by body (the method
+//! is in [`super::dynamics`]), in real arithmetic, and its tangent for
+//! the lanes of a dual-number evaluation.
+//!
+//! # Tangent
+//! The solve gives `v̇ = M⁻¹(Q + Gᵀλ)` with `(A + εD) λ = γ − G M⁻¹ Q`,
+//! `A = G M⁻¹ Gᵀ`, `D = diag(A)` and `ε` = [`RANK_REG`] (the regularised
+//! system that [`super::linalg::ordered_cholesky`] factors). A dual
+//! evaluation carries, per lane, the derivatives `G'`, `M'`, `Q'`, `γ'`
+//! of the assembled quantities. Differentiating `M v̇ = Q + Gᵀλ` and the
+//! equation for λ gives, with `r₁ = Q' − M' v̇ + G'ᵀλ` and
+//! `r₂ = γ' − G' v̇`,
+//!
+//! ```text
+//!   (A + εD) λ' = r₂ − G M⁻¹ r₁ − ε D' λ,     v̇' = M⁻¹ (r₁ + Gᵀ λ'),
+//! ```
+//!
+//! `D'_ii = Σ_b (2 d'_i·w_i − w_iᵀ M'_b w_i)` (`w_i = M_b⁻¹ d_i`). Every
+//! solve reuses the real factorizations (the constraint-space Cholesky and
+//! each body's inverse mass), and no derivative of `A` is ever formed: a
+//! lane costs one product with each `M'_b`, `M_b⁻¹` and the rows, and one
+//! constraint-space solve.
 
 use super::dynamics::{pval, System, Workspace, RANK_REG, RANK_TOL, RIGID};
-use super::linalg::{cst, min_degree_order, CholPattern, Scalar};
+use super::linalg::Factored;
+use super::linalg::{
+    fdot, gram_rows, min_degree_order, spd_factor, spd_solve, sym_times, CholPattern, Scalar,
+};
 use super::model::Param;
-use super::workspace::BodyBlock;
-use nalgebra::Vector3;
+use super::workspace::{BodyBlock, SolveScratch};
 
 impl System {
-    /// `M⁻¹ x` for rigid slot `s` (in place): `diag(1/m, J'⁻¹)`.
-    fn rigid_minv<T: Scalar>(&self, params: &[(Param, T)], s: usize, x: &mut [T]) {
-        let b = self.moving[s];
-        let body = &self.model.bodies[b];
-        let im = T::one() / pval(params, Param::Mass(b), body.mass);
-        let w = body.inv_inertia.map(cst::<T>) * Vector3::new(x[3], x[4], x[5]);
+    /// `M⁻¹ x` of slot `s` in real arithmetic (into `out`): a flexible
+    /// body by its inverse mass, a rigid one by `diag(1/m, J'⁻¹)`.
+    fn minv_times(&self, bb: &BodyBlock, s: usize, x: &[f64], out: &mut [f64]) {
+        if self.modes[s] > 0 {
+            sym_times(&bb.minv, self.dof(s), x, out);
+            return;
+        }
+        let ji = &self.model.bodies[self.moving[s]].inv_inertia;
         for c in 0..3 {
-            x[c] *= im;
-            x[3 + c] = w[c];
+            out[c] = x[c] * bb.inv_mass;
+            out[3 + c] = ji[(c, 0)] * x[3] + ji[(c, 1)] * x[4] + ji[(c, 2)] * x[5];
         }
     }
 
-    /// Gather every body's block: the rows touching it (`d`: the row's
-    /// `[∂/∂ṙ, ∂/∂ω', ∂/∂ẇ]` entries of that body) and, last, its applied
-    /// force `Q`; then `w = M⁻¹d`, `M⁻¹Q` and the Gram block `d_i·M⁻¹d_j`
-    /// of each body ([`Scalar::gram_rows`] for flexible bodies).
+    /// Gather every body's block (real parts and lanes): the rows touching
+    /// it (`d`: the row's `[∂/∂ṙ, ∂/∂ω', ∂/∂ẇ]` entries of that body) and,
+    /// last, its applied force `Q`; then, in real arithmetic, `w = M⁻¹d`,
+    /// `M⁻¹Q` and the Gram block `d_i·M⁻¹d_j` of each body.
     fn body_blocks<T: Scalar>(&self, ws: &mut Workspace<T>) {
         let nb = self.nb();
+        let nl = T::NL;
         let mut blocks = std::mem::take(&mut ws.blocks);
         blocks.resize_with(nb, BodyBlock::default);
-        for bb in blocks.iter_mut() {
+        let mut vecs = std::mem::take(&mut ws.gather);
+        vecs.resize_with(nb, Vec::new);
+        for (bb, v) in blocks.iter_mut().zip(vecs.iter_mut()) {
             bb.rows.clear();
-            bb.b.clear();
+            v.clear();
         }
         for (r, row) in ws.rows.iter().enumerate() {
             for (side, (slot, blk)) in row.blocks.iter().enumerate() {
                 let Some(s) = *slot else { continue };
                 let d = self.dof(s);
-                let bb = &mut blocks[s];
-                bb.b.extend_from_slice(blk);
+                let v = &mut vecs[s];
+                v.extend_from_slice(blk);
                 if d > 6 {
                     let mo = row.modal[side];
                     if mo == RIGID {
-                        bb.b.extend(std::iter::repeat_n(T::zero(), d - 6));
+                        v.extend(std::iter::repeat_n(T::zero(), d - 6));
                     } else {
-                        bb.b.extend_from_slice(&ws.mjac[mo..mo + d - 6]);
+                        v.extend_from_slice(&ws.mjac[mo..mo + d - 6]);
                     }
                 }
-                bb.rows.push(r);
+                blocks[s].rows.push(r);
             }
         }
-        for (s, bb) in blocks.iter_mut().enumerate() {
+        for (s, (bb, v)) in blocks.iter_mut().zip(vecs.iter_mut()).enumerate() {
             let (o, d) = (self.vel_local(s), self.dof(s));
-            bb.b.extend_from_slice(&ws.q[o..o + d]);
+            v.extend_from_slice(&ws.q[o..o + d]);
+            bb.b.clear();
+            bb.b.extend(v.iter().map(T::re_part));
+            bb.lanes.clear();
+            for l in 0..nl {
+                bb.lanes.extend(v.iter().map(|x| x.lane_part(l)));
+            }
             if self.modes[s] > 0 {
-                T::gram_rows(&ws.mfac[s], d, &bb.b, &mut bb.w, &mut bb.g);
+                bb.minv.clear();
+                bb.minv.extend(ws.mfac[s].iter().map(T::re_part));
+                gram_rows(&bb.minv, d, &bb.b, &mut bb.w, &mut bb.g);
                 continue;
             }
-            bb.w.clone_from(&bb.b);
-            for x in bb.w.chunks_exact_mut(d) {
-                self.rigid_minv(&ws.params, s, x);
-            }
+            let b = self.moving[s];
+            let mass = pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass);
+            bb.inv_mass = 1.0 / mass.re_part();
             let k = bb.rows.len() + 1;
+            bb.w.clear();
+            bb.w.resize(k * d, 0.0);
+            for i in 0..k {
+                let (x, mut out) = (&bb.b[i * d..(i + 1) * d], [0.0; 6]);
+                self.minv_times(bb, s, x, &mut out);
+                bb.w[i * d..(i + 1) * d].copy_from_slice(&out);
+            }
             bb.g.clear();
-            bb.g.resize(k * k, T::zero());
+            bb.g.resize(k * k, 0.0);
             for i in 0..k {
                 for j in 0..=i {
-                    bb.g[i * k + j] = dot(&bb.b[i * d..(i + 1) * d], &bb.w[j * d..(j + 1) * d]);
+                    bb.g[i * k + j] = fdot(&bb.b[i * d..(i + 1) * d], &bb.w[j * d..(j + 1) * d]);
                 }
             }
         }
         ws.blocks = blocks;
+        ws.gather = vecs;
+    }
+
+    /// The fill-reducing order of the constraint-space matrix and its
+    /// symbolic factorization, once per workspace (the rows touching each
+    /// body never change).
+    fn order<T: Scalar>(&self, ws: &mut Workspace<T>) {
+        let m = ws.rows.len();
+        if ws.inv_order.len() == m {
+            return;
+        }
+        let mut edges = Vec::new();
+        for bb in &ws.blocks {
+            for (x, r) in bb.rows.iter().enumerate() {
+                for c in &bb.rows[..x] {
+                    edges.push((*r, *c));
+                }
+            }
+        }
+        let order = min_degree_order(m, &edges);
+        ws.inv_order = vec![0; m];
+        for (k, &r) in order.iter().enumerate() {
+            ws.inv_order[r] = k;
+        }
+        let inv = &ws.inv_order;
+        let permuted: Vec<(usize, usize)> = edges.iter().map(|&(r, c)| (inv[r], inv[c])).collect();
+        ws.spd.set_pattern(CholPattern::new(m, &permuted));
     }
 
     /// Solve for the multipliers and accelerations with the rows, applied
     /// forces and mass factors in `ws`. Returns `v̇` (velocity layout);
-    /// `ws.rhs` = λ.
+    /// `ws.rhs` = λ. Real arithmetic throughout; a dual evaluation adds
+    /// the lanes of the tangent (module doc).
     ///
     /// Structure: `G M⁻¹ Gᵀ = Σ_bodies G_b M_b⁻¹ G_bᵀ`, each body's term a
     /// Gram block of the few rows that touch it ([`System::body_blocks`]);
     /// the matrix is scattered into a fill-reducing order, whose symbolic
-    /// factorization ([`CholPattern`]) is computed once per workspace (the
-    /// rows touching each body never change), and factored on that
-    /// pattern by the rank-counting Cholesky of [`super::linalg`].
+    /// factorization ([`CholPattern`]) is computed once per workspace, and
+    /// factored on that pattern by the rank-counting Cholesky of
+    /// [`super::linalg`].
     pub(crate) fn solve<T: Scalar>(&self, ws: &mut Workspace<T>) -> Vec<T> {
         let m = ws.rows.len();
         self.body_blocks(ws);
+        self.order(ws);
+        let mut sol = std::mem::take(&mut ws.sol);
         // λ's right-hand side γ − G M⁻¹ Q: the force is each block's last
         // vector, so d_i·M⁻¹Q is the block's last Gram row.
-        ws.rhs.clear();
-        ws.rhs.extend(ws.rows.iter().map(|row| row.gamma));
+        sol.rhs.clear();
+        sol.rhs
+            .extend(ws.rows.iter().map(|row| row.gamma.re_part()));
         for bb in &ws.blocks {
             let k = bb.rows.len() + 1;
             for (i, &r) in bb.rows.iter().enumerate() {
-                ws.rhs[r] -= bb.g[(k - 1) * k + i];
+                sol.rhs[r] -= bb.g[(k - 1) * k + i];
             }
-        }
-        // Fill-reducing order, computed once per workspace (the row
-        // structure of a system never changes).
-        if ws.inv_order.len() != m {
-            let mut edges = Vec::new();
-            for bb in &ws.blocks {
-                for (x, r) in bb.rows.iter().enumerate() {
-                    for c in &bb.rows[..x] {
-                        edges.push((*r, *c));
-                    }
-                }
-            }
-            let order = min_degree_order(m, &edges);
-            ws.inv_order = vec![0; m];
-            for (k, &r) in order.iter().enumerate() {
-                ws.inv_order[r] = k;
-            }
-            let inv = &ws.inv_order;
-            let permuted: Vec<(usize, usize)> =
-                edges.iter().map(|&(r, c)| (inv[r], inv[c])).collect();
-            ws.spd.set_pattern(CholPattern::new(m, &permuted));
         }
         let inv = &ws.inv_order;
         ws.a.clear();
-        ws.a.resize(m * m, T::zero());
+        ws.a.resize(m * m, 0.0);
         for bb in &ws.blocks {
             let k = bb.rows.len() + 1;
             for (x, r) in bb.rows.iter().enumerate() {
@@ -135,15 +186,15 @@ impl System {
             ndrop += 1;
             let p = inv[r];
             for c in 0..p {
-                ws.a[p * m + c] = T::zero();
+                ws.a[p * m + c] = 0.0;
             }
             for q in p + 1..m {
-                ws.a[q * m + p] = T::zero();
+                ws.a[q * m + p] = 0.0;
             }
-            ws.a[p * m + p] = T::one();
-            ws.rhs[r] = T::zero();
+            ws.a[p * m + p] = 1.0;
+            sol.rhs[r] = 0.0;
         }
-        let f = T::spd_factor(
+        let f = spd_factor(
             &mut ws.a,
             m,
             &mut ws.scale,
@@ -151,36 +202,169 @@ impl System {
             &mut ws.spd,
         );
         ws.rank = f.rank - ndrop;
-        let mut lam = std::mem::take(&mut ws.rhs);
-        ws.tmp.clear();
-        ws.tmp.resize(m, T::zero());
-        for r in 0..m {
-            ws.tmp[inv[r]] = lam[r];
-        }
-        std::mem::swap(&mut lam, &mut ws.tmp);
-        T::spd_solve(&ws.a, m, &ws.scale, f, &mut lam, &mut ws.spd);
-        ws.tmp.clear();
-        ws.tmp.extend((0..m).map(|r| lam[inv[r]]));
-        std::mem::swap(&mut lam, &mut ws.tmp);
+        let rhs = std::mem::take(&mut sol.rhs);
+        Self::solve_factored(ws, f, &rhs, &mut sol.lam);
+        sol.rhs = rhs;
         // v̇ = M⁻¹Q + Σ_rows (M⁻¹d) λ.
-        let mut acc = vec![T::zero(); self.nvel()];
+        sol.acc.clear();
+        sol.acc.resize(self.nvel(), 0.0);
         for (s, bb) in ws.blocks.iter().enumerate() {
             let (o, d) = (self.vel_local(s), self.dof(s));
             let k = bb.rows.len();
-            let out = &mut acc[o..o + d];
+            let out = &mut sol.acc[o..o + d];
             out.copy_from_slice(&bb.w[k * d..(k + 1) * d]);
             for (i, r) in bb.rows.iter().enumerate() {
-                let w = &bb.w[i * d..(i + 1) * d];
-                for c in 0..d {
-                    out[c] += w[c] * lam[*r];
+                let lam = sol.lam[*r];
+                for (a, w) in out.iter_mut().zip(&bb.w[i * d..(i + 1) * d]) {
+                    *a += w * lam;
                 }
             }
         }
-        ws.rhs = lam;
+        if T::NL > 0 {
+            self.tangent(ws, &mut sol, f);
+        }
+        let nl = T::NL;
+        let mut lanes = vec![0.0; nl];
+        let mut parts = |re: f64, d: &[f64], i: usize, n: usize| {
+            for (l, v) in lanes.iter_mut().enumerate() {
+                *v = d[l * n + i];
+            }
+            T::from_parts(re, &lanes)
+        };
+        let nv = self.nvel();
+        let acc: Vec<T> = (0..nv)
+            .map(|i| parts(sol.acc[i], &sol.dacc, i, nv))
+            .collect();
+        ws.rhs.clear();
+        ws.rhs
+            .extend((0..m).map(|r| parts(sol.lam[r], &sol.dlam, r, m)));
+        ws.sol = sol;
         acc
     }
-}
 
-fn dot<T: Scalar>(a: &[T], b: &[T]) -> T {
-    a.iter().zip(b).fold(T::zero(), |acc, (x, y)| acc + *x * *y)
+    /// `out = (A + εD)⁻¹ b` with the factor `f` in `ws.a` (rows in the
+    /// system's order; the fill-reducing permutation applied and undone).
+    fn solve_factored<T: Scalar>(
+        ws: &mut Workspace<T>,
+        f: Factored,
+        b: &[f64],
+        out: &mut Vec<f64>,
+    ) {
+        let m = b.len();
+        out.clear();
+        out.resize(m, 0.0);
+        for (r, v) in b.iter().enumerate() {
+            out[ws.inv_order[r]] = *v;
+        }
+        spd_solve(&ws.a, m, &ws.scale, f, out, &mut ws.spd);
+        let mut permuted = std::mem::take(&mut ws.perm);
+        permuted.clone_from(out);
+        for (r, o) in out.iter_mut().enumerate() {
+            *o = permuted[ws.inv_order[r]];
+        }
+        ws.perm = permuted;
+    }
+
+    /// The lanes of λ' and v̇' (module doc) into `sol.dlam` and
+    /// `sol.dacc`, from the real solution in `sol` and the lanes of the
+    /// rows, forces and masses in `ws`, with the real constraint-space
+    /// factor `f`.
+    fn tangent<T: Scalar>(&self, ws: &mut Workspace<T>, sol: &mut SolveScratch, f: Factored) {
+        let (m, nv, nl) = (ws.rows.len(), self.nvel(), T::NL);
+        sol.dlam.clear();
+        sol.dlam.resize(nl * m, 0.0);
+        sol.dacc.clear();
+        sol.dacc.resize(nl * nv, 0.0);
+        let mut rhs = vec![0.0; m];
+        let mut dlam = Vec::new();
+        let mut mp = Vec::new();
+        for l in 0..nl {
+            // r₂ = γ' − G'v̇ and, per body, r₁ = Q' − M'v̇ + G'ᵀλ, u = M⁻¹r₁;
+            // the right-hand side r₂ − G u − εD'λ.
+            for (r, row) in ws.rows.iter().enumerate() {
+                rhs[r] = row.gamma.lane_part(l);
+            }
+            let mut dd = vec![0.0; m];
+            for (s, bb) in ws.blocks.iter().enumerate() {
+                let (o, d) = (self.vel_local(s), self.dof(s));
+                let k = bb.rows.len();
+                let a = &sol.acc[o..o + d];
+                let lane = &bb.lanes[l * (k + 1) * d..(l + 1) * (k + 1) * d];
+                let dm = self.mass_lane(ws, s, l, &mut mp);
+                let mass_lane_times = |x: &[f64], out: &mut Vec<f64>| {
+                    out.clear();
+                    out.resize(d, 0.0);
+                    if d > 6 {
+                        sym_times(&mp, d, x, out);
+                    } else {
+                        for c in 0..3 {
+                            out[c] = dm * x[c];
+                        }
+                    }
+                };
+                sol.r1.clear();
+                sol.r1.extend_from_slice(&lane[k * d..(k + 1) * d]);
+                mass_lane_times(a, &mut sol.tmp);
+                for (x, y) in sol.r1.iter_mut().zip(&sol.tmp) {
+                    *x -= y;
+                }
+                for (i, &r) in bb.rows.iter().enumerate() {
+                    let di = &lane[i * d..(i + 1) * d];
+                    let wi = &bb.w[i * d..(i + 1) * d];
+                    rhs[r] -= fdot(di, a);
+                    for (x, y) in sol.r1.iter_mut().zip(di) {
+                        *x += y * sol.lam[r];
+                    }
+                    // D'_rr: 2 d'·w − wᵀM'w of this side.
+                    mass_lane_times(wi, &mut sol.tmp);
+                    dd[r] += 2.0 * fdot(di, wi) - fdot(wi, &sol.tmp);
+                }
+                sol.u.resize(d, 0.0);
+                self.minv_times(bb, s, &sol.r1, &mut sol.u);
+                for (i, &r) in bb.rows.iter().enumerate() {
+                    rhs[r] -= fdot(&bb.w[i * d..(i + 1) * d], &sol.r1);
+                }
+                sol.dacc[l * nv + o..l * nv + o + d].copy_from_slice(&sol.u);
+            }
+            for r in 0..m {
+                if self.dropped(r) {
+                    rhs[r] = 0.0;
+                } else {
+                    rhs[r] -= RANK_REG * dd[r] * sol.lam[r];
+                }
+            }
+            Self::solve_factored(ws, f, &rhs, &mut dlam);
+            // v̇' = u + Σ_rows w λ'.
+            for (s, bb) in ws.blocks.iter().enumerate() {
+                let (o, d) = (self.vel_local(s), self.dof(s));
+                let out = &mut sol.dacc[l * nv + o..l * nv + o + d];
+                for (i, r) in bb.rows.iter().enumerate() {
+                    for (x, w) in out.iter_mut().zip(&bb.w[i * d..(i + 1) * d]) {
+                        *x += w * dlam[*r];
+                    }
+                }
+            }
+            sol.dlam[l * m..(l + 1) * m].copy_from_slice(&dlam);
+        }
+    }
+
+    /// Lane `l` of slot `s`'s mass matrix: a flexible body's `M'_l` into
+    /// `mp` (row-major, from the lanes kept by [`Scalar::dense_factor`]);
+    /// a rigid body's is `diag(m' I, 0)`, and `m'` (the lane of its mass
+    /// parameter) is returned.
+    fn mass_lane<T: Scalar>(
+        &self,
+        ws: &Workspace<T>,
+        s: usize,
+        l: usize,
+        mp: &mut Vec<f64>,
+    ) -> f64 {
+        if self.modes[s] > 0 {
+            mp.clear();
+            mp.extend(ws.mfac[s].iter().map(|v| v.lane_part(l)));
+            return 0.0;
+        }
+        let b = self.moving[s];
+        pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass).lane_part(l)
+    }
 }

@@ -45,10 +45,15 @@ pub struct Row<T: Scalar> {
 #[derive(Debug, Clone)]
 pub struct Workspace<T: Scalar> {
     pub rows: Vec<Row<T>>,
-    pub a: Vec<T>,
+    /// The constraint-space matrix and then its factor (real parts: the
+    /// solve is real, its tangent reuses the factor).
+    pub a: Vec<f64>,
+    /// The multipliers λ after a solve.
     pub rhs: Vec<T>,
-    pub(crate) scale: Vec<T>,
-    pub(crate) tmp: Vec<T>,
+    pub(crate) scale: Vec<f64>,
+    /// Real scratch of the solve: right-hand side and λ, accelerations,
+    /// and per lane of a dual evaluation λ' and v̇'.
+    pub(crate) sol: SolveScratch,
     pub kin: Vec<BodyKin<T>>,
     /// Kinematics of every marker at the current state.
     pub mk: Vec<MarkerKin<T>>,
@@ -62,7 +67,12 @@ pub struct Workspace<T: Scalar> {
     pub(crate) shape_seeds: Vec<Option<Vec<(usize, T)>>>,
     /// Per moving body: the constraint rows touching it and their
     /// products with its inverse mass ([`BodyBlock`]).
-    pub(crate) blocks: Vec<BodyBlock<T>>,
+    pub(crate) blocks: Vec<BodyBlock>,
+    /// Per moving body: its rows' and force's entries as gathered, before
+    /// the split into real parts and lanes.
+    pub(crate) gather: Vec<Vec<T>>,
+    /// Scratch for the permutation of the constraint-space solve.
+    pub(crate) perm: Vec<f64>,
     /// Modal Jacobian entries of the rows' flexible sides.
     pub mjac: Vec<T>,
     /// Position of each row in the fill-reducing order.
@@ -97,27 +107,37 @@ pub struct Workspace<T: Scalar> {
     pub segments: Vec<usize>,
 }
 
-/// One body's share of the constraint-space matrix: the rows touching
-/// the body, their entries `d_i` for its `dof` velocities followed by its
-/// applied force `Q` (`b`, `(k + 1) × dof`), `w = M⁻¹ b` alike, and the
-/// Gram block `g_ij = b_i · w_j` (`(k + 1)²`, lower triangle).
-#[derive(Debug, Clone)]
-pub struct BodyBlock<T> {
+/// One body's share of the constraint-space matrix, in real arithmetic:
+/// the rows touching the body, their entries `d_i` for its `dof`
+/// velocities followed by its applied force `Q` (`b`, `(k + 1) × dof`,
+/// real parts; `lanes`, the same per lane of a dual evaluation), `w =
+/// M⁻¹ b` alike, the Gram block `g_ij = b_i · w_j` (`(k + 1)²`, lower
+/// triangle), and the real inverse mass (`minv`, `dof²`; a rigid body
+/// keeps `1/m` in `inv_mass` and its inertia in the model).
+#[derive(Debug, Clone, Default)]
+pub struct BodyBlock {
     pub(crate) rows: Vec<usize>,
-    pub(crate) b: Vec<T>,
-    pub(crate) w: Vec<T>,
-    pub(crate) g: Vec<T>,
+    pub(crate) b: Vec<f64>,
+    pub(crate) lanes: Vec<f64>,
+    pub(crate) w: Vec<f64>,
+    pub(crate) g: Vec<f64>,
+    pub(crate) minv: Vec<f64>,
+    pub(crate) inv_mass: f64,
 }
 
-impl<T> Default for BodyBlock<T> {
-    fn default() -> Self {
-        BodyBlock {
-            rows: Vec::new(),
-            b: Vec::new(),
-            w: Vec::new(),
-            g: Vec::new(),
-        }
-    }
+/// Real scratch of the constraint-space solve ([`super::solve`]).
+#[derive(Debug, Clone, Default)]
+pub struct SolveScratch {
+    pub(crate) rhs: Vec<f64>,
+    pub(crate) lam: Vec<f64>,
+    pub(crate) acc: Vec<f64>,
+    pub(crate) tmp: Vec<f64>,
+    /// Per lane: λ' (`lanes × m`) and v̇' (`lanes × nvel`).
+    pub(crate) dlam: Vec<f64>,
+    pub(crate) dacc: Vec<f64>,
+    /// One body's `r₁` and `M⁻¹r₁`.
+    pub(crate) r1: Vec<f64>,
+    pub(crate) u: Vec<f64>,
 }
 
 /// Translational and rotational mode-shape rows of a node (n columns each).
