@@ -17,19 +17,26 @@ fn sar_system() -> System {
     System::new(load_scene(&study).unwrap().model)
 }
 
-#[test]
-fn dual_jacobian_vector_product_matches_central_differences() {
-    // SAR scene at a state with non-zero velocities (all terms active):
-    // J v from one Dual64 evaluation vs (f(y + hv) − f(y − hv)) / 2h.
-    let sys = sar_system();
+/// A consistent state of `sys` with non-zero velocities (every velocity
+/// term active) and a direction in the state space.
+fn moving_state(sys: &System) -> (Vec<f64>, Vec<f64>) {
     let mut y = sys.initial_state();
     let vo = sys.voff();
     for (k, v) in y[vo..].iter_mut().enumerate() {
         *v = 0.05 * ((k as f64) * 0.7).sin();
     }
     sys.project(0.0, &mut y).unwrap();
+    let dir = (0..y.len()).map(|k| ((k as f64) * 1.3).cos()).collect();
+    (y, dir)
+}
+
+#[test]
+fn dual_jacobian_vector_product_matches_central_differences() {
+    // SAR scene at a state with non-zero velocities (all terms active):
+    // J v from one Dual64 evaluation vs (f(y + hv) − f(y − hv)) / 2h.
+    let sys = sar_system();
+    let (y, dir) = moving_state(&sys);
     let n = y.len();
-    let dir: Vec<f64> = (0..n).map(|k| ((k as f64) * 1.3).cos()).collect();
     let mut ws = Workspace::empty();
     let mut wsd = Workspace::empty();
     let yd: Vec<Dual64> = (0..n).map(|k| Dual64::new(y[k], dir[k])).collect();
@@ -69,14 +76,8 @@ fn mass_and_state_directions_match_central_differences() {
     let sys = sar_system();
     let b3 = sys.model.body("B3").unwrap();
     let m3 = sys.model.bodies[b3].mass;
-    let mut y = sys.initial_state();
-    let vo = sys.voff();
-    for (k, v) in y[vo..].iter_mut().enumerate() {
-        *v = 0.05 * ((k as f64) * 0.7).sin();
-    }
-    sys.project(0.0, &mut y).unwrap();
+    let (y, dir) = moving_state(&sys);
     let n = y.len();
-    let dir: Vec<f64> = (0..n).map(|k| ((k as f64) * 1.3).cos()).collect();
     let dm = 0.8; // kg per unit of the direction
     let mut wsd = Workspace::empty();
     wsd.params = vec![(Param::Mass(b3), Dual64::new(m3, dm))];
