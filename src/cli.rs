@@ -32,7 +32,7 @@ pub struct Common {
     #[arg(long, short)]
     pub quiet: bool,
     /// Discard an earlier runs.csv instead of keeping it as
-    /// runs-<UTC time>.csv (multistart without --resume).
+    /// `runs-<UTC time>.csv` (multistart without --resume).
     #[arg(long)]
     pub force: bool,
 }
@@ -493,7 +493,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
     row[b.len()]
 }
 
-/// Run every section the study asks for, in the order of [`handlers`]
+/// Run every section the study asks for, in the order of `handlers`
 /// (unknown sections were refused by [`RunConfig::resolve`]).
 pub fn run_study(cfg: &RunConfig) -> Result<()> {
     check_study(&cfg.study)?;

@@ -24,11 +24,10 @@
 //! shift level and are counted ([`RANK_TOL`]); their multipliers take the
 //! minimum-norm split, and the accelerations, which do not depend on that
 //! split, stay unique. One factorization per evaluation (plus the explicit
-//! inverse of each flexible body's mass). A dual-number evaluation factors only the
-//! real parts and differentiates each solve analytically with that same
-//! factor, `x' = A⁻¹(b' − A'x)` ([`Scalar::spd_solve`],
-//! [`Scalar::gram_rows`]): no dual arithmetic inside the factorizations,
-//! no finite differences.
+//! inverse of each flexible body's mass). The solve is real arithmetic for
+//! every scalar type: a dual-number evaluation adds its tangent with the
+//! same factorizations ([`super::solve`] has the formulas), with no dual
+//! arithmetic inside a factorization and no finite differences.
 //!
 //! Markers on nodes of flexible bodies move with the modes
 //! (`x = r + A(s_k + Φ_k w)`) and rotate with them (frame

@@ -202,7 +202,7 @@ impl JointKind {
         }
     }
     /// Names of the constraint equations, in the order
-    /// [`super::rows::joint_rows`] assembles them: `x`, `y`, `z` the
+    /// `super::rows::joint_rows` assembles them: `x`, `y`, `z` the
     /// global components of `x_i − x_j` (coincident points); `xi.zj`,
     /// `yi.zj`, `xi.yj` the dot products of marker axes (parallel axes,
     /// no twist); `angle` the prescribed `θ − f(t)`; `xi.d`, `yi.d` the
