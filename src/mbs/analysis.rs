@@ -399,6 +399,7 @@ impl<T: Scalar> Workspace<T> {
             mk: Vec::new(),
             shapes: Vec::new(),
             shape_seeds: Vec::new(),
+            planes: Vec::new(),
             blocks: Vec::new(),
             gather: Vec::new(),
             perm: Vec::new(),

@@ -45,6 +45,7 @@ use super::linalg::{
     cst, euler_rate, rotation, rotation_tangent, rotation_vector, spd_inverse, sym_times, Scalar,
 };
 use super::model::{Model, Param};
+use super::planes::ShapePlanes;
 use super::rows::joint_rows;
 pub use super::rows::{angle_of, slide_of};
 pub use super::workspace::{
@@ -287,16 +288,17 @@ impl System {
 
     /// Global kinematics of marker `m`.
     pub fn marker_kin<T: Scalar>(&self, kin: &[BodyKin<T>], m: usize) -> MarkerKin<T> {
-        let shapes = self.marker_shapes(kin, m);
-        self.marker_kin_with(kin, m, &shapes)
+        let (phi, psi) = self.marker_shapes(kin, m);
+        self.marker_kin_with(kin, m, &ShapePlanes::new(&phi, &psi))
     }
 
-    /// [`System::marker_kin`] with the marker's node shapes given.
+    /// [`System::marker_kin`] with the marker's node shapes given (as
+    /// planes).
     fn marker_kin_with<T: Scalar>(
         &self,
         kin: &[BodyKin<T>],
         m: usize,
-        shapes: &NodeShapes<T>,
+        planes: &ShapePlanes,
     ) -> MarkerKin<T> {
         let mk = &self.model.markers[m];
         let pos = mk.pos.map(cst::<T>);
@@ -336,15 +338,8 @@ impl System {
                 let k = &kin[s];
                 match (mk.node, mk.body) {
                     (Some(node), Some(b)) if !k.q.is_empty() => {
-                        let (phi, psi) = shapes;
-                        let (mut du, mut th) = (Vector3::zeros(), Vector3::zeros());
-                        let (mut vd, mut wd) = (Vector3::zeros(), Vector3::zeros());
-                        for j in 0..phi.len() {
-                            du += phi[j] * k.q[j];
-                            vd += phi[j] * k.qd[j];
-                            th += psi[j] * k.q[j];
-                            wd += psi[j] * k.qd[j];
-                        }
+                        let (du, th) = planes.combine(&k.q);
+                        let (vd, wd) = planes.combine(&k.qd);
                         let sg = k.a * (pos + du);
                         let vdg = k.a * vd;
                         // Exact angular velocity of the node frame
@@ -395,6 +390,7 @@ impl System {
         ws.mk.clear();
         ws.shapes.resize_with(nm, || (Vec::new(), Vec::new()));
         ws.shape_seeds.resize_with(nm, || None);
+        ws.planes.resize_with(nm, ShapePlanes::default);
         for m in 0..nm {
             let mk = &self.model.markers[m];
             let seeds = match (mk.node, mk.body.and_then(|b| self.slot[b])) {
@@ -409,8 +405,9 @@ impl System {
             if !fresh {
                 ws.shapes[m] = self.marker_shapes(&ws.kin, m);
                 ws.shape_seeds[m] = seeds.cloned();
+                ws.planes[m] = ShapePlanes::new(&ws.shapes[m].0, &ws.shapes[m].1);
             }
-            let k = self.marker_kin_with(&ws.kin, m, &ws.shapes[m]);
+            let k = self.marker_kin_with(&ws.kin, m, &ws.planes[m]);
             ws.mk.push(k);
         }
     }
@@ -460,15 +457,11 @@ impl System {
                 let mk = &ws.mk[row.markers[side]];
                 if mk.node.is_some() {
                     // ∂/∂ẇ_j = (Aᵀdv)·Φ_kj + (Tᵀ Aᵀ(dw_g − s×dv))·Ψ_kj.
-                    let (phi, psi) = &ws.shapes[row.markers[side]];
                     let av = k.a.transpose() * dv;
                     let aw = mk.tangent.transpose() * (k.a.transpose() * (wg - mk.s.cross(&dv)));
                     row.modal[side] = ws.mjac.len();
-                    for j in 0..phi.len() {
-                        let e = av.dot(&phi[j]) + aw.dot(&psi[j]);
-                        phidot += e * k.qd[j];
-                        ws.mjac.push(e);
-                    }
+                    let planes = &ws.planes[row.markers[side]];
+                    phidot += planes.row_entries((&av, &aw), &k.qd, &mut ws.mjac);
                 }
                 let wb = k.a.transpose() * wg;
                 blk[3] = wb[0];

@@ -68,6 +68,7 @@ pub mod forces;
 pub mod linalg;
 pub mod model;
 pub mod ode;
+pub mod planes;
 pub mod responses;
 pub mod rows;
 pub mod segments;

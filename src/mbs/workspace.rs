@@ -65,6 +65,9 @@ pub struct Workspace<T: Scalar> {
     /// The design seeds each marker's `shapes` were built with (`None`
     /// for markers not on a flexible node).
     pub(crate) shape_seeds: Vec<Option<Vec<(usize, T)>>>,
+    /// The same shapes as real planes ([`super::planes`]), for the sums
+    /// over the modes.
+    pub(crate) planes: Vec<super::planes::ShapePlanes>,
     /// Per moving body: the constraint rows touching it and their
     /// products with its inverse mass ([`BodyBlock`]).
     pub(crate) blocks: Vec<BodyBlock>,

@@ -1,0 +1,197 @@
+//! The mode-shape rows of a node split into real planes, for the sums over
+//! the modes that every right-hand side makes at a node marker: its
+//! deformation `Σ_j Φ_j w_j`, rotation `Σ_j Ψ_j w_j` and their rates, and
+//! the modal entries `a·Φ_j + b·Ψ_j` of the constraint rows at the node.
+//!
+//! In a dual evaluation the shapes carry the design seeds (`Φ + Σ_v Φ'_v
+//! δ_v`), so each term of these sums is a product of two dual numbers. The
+//! planes hold the shapes' real parts and lanes as plain `f64`, built once
+//! with the shapes (they change only with the design seeds), and the sums
+//! are taken plane by plane with the product rule,
+//! `(x·y)'_l = x'_l·y + x·y'_l`: real arithmetic in contiguous arrays
+//! instead of `14 × 6` dual products per sum. For `f64` there is one plane
+//! and the sums are the plain ones.
+
+use super::linalg::Scalar;
+use nalgebra::Vector3;
+
+/// Most planes a number splits into: the real part and up to 8 lanes (the
+/// kernel's duals have 1, 2 or 4).
+const MAX_PLANES: usize = 9;
+
+/// The shape rows `(Φ_j, Ψ_j)`, `j < n`, of one node as planes: `v[(p·n +
+/// j)·6 + c]` with plane `p = 0` the real parts and `p = 1 + l` lane `l`,
+/// `c < 3` the translation `Φ_j` and `c ≥ 3` the rotation `Ψ_j`.
+#[derive(Debug, Clone, Default)]
+pub struct ShapePlanes {
+    n: usize,
+    v: Vec<f64>,
+}
+
+/// The real part and lanes of `x` into `out` (`1 + NL` long).
+fn split<T: Scalar>(x: &T, out: &mut [f64]) {
+    out[0] = x.re_part();
+    for (l, o) in out[1..].iter_mut().enumerate() {
+        *o = x.lane_part(l);
+    }
+}
+
+impl ShapePlanes {
+    /// The planes of the shape rows `phi`, `psi` (equal lengths).
+    pub fn new<T: Scalar>(phi: &[Vector3<T>], psi: &[Vector3<T>]) -> ShapePlanes {
+        let (n, np) = (phi.len(), 1 + T::NL);
+        let mut v = vec![0.0; np * n * 6];
+        let mut parts = vec![0.0; np];
+        for (j, (f, s)) in phi.iter().zip(psi).enumerate() {
+            for c in 0..6 {
+                split(if c < 3 { &f[c] } else { &s[c - 3] }, &mut parts);
+                for (p, x) in parts.iter().enumerate() {
+                    v[(p * n + j) * 6 + c] = *x;
+                }
+            }
+        }
+        ShapePlanes { n, v }
+    }
+
+    /// Number of modes.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Row `j` of plane `p` (six entries: `Φ_j`, then `Ψ_j`).
+    fn row(&self, p: usize, j: usize) -> &[f64] {
+        &self.v[(p * self.n + j) * 6..(p * self.n + j + 1) * 6]
+    }
+
+    /// `(Σ_j Φ_j x_j, Σ_j Ψ_j x_j)` for the `n` numbers `x`.
+    pub fn combine<T: Scalar>(&self, x: &[T]) -> (Vector3<T>, Vector3<T>) {
+        let np = 1 + T::NL;
+        assert!(np <= MAX_PLANES, "at most {} lanes", MAX_PLANES - 1);
+        let mut acc = [0.0; MAX_PLANES * 6];
+        let mut xp = [0.0; MAX_PLANES];
+        for (j, xj) in x.iter().enumerate().take(self.n) {
+            split(xj, &mut xp[..np]);
+            let s0 = self.row(0, j);
+            for c in 0..6 {
+                acc[c] += s0[c] * xp[0];
+            }
+            for p in 1..np {
+                let sp = self.row(p, j);
+                for c in 0..6 {
+                    acc[p * 6 + c] += sp[c] * xp[0] + s0[c] * xp[p];
+                }
+            }
+        }
+        let mut lanes = [0.0; MAX_PLANES];
+        let mut entry = |c: usize| {
+            for (l, v) in lanes[..np - 1].iter_mut().enumerate() {
+                *v = acc[(1 + l) * 6 + c];
+            }
+            T::from_parts(acc[c], &lanes[..np - 1])
+        };
+        (
+            Vector3::new(entry(0), entry(1), entry(2)),
+            Vector3::new(entry(3), entry(4), entry(5)),
+        )
+    }
+
+    /// The modal entries `e_j = a·Φ_j + b·Ψ_j` of a constraint row (pushed
+    /// onto `out`) and `Σ_j e_j c_j`.
+    pub fn row_entries<T: Scalar>(
+        &self,
+        (a, b): (&Vector3<T>, &Vector3<T>),
+        c: &[T],
+        out: &mut Vec<T>,
+    ) -> T {
+        let np = 1 + T::NL;
+        assert!(np <= MAX_PLANES, "at most {} lanes", MAX_PLANES - 1);
+        // ab[p][k]: plane p of the six coefficients (a, then b).
+        let mut ab = [0.0; MAX_PLANES * 6];
+        let mut parts = [0.0; MAX_PLANES];
+        for k in 0..6 {
+            split(if k < 3 { &a[k] } else { &b[k - 3] }, &mut parts[..np]);
+            for p in 0..np {
+                ab[p * 6 + k] = parts[p];
+            }
+        }
+        let (mut e, mut cp, mut sum) = ([0.0; MAX_PLANES], [0.0; MAX_PLANES], [0.0; MAX_PLANES]);
+        for (j, cj) in c.iter().enumerate().take(self.n) {
+            let s0 = self.row(0, j);
+            e[0] = (0..6).map(|k| ab[k] * s0[k]).sum();
+            for p in 1..np {
+                let sp = self.row(p, j);
+                e[p] = (0..6).map(|k| ab[p * 6 + k] * s0[k] + ab[k] * sp[k]).sum();
+            }
+            out.push(T::from_parts(e[0], &e[1..np]));
+            split(cj, &mut cp[..np]);
+            sum[0] += e[0] * cp[0];
+            for p in 1..np {
+                sum[p] += e[p] * cp[0] + e[0] * cp[p];
+            }
+        }
+        T::from_parts(sum[0], &sum[1..np])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mbs::linalg::Lanes;
+    use num_dual::DualSVec64;
+
+    type D = DualSVec64<2>;
+
+    fn d(k: usize) -> D {
+        let x = k as f64;
+        D::with((0.7 * x).sin(), &[(1.3 * x).cos(), (0.4 * x + 1.0).sin()])
+    }
+
+    fn close(a: D, b: D) -> bool {
+        let tol = |x: f64, y: f64| (x - y).abs() <= 1e-14 * (1.0 + y.abs());
+        tol(a.re, b.re) && (0..2).all(|l| tol(a.lane(l), b.lane(l)))
+    }
+
+    #[test]
+    fn plane_sums_equal_dual_arithmetic() {
+        // The planes' product rule against num-dual's own products, for
+        // the deformation sums and the modal entries of a row.
+        let n = 5;
+        let phi: Vec<Vector3<D>> = (0..n)
+            .map(|j| Vector3::new(d(6 * j), d(6 * j + 1), d(6 * j + 2)))
+            .collect();
+        let psi: Vec<Vector3<D>> = (0..n)
+            .map(|j| Vector3::new(d(6 * j + 3), d(6 * j + 4), d(6 * j + 5)))
+            .collect();
+        let x: Vec<D> = (0..n).map(|j| d(100 + j)).collect();
+        let planes = ShapePlanes::new(&phi, &psi);
+        assert_eq!(planes.n(), n);
+        let (u, t) = planes.combine(&x);
+        let (mut u0, mut t0) = (Vector3::<D>::zeros(), Vector3::<D>::zeros());
+        for j in 0..n {
+            u0 += phi[j] * x[j];
+            t0 += psi[j] * x[j];
+        }
+        for c in 0..3 {
+            assert!(close(u[c], u0[c]) && close(t[c], t0[c]), "component {c}");
+        }
+        let (a, b) = (
+            Vector3::new(d(50), d(51), d(52)),
+            Vector3::new(d(53), d(54), d(55)),
+        );
+        let mut out = Vec::new();
+        let sum = planes.row_entries((&a, &b), &x, &mut out);
+        let mut sum0 = D::from(0.0);
+        for j in 0..n {
+            let e = a.dot(&phi[j]) + b.dot(&psi[j]);
+            assert!(close(out[j], e), "entry {j}");
+            sum0 += e * x[j];
+        }
+        assert!(close(sum, sum0));
+        // One plane for f64: the plain sums.
+        let phr: Vec<Vector3<f64>> = phi.iter().map(|v| v.map(|e| e.re)).collect();
+        let psr: Vec<Vector3<f64>> = psi.iter().map(|v| v.map(|e| e.re)).collect();
+        let xr: Vec<f64> = x.iter().map(|e| e.re).collect();
+        let (ur, _) = ShapePlanes::new(&phr, &psr).combine(&xr);
+        assert!((ur[0] - u0[0].re).abs() < 1e-14);
+    }
+}
