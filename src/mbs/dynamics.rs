@@ -391,21 +391,38 @@ impl System {
         ws.shapes.resize_with(nm, || (Vec::new(), Vec::new()));
         ws.shape_seeds.resize_with(nm, || None);
         ws.planes.resize_with(nm, ShapePlanes::default);
+        ws.shape_spare.resize_with(nm, Vec::new);
         for m in 0..nm {
             let mk = &self.model.markers[m];
             let seeds = match (mk.node, mk.body.and_then(|b| self.slot[b])) {
                 (Some(_), Some(s)) if !ws.kin[s].q.is_empty() => Some(&ws.kin[s].design),
                 _ => None,
             };
-            let fresh = match (&ws.shape_seeds[m], seeds) {
+            let built_for = |sd: &Option<Vec<(usize, T)>>, shapes: &NodeShapes<T>| match (sd, seeds)
+            {
                 (Some(old), Some(new)) => same_seeds(old, new),
-                (None, None) => ws.shapes[m].0.is_empty(),
+                (None, None) => shapes.0.is_empty(),
                 _ => false,
             };
-            if !fresh {
-                ws.shapes[m] = self.marker_shapes(&ws.kin, m);
-                ws.shape_seeds[m] = seeds.cloned();
-                ws.planes[m] = ShapePlanes::new(&ws.shapes[m].0, &ws.shapes[m].1);
+            if !built_for(&ws.shape_seeds[m], &ws.shapes[m]) {
+                // Earlier shapes are kept for seeds that cycle (as the
+                // invariants are, `System::invariants`).
+                let spare = &mut ws.shape_spare[m];
+                let cached = match spare.iter().position(|e| built_for(&e.0, &e.1)) {
+                    Some(i) => spare.remove(i),
+                    None => {
+                        let (phi, psi) = self.marker_shapes(&ws.kin, m);
+                        let planes = ShapePlanes::new(&phi, &psi);
+                        (seeds.cloned(), (phi, psi), planes)
+                    }
+                };
+                let old = (
+                    std::mem::replace(&mut ws.shape_seeds[m], cached.0),
+                    std::mem::replace(&mut ws.shapes[m], cached.1),
+                    std::mem::replace(&mut ws.planes[m], cached.2),
+                );
+                ws.shape_spare[m].insert(0, old);
+                ws.shape_spare[m].truncate(SEED_SPARES);
             }
             let k = self.marker_kin_with(&ws.kin, m, &ws.planes[m]);
             ws.mk.push(k);
@@ -484,9 +501,23 @@ impl System {
         let Some(flex) = flex else { return };
         ws.inv.resize_with(self.nb(), || None);
         ws.inv_seeds.resize_with(self.nb(), Vec::new);
-        if ws.inv[s].is_none() || !same_seeds(&ws.inv_seeds[s], &ws.kin[s].design) {
-            ws.inv[s] = Some(InvT::lift(flex, &ws.kin[s].design));
-            ws.inv_seeds[s].clone_from(&ws.kin[s].design);
+        ws.inv_spare.resize_with(self.nb(), Vec::new);
+        let design = &ws.kin[s].design;
+        if ws.inv[s].is_some() && same_seeds(&ws.inv_seeds[s], design) {
+            return;
+        }
+        // Earlier lifts are kept for evaluations that cycle through a few
+        // sets of seeds (the staggered sensitivities: J·s without design
+        // seeds, ∂f/∂p with one variable's).
+        let spare = &mut ws.inv_spare[s];
+        let (seeds, inv) = match spare.iter().position(|(sd, _)| same_seeds(sd, design)) {
+            Some(i) => spare.remove(i),
+            None => (design.clone(), InvT::lift(flex, design)),
+        };
+        let old_seeds = std::mem::replace(&mut ws.inv_seeds[s], seeds);
+        if let Some(old) = ws.inv[s].replace(inv) {
+            ws.inv_spare[s].insert(0, (old_seeds, old));
+            ws.inv_spare[s].truncate(SEED_SPARES);
         }
     }
 
@@ -608,6 +639,12 @@ impl System {
         }
     }
 }
+
+/// How many earlier lifts of the invariants and node shapes a workspace
+/// keeps besides the current ones: the staggered sensitivities cycle
+/// through one set of design seeds per lane plus the empty set (`J·s`), so
+/// three cover two design variables and the empty set with one to spare.
+const SEED_SPARES: usize = 3;
 
 /// Whether two lists of design seeds `(variable, δ)` are the same, every
 /// dual component compared (`PartialEq` of num-dual's numbers compares the

@@ -68,6 +68,17 @@ pub struct Workspace<T: Scalar> {
     /// The same shapes as real planes ([`super::planes`]), for the sums
     /// over the modes.
     pub(crate) planes: Vec<super::planes::ShapePlanes>,
+    /// Per marker: shapes (seeds, rows, planes) built before the current
+    /// ones, most recent first, for evaluations that cycle through a few
+    /// sets of design seeds.
+    #[allow(clippy::type_complexity)]
+    pub(crate) shape_spare: Vec<
+        Vec<(
+            Option<Vec<(usize, T)>>,
+            NodeShapes<T>,
+            super::planes::ShapePlanes,
+        )>,
+    >,
     /// Per moving body: the constraint rows touching it and their
     /// products with its inverse mass ([`BodyBlock`]).
     pub(crate) blocks: Vec<BodyBlock>,
@@ -93,6 +104,10 @@ pub struct Workspace<T: Scalar> {
     /// lifted again only when an evaluation's seeds differ (fused
     /// sensitivities seed the same unit lanes at every stage).
     pub(crate) inv_seeds: Vec<Vec<(usize, T)>>,
+    /// Per moving body: lifts before the current one, most recent first,
+    /// with their seeds.
+    #[allow(clippy::type_complexity)]
+    pub(crate) inv_spare: Vec<Vec<(Vec<(usize, T)>, InvT<T>)>>,
     /// Per moving body: the kinetic energy `½ vᵀMv` of a flexible body,
     /// from its mass matrix before the factorization (zero for rigid
     /// bodies, whose energy [`super::energy`] computes directly).
