@@ -380,11 +380,13 @@ impl System {
     }
 
     /// Kinematics of every marker into `ws.mk`, and their node shapes
-    /// into `ws.shapes` (from `ws.kin`).
+    /// into `ws.shapes` and `ws.planes` (from `ws.kin`).
+    ///
     /// The node shapes depend on the design seeds alone, not on the
     /// state: they are built again only when a body's seeds differ from
-    /// those they were built with (fused sensitivities seed the same unit
-    /// lanes at every stage).
+    /// those of the current shapes and of the `SEED_SPARES` sets built
+    /// before (fused sensitivities seed the same unit lanes at every
+    /// stage; the staggered ones cycle through a few sets).
     pub fn markers_kin<T: Scalar>(&self, ws: &mut Workspace<T>) {
         let nm = self.model.markers.len();
         ws.mk.clear();
@@ -495,7 +497,8 @@ impl System {
     }
 
     /// The invariants of flexible slot `s` in `T`, lifted again only when
-    /// the design seeds differ from those of the cached copy.
+    /// the design seeds differ from those of the current copy and of the
+    /// `SEED_SPARES` copies lifted before.
     fn invariants<T: Scalar>(&self, s: usize, ws: &mut Workspace<T>) {
         let flex = self.model.bodies[self.moving[s]].flex.as_ref();
         let Some(flex) = flex else { return };
