@@ -219,12 +219,12 @@ pub fn fdot(a: &[f64], b: &[f64]) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
-/// A dual number with `L` derivative lanes, as the solves of [`Scalar`]
-/// see it: a real part and `L` dual parts, read and written by lane.
+/// num-dual's numbers read and written by lane, behind [`Scalar`]'s parts
+/// accessors (the kernel uses those): a real part and `L` dual parts.
 /// `num_dual::Dual64` has one lane; `num_dual::DualSVec64<N>` has `N`
 /// (one multi-lane evaluation gives a value and `N` directional
 /// derivatives at once).
-pub trait Lanes: Copy {
+trait Lanes: Copy {
     /// Number of dual parts.
     const L: usize;
     /// The real part.

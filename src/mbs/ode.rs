@@ -12,7 +12,7 @@
 //! same operations as the `f64` right-hand side.
 
 use super::dynamics::System;
-use super::linalg::{Lanes, Scalar};
+use super::linalg::Scalar;
 use super::model::Param;
 use super::segments::{Crossing, Events};
 use super::workspace::{BodyKin, Workspace};
@@ -27,12 +27,12 @@ pub struct LaneWork<D: Scalar> {
     dy: Vec<D>,
 }
 
-impl<D: Scalar + Lanes> LaneWork<D> {
+impl<D: Scalar> LaneWork<D> {
     fn new(n: usize) -> LaneWork<D> {
         LaneWork {
             ws: Workspace::empty(),
-            y: vec![D::with(0.0, &vec![0.0; D::L]); n],
-            dy: vec![D::with(0.0, &vec![0.0; D::L]); n],
+            y: vec![D::from_parts(0.0, &vec![0.0; D::NL]); n],
+            dy: vec![D::from_parts(0.0, &vec![0.0; D::NL]); n],
         }
     }
 }
@@ -50,11 +50,11 @@ pub struct SystemWork {
 
 impl System {
     /// One evaluation on `D` numbers of the lanes `first..first + k`
-    /// (`k ≤ D::L`, `k = lanes.len() / n`; padding lanes are zero): the
+    /// (`k ≤ D::NL`, `k = lanes.len() / n`; padding lanes are zero): the
     /// value into `dy` (when asked) and dual part `l` into lane `first + l`
     /// of `dlanes`.
     #[allow(clippy::too_many_arguments)]
-    fn eval_lanes<D: Scalar + Lanes>(
+    fn eval_lanes<D: Scalar>(
         &self,
         lw: &mut LaneWork<D>,
         t: f64,
@@ -67,31 +67,31 @@ impl System {
         let n = y.len();
         let k = lanes.len() / n;
         let mut buf = [0.0f64; 8];
-        let buf = &mut buf[..D::L];
+        let buf = &mut buf[..D::NL];
         lw.ws.params.clear();
         for (j, par) in names.iter().enumerate() {
             buf.fill(0.0);
             if (first..first + k).contains(&j) {
                 buf[j - first] = 1.0;
             }
-            lw.ws.params.push((*par, D::with(p[j], buf)));
+            lw.ws.params.push((*par, D::from_parts(p[j], buf)));
         }
         for (c, yc) in y.iter().enumerate() {
             for (l, b) in buf.iter_mut().enumerate() {
                 *b = if l < k { lanes[l * n + c] } else { 0.0 };
             }
-            lw.y[c] = D::with(*yc, buf);
+            lw.y[c] = D::from_parts(*yc, buf);
         }
         self.rhs(t, &lw.y, &mut lw.dy, &mut lw.ws);
         if let Some(dy) = dy {
             for (o, d) in dy.iter_mut().zip(&lw.dy) {
-                *o = d.re();
+                *o = d.re_part();
             }
         }
         for l in 0..k {
             let out = &mut dlanes[(first + l) * n..(first + l + 1) * n];
             for (o, d) in out.iter_mut().zip(&lw.dy) {
-                *o = d.lane(l);
+                *o = d.lane_part(l);
             }
         }
     }

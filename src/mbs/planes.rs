@@ -136,19 +136,18 @@ impl ShapePlanes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mbs::linalg::Lanes;
     use num_dual::DualSVec64;
 
     type D = DualSVec64<2>;
 
     fn d(k: usize) -> D {
         let x = k as f64;
-        D::with((0.7 * x).sin(), &[(1.3 * x).cos(), (0.4 * x + 1.0).sin()])
+        D::from_parts((0.7 * x).sin(), &[(1.3 * x).cos(), (0.4 * x + 1.0).sin()])
     }
 
     fn close(a: D, b: D) -> bool {
         let tol = |x: f64, y: f64| (x - y).abs() <= 1e-14 * (1.0 + y.abs());
-        tol(a.re, b.re) && (0..2).all(|l| tol(a.lane(l), b.lane(l)))
+        tol(a.re, b.re) && (0..2).all(|l| tol(a.lane_part(l), b.lane_part(l)))
     }
 
     #[test]

@@ -275,7 +275,7 @@ impl System {
         sol.dlam.resize(nl * m, 0.0);
         sol.dacc.clear();
         sol.dacc.resize(nl * nv, 0.0);
-        let mut rhs = vec![0.0; m];
+        let (mut rhs, mut dd) = (vec![0.0; m], vec![0.0; m]);
         let mut dlam = Vec::new();
         let mut mp = Vec::new();
         for l in 0..nl {
@@ -284,7 +284,7 @@ impl System {
             for (r, row) in ws.rows.iter().enumerate() {
                 rhs[r] = row.gamma.lane_part(l);
             }
-            let mut dd = vec![0.0; m];
+            dd.fill(0.0);
             for (s, bb) in ws.blocks.iter().enumerate() {
                 let (o, d) = (self.vel_local(s), self.dof(s));
                 let k = bb.rows.len();
