@@ -42,7 +42,8 @@
 use super::energy::quadratic_form;
 use super::flexdyn::{flex_terms, FlexEffects, FlexState, InvT};
 use super::linalg::{
-    cst, euler_rate, rotation, rotation_tangent, rotation_vector, spd_inverse, sym_times, Scalar,
+    cst, euler_rate, mm, mtv, mv, rotation, rotation_tangent, rotation_vector, spd_inverse,
+    sym_times, Scalar,
 };
 use super::model::{Model, Param};
 use super::planes::ShapePlanes;
@@ -218,7 +219,7 @@ impl System {
             k.r = r;
             k.a = a;
             k.v = v;
-            k.w = a * wb;
+            k.w = mv(&a, &wb);
             k.wb = wb;
             k.q.clear();
             k.q.extend_from_slice(&y[p + 7..p + 7 + n]);
@@ -318,7 +319,7 @@ impl System {
                             .to_rotation_matrix()
                             .into_inner()
                             .map(cst::<T>);
-                        (body.r0.map(cst::<T>) + a * pos, a * frame)
+                        (body.r0.map(cst::<T>) + mv(&a, &pos), mm(&a, &frame))
                     }
                 };
                 MarkerKin {
@@ -340,33 +341,33 @@ impl System {
                     (Some(node), Some(b)) if !k.q.is_empty() => {
                         let (du, th) = planes.combine(&k.q);
                         let (vd, wd) = planes.combine(&k.qd);
-                        let sg = k.a * (pos + du);
-                        let vdg = k.a * vd;
+                        let sg = mv(&k.a, &(pos + du));
+                        let vdg = mv(&k.a, &vd);
                         // Exact angular velocity of the node frame
                         // A R(θ) F₀: ω + A T(θ) θ̇, and its rate terms.
                         let (tm, tdot) = rotation_tangent(&th, &wd);
-                        let wdg = k.a * (tm * wd);
+                        let wdg = mv(&k.a, &mv(&tm, &wd));
                         MarkerKin {
                             slot: Some(s),
                             x: k.r + sg,
                             v: k.v + k.w.cross(&sg) + vdg,
                             s: sg,
-                            frame: k.a * rotation_vector(&th) * frame,
+                            frame: mm(&k.a, &mm(&rotation_vector(&th), &frame)),
                             w: k.w + wdg,
                             acc: k.w.cross(&k.w.cross(&sg)) + k.w.cross(&vdg) * cst::<T>(2.0),
-                            alpha: k.w.cross(&wdg) + k.a * tdot,
+                            alpha: k.w.cross(&wdg) + mv(&k.a, &tdot),
                             node: Some((b, node)),
                             tangent: tm,
                         }
                     }
                     _ => {
-                        let sg = k.a * pos;
+                        let sg = mv(&k.a, &pos);
                         MarkerKin {
                             slot: Some(s),
                             x: k.r + sg,
                             v: k.v + k.w.cross(&sg),
                             s: sg,
-                            frame: k.a * frame,
+                            frame: mm(&k.a, &frame),
                             w: k.w,
                             acc: k.w.cross(&k.w.cross(&sg)),
                             alpha: Vector3::zeros(),
@@ -476,13 +477,13 @@ impl System {
                 let mk = &ws.mk[row.markers[side]];
                 if mk.node.is_some() {
                     // ∂/∂ẇ_j = (Aᵀdv)·Φ_kj + (Tᵀ Aᵀ(dw_g − s×dv))·Ψ_kj.
-                    let av = k.a.transpose() * dv;
-                    let aw = mk.tangent.transpose() * (k.a.transpose() * (wg - mk.s.cross(&dv)));
+                    let av = mtv(&k.a, &dv);
+                    let aw = mtv(&mk.tangent, &mtv(&k.a, &(wg - mk.s.cross(&dv))));
                     row.modal[side] = ws.mjac.len();
                     let planes = &ws.planes[row.markers[side]];
                     phidot += planes.row_entries((&av, &aw), &k.qd, &mut ws.mjac);
                 }
-                let wb = k.a.transpose() * wg;
+                let wb = mtv(&k.a, &wg);
                 blk[3] = wb[0];
                 blk[4] = wb[1];
                 blk[5] = wb[2];

@@ -17,7 +17,7 @@
 //! ([`System::strain_energy_dual`]).
 
 use super::dynamics::{pval, System, Workspace};
-use super::linalg::{cst, Scalar};
+use super::linalg::{cst, mv, Scalar};
 use super::model::Param;
 
 /// One energy term (J).
@@ -76,7 +76,7 @@ impl System {
         let body = &self.model.bodies[b];
         let k = &ws.kin[s];
         let m = pval(&ws.params, Param::Mass(b), body.mass);
-        let jw = body.inertia.map(cst::<T>) * k.wb;
+        let jw = mv(&body.inertia.map(cst::<T>), &k.wb);
         (m * k.v.norm_squared() + k.wb.dot(&jw)) * cst::<T>(0.5)
     }
 

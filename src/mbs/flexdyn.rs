@@ -31,7 +31,7 @@
 #![allow(clippy::needless_range_loop)] // index-heavy small dense kernels
 
 use super::flex::Invariants;
-use super::linalg::{cst, Scalar};
+use super::linalg::{cst, mm, mv, Scalar};
 use super::model::Flex;
 use nalgebra::{Matrix3, Vector3};
 
@@ -190,7 +190,7 @@ pub fn flex_terms<T: Scalar>(
     for k in 0..3 {
         put(mass, k, k, inv.mass);
     }
-    let ast = -(a * s.cross_matrix());
+    let ast = -mm(a, &s.cross_matrix());
     for r in 0..3 {
         for c in 0..3 {
             put(mass, r, 3 + c, ast[(r, c)]);
@@ -199,7 +199,7 @@ pub fn flex_terms<T: Scalar>(
     }
     for j in 0..n {
         let col = Vector3::new(inv.i3[j], inv.i3[n + j], inv.i3[2 * n + j]);
-        let ac = a * col;
+        let ac = mv(a, &col);
         for r in 0..3 {
             put(mass, r, 6 + j, ac[r]);
             put(mass, 3 + r, 6 + j, mwq[j][r]);
@@ -229,7 +229,7 @@ pub fn flex_terms<T: Scalar>(
         }
         v
     };
-    let qr = a * (om.cross(&om.cross(&s)) + om.cross(&dvec) * two);
+    let qr = mv(a, &(om.cross(&om.cross(&s)) + om.cross(&dvec) * two));
     // H_j and G = Σ ẇ_j H_j.
     let mut g = Matrix3::<T>::zeros();
     let mut crot = Vector3::<T>::zeros();
@@ -243,15 +243,15 @@ pub fn flex_terms<T: Scalar>(
                 vs[c] += inv.v[o + c] * wd[i];
             }
         }
-        let qj = om.dot(&(h * om)) - om.norm_squared() * h.trace() + two * om.dot(&vs);
+        let qj = om.dot(&mv(h, &om)) - om.norm_squared() * h.trace() + two * om.dot(&vs);
         force[6 + j] -= qj;
         for c in 0..3 {
             crot[c] += inv.c_rot[c * n + j] * wd[j];
         }
     }
-    let qw = om.cross(&(j_tr * om))
-        + (om * g.trace() - g * om) * two
-        + om.cross(&(inv.j_rot * om + crot));
+    let qw = om.cross(&mv(&j_tr, &om))
+        + (om * g.trace() - mv(&g, &om)) * two
+        + om.cross(&(mv(&inv.j_rot, &om) + crot));
     for c in 0..3 {
         force[c] -= qr[c];
         force[3 + c] -= qw[c];

@@ -14,7 +14,7 @@
 //! `pval`, so a dual-number evaluation differentiates it exactly.
 
 use super::dynamics::{angle_of, bump, pval, slide_of, System, Workspace};
-use super::linalg::{cst, Scalar};
+use super::linalg::{cst, mtv, mv, Scalar};
 use super::model::{Force, Load, LoadFrame, Param, PiecewiseLaw};
 use nalgebra::Vector3;
 
@@ -72,7 +72,7 @@ impl System {
             bump(&self.counters.quadratic);
             let body = &self.model.bodies[b];
             let k = &ws.kin[s];
-            let jw = body.inertia.map(cst::<T>) * k.wb;
+            let jw = mv(&body.inertia.map(cst::<T>), &k.wb);
             let gyro = -k.wb.cross(&jw);
             let o = self.vel_local(s);
             for c in 0..3 {
@@ -92,7 +92,7 @@ impl System {
             match &ws.inv.get(s).and_then(|i| i.as_ref()) {
                 Some(inv) if self.modes[s] > 0 => {
                     let k = &ws.kin[s];
-                    let gb = k.a.transpose() * gt;
+                    let gb = mtv(&k.a, &gt);
                     let sm = inv.first_moment(&k.q);
                     let tq = sm.cross(&gb);
                     let modal = inv.i3t(&gb);
@@ -127,7 +127,7 @@ impl System {
         let (f, tau) = (f.map(cst::<T>), tau.map(cst::<T>));
         match frame {
             LoadFrame::Global => (f, tau),
-            LoadFrame::Body => (ws.kin[s].a * f, ws.kin[s].a * tau),
+            LoadFrame::Body => (mv(&ws.kin[s].a, &f), mv(&ws.kin[s].a, &tau)),
         }
     }
 
@@ -145,7 +145,7 @@ impl System {
         bump(&self.counters.loads);
         let Some(s) = self.slot[body] else { return };
         let (force, torque) = self.load_global(t, ws, s, load);
-        let tb = ws.kin[s].a.transpose() * torque;
+        let tb = mtv(&ws.kin[s].a, &torque);
         let o = self.vel_local(s);
         // A flexible body's frame origin is not its centre of mass: the
         // force acts at the centre of mass.
@@ -153,7 +153,7 @@ impl System {
             Some(inv) if self.modes[s] > 0 => Some(inv.first_moment(&ws.kin[s].q) / inv.mass),
             _ => None,
         };
-        let fb = ws.kin[s].a.transpose() * force;
+        let fb = mtv(&ws.kin[s].a, &force);
         let extra = arm.map_or(Vector3::zeros(), |c| c.cross(&fb));
         for c in 0..3 {
             ws.q[o + c] += force[c];
@@ -281,12 +281,12 @@ impl System {
         let mk = ws.mk[m];
         let Some(s) = mk.slot else { return };
         let o = self.vel_local(s);
-        let tb = ws.kin[s].a.transpose() * tau;
+        let tb = mtv(&ws.kin[s].a, tau);
         for c in 0..3 {
             ws.q[o + 3 + c] += tb[c];
         }
         if mk.node.is_some() {
-            let tt = mk.tangent.transpose() * tb;
+            let tt = mtv(&mk.tangent, &tb);
             for (j, p) in ws.shapes[m].1.iter().enumerate() {
                 ws.q[o + 6 + j] += p.dot(&tt);
             }

@@ -8,10 +8,11 @@
 //! numbers compares the real parts: the derivative follows the same branch
 //! as the value. Structural zeros are detected on all components.
 
+use super::dual::DualN;
 use nalgebra::{Matrix3, RealField, Vector3};
 
 /// The scalar types of the kernel: `f64`, and dual numbers with `NL`
-/// derivative lanes (`num_dual::Dual64`, `num_dual::DualSVec64<N>`).
+/// derivative lanes (`num_dual::Dual64`, [`DualN<N>`](super::dual::DualN)).
 /// `is_exact_zero` is true only when every component is exactly zero.
 ///
 /// The two symmetric positive definite solves of a right-hand side (the
@@ -44,6 +45,10 @@ pub trait Scalar: RealField + Copy {
     /// the body); the lanes of a dual number keep `A'`.
     fn dense_factor(a: &mut [Self], n: usize) -> bool;
 }
+
+/// Most derivative lanes of a [`Scalar`] type (fixed-size lane buffers
+/// of the kernel; the multi-lane evaluations use 2 or 4).
+pub const MAX_LANES: usize = 8;
 
 /// Real scratch storage of [`spd_factor`] / [`spd_solve`],
 /// with the symbolic factorization they follow ([`SpdScratch::set_pattern`];
@@ -219,11 +224,10 @@ pub fn fdot(a: &[f64], b: &[f64]) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
-/// num-dual's numbers read and written by lane, behind [`Scalar`]'s parts
+/// Dual numbers read and written by lane, behind [`Scalar`]'s parts
 /// accessors (the kernel uses those): a real part and `L` dual parts.
-/// `num_dual::Dual64` has one lane; `num_dual::DualSVec64<N>` has `N`
-/// (one multi-lane evaluation gives a value and `N` directional
-/// derivatives at once).
+/// `num_dual::Dual64` has one lane; [`DualN<N>`] has `N` (one multi-lane
+/// evaluation gives a value and `N` directional derivatives at once).
 trait Lanes: Copy {
     /// Number of dual parts.
     const L: usize;
@@ -261,25 +265,22 @@ impl Lanes for num_dual::Dual64 {
     }
 }
 
-impl<const N: usize> Lanes for num_dual::DualSVec64<N> {
-    const L: usize = N;
+impl<const N: usize> Lanes for DualN<N> {
+    const L: usize = {
+        assert!(N <= MAX_LANES, "more lanes than the kernel's lane buffers");
+        N
+    };
     #[inline]
     fn re(&self) -> f64 {
         self.re
     }
     #[inline]
     fn lane(&self, k: usize) -> f64 {
-        self.eps.0.as_ref().map_or(0.0, |e| e[k])
+        self.eps[k]
     }
     #[inline]
     fn with(re: f64, lanes: &[f64]) -> Self {
-        // Always a dual part, zero lanes included: num-dual skips the
-        // arithmetic of an absent part but tests for it at every
-        // operation, and with parts present wherever the kernel builds a
-        // number those tests are predictable (the 2-lane SAR right-hand
-        // side: 119 -> 110 us, bit-identical results).
-        let e = nalgebra::SVector::<f64, N>::from_column_slice(lanes);
-        Self::new(re, num_dual::Derivative::some(e))
+        DualN::new(re, std::array::from_fn(|l| lanes[l]))
     }
     #[inline]
     fn set_re(&mut self, re: f64) {
@@ -350,6 +351,19 @@ pub fn spd_inverse(a: &mut [f64], n: usize) -> bool {
     true
 }
 
+/// `xᵀ S x` for a symmetric row-major `n × n` matrix `S` from its lower
+/// triangle: `Σ_j x_j (S_jj x_j + 2 Σ_{k<j} S_jk x_k)`, half the products
+/// of `x · (S x)`.
+#[inline]
+pub fn sym_quad(s: &[f64], n: usize, x: &[f64]) -> f64 {
+    let mut q = 0.0;
+    for j in 0..n {
+        let row = &s[j * n..j * n + j];
+        q += x[j] * (s[j * n + j] * x[j] + 2.0 * fdot(row, &x[..j]));
+    }
+    q
+}
+
 /// `out = S x` for a symmetric row-major `n × n` matrix `S`, as a sum of
 /// its rows scaled by the entries of `x` (row `j` = column `j`): vector
 /// updates, and nothing done for the zero entries of `x` (the rigid
@@ -396,7 +410,7 @@ impl Scalar for num_dual::Dual64 {
     lanes_scalar!();
 }
 
-impl<const N: usize> Scalar for num_dual::DualSVec64<N> {
+impl<const N: usize> Scalar for DualN<N> {
     lanes_scalar!();
 }
 
@@ -404,6 +418,27 @@ impl<const N: usize> Scalar for num_dual::DualSVec64<N> {
 #[inline]
 pub fn cst<T: RealField + Copy>(x: f64) -> T {
     nalgebra::convert(x)
+}
+
+/// `A v` for a 3 × 3 matrix, written out. nalgebra's generic product
+/// forms `α A v + β y` with `α = 1`, `β = 0` for any scalar type: two
+/// more products per entry, which a dual number pays in full (on `f64`
+/// the result is the same to the bit: the sums run in the same order).
+#[inline(always)]
+pub fn mv<T: Scalar>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
+    Vector3::from_fn(|i, _| a[(i, 0)] * v[0] + a[(i, 1)] * v[1] + a[(i, 2)] * v[2])
+}
+
+/// `Aᵀ v` for a 3 × 3 matrix, written out (see [`mv`]).
+#[inline(always)]
+pub fn mtv<T: Scalar>(a: &Matrix3<T>, v: &Vector3<T>) -> Vector3<T> {
+    Vector3::from_fn(|i, _| a[(0, i)] * v[0] + a[(1, i)] * v[1] + a[(2, i)] * v[2])
+}
+
+/// `A B` for 3 × 3 matrices, written out (see [`mv`]).
+#[inline(always)]
+pub fn mm<T: Scalar>(a: &Matrix3<T>, b: &Matrix3<T>) -> Matrix3<T> {
+    Matrix3::from_fn(|i, j| a[(i, 0)] * b[(0, j)] + a[(i, 1)] * b[(1, j)] + a[(i, 2)] * b[(2, j)])
 }
 
 /// Rotation matrix `A(p)` of the Euler parameters `p = (e0, e1, e2, e3)`
@@ -659,7 +694,7 @@ pub fn rotation_vector<T: Scalar>(th: &Vector3<T>) -> Matrix3<T> {
         (phi.sin() / phi, (T::one() - phi.cos()) / p2)
     };
     let k = th.cross_matrix();
-    Matrix3::identity() + k * a + k * k * b
+    Matrix3::identity() + k * a + mm(&k, &k) * b
 }
 
 /// Tangent operator of the rotation vector and its rate term: for
@@ -695,7 +730,7 @@ pub fn rotation_tangent<T: Scalar>(th: &Vector3<T>, thd: &Vector3<T>) -> (Matrix
         )
     };
     let k = th.cross_matrix();
-    let tmat = Matrix3::identity() + k * b + k * k * cc;
+    let tmat = Matrix3::identity() + k * b + mm(&k, &k) * cc;
     let two_dot = c(2.0) * th.dot(thd);
     let txd = th.cross(thd);
     let rate = txd * (db * two_dot) + th.cross(&txd) * (dc * two_dot) + thd.cross(&txd) * cc;
@@ -903,7 +938,7 @@ mod tests {
         // and plain dot products, and the dual form: real parts the
         // inverse of the real matrix, lanes the matrix's derivative A'
         // (what the tangent of the constraint-space solve reads).
-        use num_dual::DualSVec64;
+        use crate::mbs::dual::DualN;
         let n = 6;
         let (a0, b0) = perturbed_system(n, [0.0; 2]);
         let (a1, _) = perturbed_system(n, [1.0, 0.0]);
@@ -938,10 +973,10 @@ mod tests {
         for (got, want) in [(g[0], bx), (g[2], 2.0 * bx), (g[3], 4.0 * bx)] {
             assert!((got - want).abs() < 1e-12 * (1.0 + want.abs()));
         }
-        let mut ad: Vec<DualSVec64<2>> = (0..n * n)
-            .map(|k| DualSVec64::<2>::with(a0[k], &[a1[k] - a0[k], a2[k] - a0[k]]))
+        let mut ad: Vec<DualN<2>> = (0..n * n)
+            .map(|k| DualN::<2>::with(a0[k], &[a1[k] - a0[k], a2[k] - a0[k]]))
             .collect();
-        assert!(<DualSVec64<2> as Scalar>::dense_factor(&mut ad, n));
+        assert!(<DualN<2> as Scalar>::dense_factor(&mut ad, n));
         for k in 0..n * n {
             assert!((ad[k].re - inv[k]).abs() < 1e-14 * (1.0 + inv[k].abs()));
             assert_eq!(ad[k].lane(0), a1[k] - a0[k]);

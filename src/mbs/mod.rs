@@ -60,6 +60,7 @@
 
 pub mod analysis;
 pub mod beam;
+pub mod dual;
 pub mod dynamics;
 pub mod energy;
 pub mod flex;

@@ -5,19 +5,20 @@
 //!
 //! Fused sensitivities ([`OdeModel::rhs_lanes`]) take one multi-lane
 //! evaluation per stage: with `np` lanes the state is `y + Σ_i ε_i s_i`
-//! and parameter `i` is `p_i + ε_i`, on `num_dual::DualSVec64<N>` numbers
+//! and parameter `i` is `p_i + ε_i`, on [`DualN<N>`] numbers
 //! (`N` = 1, 2 or 4; more lanes go in chunks of 4). The real part of the
 //! result is `f` itself and dual part `i` is `J s_i + ∂f/∂p_i`, so no
 //! separate `f64` evaluation is made; the real parts are computed by the
 //! same operations as the `f64` right-hand side.
 
+use super::dual::DualN;
 use super::dynamics::System;
-use super::linalg::Scalar;
+use super::linalg::{Scalar, MAX_LANES};
 use super::model::Param;
 use super::segments::{Crossing, Events};
 use super::workspace::{BodyKin, Workspace};
 use crate::integrate::OdeModel;
-use num_dual::{Dual64, DualSVec64};
+use num_dual::Dual64;
 
 /// Scratch of dual-number evaluations with `D`: workspace and state
 /// buffers.
@@ -43,8 +44,8 @@ impl<D: Scalar> LaneWork<D> {
 pub struct SystemWork {
     ws: Workspace<f64>,
     d1: LaneWork<Dual64>,
-    d2: LaneWork<DualSVec64<2>>,
-    d4: LaneWork<DualSVec64<4>>,
+    d2: LaneWork<DualN<2>>,
+    d4: LaneWork<DualN<4>>,
     kin: Vec<BodyKin<f64>>,
 }
 
@@ -66,7 +67,7 @@ impl System {
     ) {
         let n = y.len();
         let k = lanes.len() / n;
-        let mut buf = [0.0f64; 8];
+        let mut buf = [0.0f64; MAX_LANES];
         let buf = &mut buf[..D::NL];
         lw.ws.params.clear();
         for (j, par) in names.iter().enumerate() {

@@ -136,9 +136,9 @@ impl ShapePlanes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use num_dual::DualSVec64;
+    use crate::mbs::dual::DualN;
 
-    type D = DualSVec64<2>;
+    type D = DualN<2>;
 
     fn d(k: usize) -> D {
         let x = k as f64;

@@ -25,7 +25,8 @@
 use super::dynamics::{pval, System, Workspace, RANK_REG, RANK_TOL, RIGID};
 use super::linalg::Factored;
 use super::linalg::{
-    fdot, gram_rows, min_degree_order, spd_factor, spd_solve, sym_times, CholPattern, Scalar,
+    fdot, gram_rows, min_degree_order, spd_factor, spd_solve, sym_quad, sym_times, CholPattern,
+    Scalar, MAX_LANES,
 };
 use super::model::Param;
 use super::workspace::{BodyBlock, SolveScratch};
@@ -223,13 +224,13 @@ impl System {
         if T::NL > 0 {
             self.tangent(ws, &mut sol, f);
         }
-        let nl = T::NL;
-        let mut lanes = vec![0.0; nl];
+        let mut buf = [0.0; MAX_LANES];
+        let lanes = &mut buf[..T::NL];
         let mut parts = |re: f64, d: &[f64], i: usize, n: usize| {
             for (l, v) in lanes.iter_mut().enumerate() {
                 *v = d[l * n + i];
             }
-            T::from_parts(re, &lanes)
+            T::from_parts(re, lanes)
         };
         let nv = self.nvel();
         let acc: Vec<T> = (0..nv)
@@ -316,8 +317,12 @@ impl System {
                         *x += y * sol.lam[r];
                     }
                     // D'_rr: 2 d'·w − wᵀM'w of this side.
-                    mass_lane_times(wi, &mut sol.tmp);
-                    dd[r] += 2.0 * fdot(di, wi) - fdot(wi, &sol.tmp);
+                    let quad = if d > 6 {
+                        sym_quad(&mp, d, wi)
+                    } else {
+                        dm * (wi[0] * wi[0] + wi[1] * wi[1] + wi[2] * wi[2])
+                    };
+                    dd[r] += 2.0 * fdot(di, wi) - quad;
                 }
                 sol.u.resize(d, 0.0);
                 self.minv_times(bb, s, &sol.r1, &mut sol.u);
