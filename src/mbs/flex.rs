@@ -43,10 +43,10 @@
 //! invariants' derivatives follow exactly (they are linear or bilinear in
 //! `X`) and are computed by one dual-number evaluation of the same sums.
 
-use super::linalg::Scalar;
 use crate::error::{Error, Result};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, Par};
 use nalgebra::{Matrix3, Vector3};
-use num_dual::Dual64;
 
 /// Derivatives of a basis with respect to one design variable.
 #[derive(Debug, Clone, PartialEq)]
@@ -353,26 +353,33 @@ pub struct Invariants {
 impl Invariants {
     /// The invariants of `basis`.
     pub fn new(basis: &ModalBasis) -> Invariants {
-        let v = sums::<f64>(basis, &|i| basis.shapes[i]);
+        let sh = ShapeMatrices::new(basis, &basis.shapes);
+        let (g, h) = (sh.gram(&sh), sh.rot_gram(&sh));
+        let v = flat_sums(basis, &basis.shapes, (&g, &h), true);
         Invariants::from_flat(basis.n_modes, &v, basis.eigenvalues.clone())
     }
 
     /// The invariants of `basis` and their derivatives with respect to
-    /// each of its design variables (exact: one dual-number evaluation of
-    /// the sums per variable).
+    /// each of its design variables, exact: the sums are linear in the
+    /// shapes `X` or bilinear (`G = ΦᵀMΦ`, `H = ΨᵀJΨ`), so a derivative
+    /// takes the linear sums of `X'` and `G' = S + Sᵀ`, `S = Φ'ᵀMΦ` (and
+    /// alike for `H`).
     pub fn with_derivatives(basis: &ModalBasis) -> (Invariants, Vec<Invariants>) {
-        let value = Invariants::new(basis);
         let n = basis.n_modes;
+        let sh = ShapeMatrices::new(basis, &basis.shapes);
+        let (g, h) = (sh.gram(&sh), sh.rot_gram(&sh));
+        let v = flat_sums(basis, &basis.shapes, (&g, &h), true);
+        let value = Invariants::from_flat(n, &v, basis.eigenvalues.clone());
+        let sym =
+            |s: Mat<f64>| Mat::<f64>::from_fn(s.nrows(), s.ncols(), |i, j| s[(i, j)] + s[(j, i)]);
         let derivs = basis
             .derivatives
             .iter()
             .map(|d| {
-                let dual = sums::<Dual64>(basis, &|i| Dual64::new(basis.shapes[i], d.shapes[i]));
-                let eps: Vec<f64> = dual.iter().map(|x| x.eps).collect();
-                let mut inv = Invariants::from_flat(n, &eps, d.eigenvalues.clone());
-                // Node masses and positions do not depend on the design.
-                inv.mass = 0.0;
-                inv
+                let dsh = ShapeMatrices::new(basis, &d.shapes);
+                let (dg, dh) = (sym(dsh.gram(&sh)), sym(dsh.rot_gram(&sh)));
+                let dv = flat_sums(basis, &d.shapes, (&dg, &dh), false);
+                Invariants::from_flat(n, &dv, d.eigenvalues.clone())
             })
             .collect();
         (value, derivs)
@@ -421,65 +428,133 @@ impl Invariants {
     }
 }
 
-/// All invariant sums of `basis` with mode-shape entries read through
-/// `x(index)` (so that dual numbers carry `dX`), flattened in the order
-/// of [`Invariants::from_flat`].
-fn sums<T: Scalar>(basis: &ModalBasis, x: &dyn Fn(usize) -> T) -> Vec<T> {
+/// The mode shapes of a basis (or their derivatives) arranged for the
+/// bilinear sums: `Φ` (`N × 3n`, row `k` = node `k`, column `r·n + j` =
+/// component `r` of mode `j`) and `Ψ` (`3N × n`, row `3k + c`), with
+/// `MΦ` and `JΨ` (rows scaled by the node masses and rotary inertias).
+struct ShapeMatrices {
+    phi: Mat<f64>,
+    mphi: Mat<f64>,
+    psi: Mat<f64>,
+    jpsi: Mat<f64>,
+}
+
+impl ShapeMatrices {
+    fn new(basis: &ModalBasis, shapes: &[f64]) -> ShapeMatrices {
+        let (nn, n) = (basis.nodes.len(), basis.n_modes);
+        let phi = Mat::<f64>::from_fn(nn, 3 * n, |k, col| {
+            let (r, j) = (col / n, col % n);
+            shapes[(k * 6 + r) * n + j]
+        });
+        let psi = Mat::<f64>::from_fn(3 * nn, n, |row, j| {
+            let (k, c) = (row / 3, row % 3);
+            shapes[(k * 6 + 3 + c) * n + j]
+        });
+        let mphi = Mat::<f64>::from_fn(nn, 3 * n, |k, col| basis.node_mass[k] * phi[(k, col)]);
+        let jpsi = Mat::<f64>::from_fn(3 * nn, n, |row, j| {
+            basis.node_inertia[row / 3][row % 3] * psi[(row, j)]
+        });
+        ShapeMatrices {
+            phi,
+            mphi,
+            psi,
+            jpsi,
+        }
+    }
+
+    /// `Φᵀ M Φ_o` (`3n × 3n`), `Φ` of `self` and `Φ_o` of `other`.
+    fn gram(&self, other: &ShapeMatrices) -> Mat<f64> {
+        let c = self.phi.ncols();
+        let mut g = Mat::<f64>::zeros(c, c);
+        matmul(
+            g.as_mut(),
+            Accum::Replace,
+            self.phi.transpose(),
+            other.mphi.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        g
+    }
+
+    /// `Ψᵀ J Ψ_o` (`n × n`).
+    fn rot_gram(&self, other: &ShapeMatrices) -> Mat<f64> {
+        let c = self.psi.ncols();
+        let mut h = Mat::<f64>::zeros(c, c);
+        matmul(
+            h.as_mut(),
+            Accum::Replace,
+            self.psi.transpose(),
+            other.jpsi.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        h
+    }
+}
+
+/// Every invariant sum in the order of [`Invariants::from_flat`]: the
+/// sums linear in `shapes` (`i3`, `ls`, `p`, `c_rot`) node by node, the
+/// bilinear ones read from `G` (`q_ij[r][c] = G[r·n+i, c·n+j]`, `v_ij`
+/// its antisymmetric part, `mww = Σ_r G_rr + H`) and, when `constant`,
+/// the design-independent `mass`, `s0`, `e0`, `j_rot` (zero otherwise:
+/// node masses and positions do not depend on the design).
+fn flat_sums(
+    basis: &ModalBasis,
+    shapes: &[f64],
+    (g, h): (&Mat<f64>, &Mat<f64>),
+    constant: bool,
+) -> Vec<f64> {
     let n = basis.n_modes;
-    let mut mass = T::zero();
-    let mut s0 = Vector3::<T>::zeros();
-    let mut e0 = Matrix3::<T>::zeros();
-    let mut i3 = vec![T::zero(); 3 * n];
-    let mut ls = vec![T::zero(); 3 * n];
-    let mut p = vec![T::zero(); 9 * n];
-    let mut q = vec![T::zero(); 9 * n * n];
-    let mut vv = vec![T::zero(); 3 * n * n];
-    let mut j_rot = Matrix3::<T>::zeros();
-    let mut c_rot = vec![T::zero(); 3 * n];
-    let mut mww = vec![T::zero(); n * n];
-    let mut phi = vec![Vector3::<T>::zeros(); n];
-    let mut psi = vec![Vector3::<T>::zeros(); n];
+    let mut mass = 0.0;
+    let mut s0 = Vector3::<f64>::zeros();
+    let mut e0 = Matrix3::<f64>::zeros();
+    let mut j_rot = Matrix3::<f64>::zeros();
+    let mut i3 = vec![0.0; 3 * n];
+    let mut ls = vec![0.0; 3 * n];
+    let mut p = vec![0.0; 9 * n];
+    let mut c_rot = vec![0.0; 3 * n];
     for (k, s) in basis.nodes.iter().enumerate() {
-        let m = T::from_subset(&basis.node_mass[k]);
-        let jk = basis.node_inertia[k].map(|v| T::from_subset(&v));
-        let s = s.map(|v| T::from_subset(&v));
-        for j in 0..n {
+        let (m, jk) = (basis.node_mass[k], basis.node_inertia[k]);
+        if constant {
+            mass += m;
+            s0 += s * m;
+            e0 += s * s.transpose() * m;
             for c in 0..3 {
-                phi[j][c] = x((k * 6 + c) * n + j);
-                psi[j][c] = x((k * 6 + 3 + c) * n + j);
+                j_rot[(c, c)] += jk[c];
             }
         }
-        mass += m;
-        s0 += s * m;
-        e0 += s * s.transpose() * m;
-        for c in 0..3 {
-            j_rot[(c, c)] += jk[c];
-        }
         for j in 0..n {
-            let mp = phi[j] * m;
-            let sxp = s.cross(&phi[j]) * m;
+            let phi = Vector3::from_fn(|c, _| shapes[(k * 6 + c) * n + j]);
+            let mp = phi * m;
+            let sxp = s.cross(&phi) * m;
             for c in 0..3 {
                 i3[c * n + j] += mp[c];
                 ls[c * n + j] += sxp[c];
-                c_rot[c * n + j] += jk[c] * psi[j][c];
+                c_rot[c * n + j] += jk[c] * shapes[(k * 6 + 3 + c) * n + j];
                 for r in 0..3 {
                     p[j * 9 + 3 * r + c] += mp[r] * s[c];
                 }
             }
-            for i in 0..n {
-                let pi = phi[i] * m;
-                let o = (i * n + j) * 9;
-                for r in 0..3 {
-                    for c in 0..3 {
-                        q[o + 3 * r + c] += pi[r] * phi[j][c];
-                    }
-                }
-                let cr = pi.cross(&phi[j]);
+        }
+    }
+    let mut q = vec![0.0; 9 * n * n];
+    let mut vv = vec![0.0; 3 * n * n];
+    let mut mww = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..n {
+            let gg = |r: usize, c: usize| g[(r * n + i, c * n + j)];
+            let o = (i * n + j) * 9;
+            for r in 0..3 {
                 for c in 0..3 {
-                    vv[(i * n + j) * 3 + c] += cr[c];
+                    q[o + 3 * r + c] = gg(r, c);
                 }
-                mww[i * n + j] += pi.dot(&phi[j]) + psi[i].component_mul(&jk).dot(&psi[j]);
             }
+            let o = (i * n + j) * 3;
+            vv[o] = gg(1, 2) - gg(2, 1);
+            vv[o + 1] = gg(2, 0) - gg(0, 2);
+            vv[o + 2] = gg(0, 1) - gg(1, 0);
+            mww[i * n + j] = gg(0, 0) + gg(1, 1) + gg(2, 2) + h[(i, j)];
         }
     }
     let mut out = Vec::with_capacity(Invariants::len_flat(n));
@@ -500,6 +575,84 @@ fn sums<T: Scalar>(basis: &ModalBasis, x: &dyn Fn(usize) -> T) -> Vec<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mbs::linalg::Scalar;
+    use num_dual::Dual64;
+
+    /// The definitions node by node (the table of the module doc), in any
+    /// scalar, flattened in the order of [`Invariants::from_flat`]: the
+    /// reference for the matrix-product sums.
+    fn sums<T: Scalar>(basis: &ModalBasis, x: &dyn Fn(usize) -> T) -> Vec<T> {
+        let n = basis.n_modes;
+        let mut mass = T::zero();
+        let mut s0 = Vector3::<T>::zeros();
+        let mut e0 = Matrix3::<T>::zeros();
+        let mut i3 = vec![T::zero(); 3 * n];
+        let mut ls = vec![T::zero(); 3 * n];
+        let mut p = vec![T::zero(); 9 * n];
+        let mut q = vec![T::zero(); 9 * n * n];
+        let mut vv = vec![T::zero(); 3 * n * n];
+        let mut j_rot = Matrix3::<T>::zeros();
+        let mut c_rot = vec![T::zero(); 3 * n];
+        let mut mww = vec![T::zero(); n * n];
+        let mut phi = vec![Vector3::<T>::zeros(); n];
+        let mut psi = vec![Vector3::<T>::zeros(); n];
+        for (k, s) in basis.nodes.iter().enumerate() {
+            let m = T::from_subset(&basis.node_mass[k]);
+            let jk = basis.node_inertia[k].map(|v| T::from_subset(&v));
+            let s = s.map(|v| T::from_subset(&v));
+            for j in 0..n {
+                for c in 0..3 {
+                    phi[j][c] = x((k * 6 + c) * n + j);
+                    psi[j][c] = x((k * 6 + 3 + c) * n + j);
+                }
+            }
+            mass += m;
+            s0 += s * m;
+            e0 += s * s.transpose() * m;
+            for c in 0..3 {
+                j_rot[(c, c)] += jk[c];
+            }
+            for j in 0..n {
+                let mp = phi[j] * m;
+                let sxp = s.cross(&phi[j]) * m;
+                for c in 0..3 {
+                    i3[c * n + j] += mp[c];
+                    ls[c * n + j] += sxp[c];
+                    c_rot[c * n + j] += jk[c] * psi[j][c];
+                    for r in 0..3 {
+                        p[j * 9 + 3 * r + c] += mp[r] * s[c];
+                    }
+                }
+                for i in 0..n {
+                    let pi = phi[i] * m;
+                    let o = (i * n + j) * 9;
+                    for r in 0..3 {
+                        for c in 0..3 {
+                            q[o + 3 * r + c] += pi[r] * phi[j][c];
+                        }
+                    }
+                    let cr = pi.cross(&phi[j]);
+                    for c in 0..3 {
+                        vv[(i * n + j) * 3 + c] += cr[c];
+                    }
+                    mww[i * n + j] += pi.dot(&phi[j]) + psi[i].component_mul(&jk).dot(&psi[j]);
+                }
+            }
+        }
+        let mut out = Vec::with_capacity(Invariants::len_flat(n));
+        out.push(mass);
+        out.extend(s0.iter().copied());
+        out.extend(e0.transpose().iter().copied()); // row-major
+        out.extend(i3);
+        out.extend(ls);
+        out.extend(p);
+        out.extend(q);
+        out.extend(vv);
+        out.extend(j_rot.transpose().iter().copied());
+        out.extend(c_rot);
+        out.extend(mww);
+        out
+    }
 
     /// Two point masses on a massless spring along x, one mode (the
     /// stretching mode), with a third rotary-inertia node.
@@ -560,6 +713,67 @@ mod tests {
         assert!((inv.c_rot[2] - 0.06).abs() < 1e-15);
         assert!((inv.mww[0] - (1.0 + 0.018)).abs() < 1e-15);
         assert!((inv.j_rot[(2, 2)] - 0.2).abs() < 1e-15);
+    }
+
+    /// A basis of 7 nodes and 3 modes with deterministic pseudo-random
+    /// positions, masses, inertias, shapes and shape derivatives.
+    fn scrambled() -> ModalBasis {
+        let r = |k: usize| ((k as f64 * 0.618_034 + 0.1).fract() - 0.5) * 2.0;
+        let (nn, n) = (7, 3);
+        ModalBasis {
+            nodes: (0..nn)
+                .map(|k| Vector3::new(r(3 * k), r(3 * k + 1), r(3 * k + 2)))
+                .collect(),
+            node_mass: (0..nn).map(|k| 1.0 + r(50 + k).abs()).collect(),
+            node_inertia: (0..nn)
+                .map(|k| Vector3::new(r(60 + k).abs(), r(70 + k).abs(), r(80 + k).abs()))
+                .collect(),
+            n_modes: n,
+            shapes: (0..6 * nn * n).map(|i| r(100 + i)).collect(),
+            eigenvalues: vec![1.0, 2.0, 3.0],
+            derivatives: vec![BasisDerivative {
+                name: "b".into(),
+                eigenvalues: vec![0.1, 0.2, 0.3],
+                shapes: (0..6 * nn * n).map(|i| r(400 + i)).collect(),
+            }],
+            rigid: RigidScreen::default(),
+        }
+    }
+
+    #[test]
+    fn matrix_product_sums_equal_the_node_by_node_definitions() {
+        // Values from f64 sums, derivatives from dual-number sums of the
+        // definitions, both node by node; the products agree to round-off.
+        let b = scrambled();
+        let (inv, d) = Invariants::with_derivatives(&b);
+        let n = b.n_modes;
+        let want =
+            Invariants::from_flat(n, &sums::<f64>(&b, &|i| b.shapes[i]), b.eigenvalues.clone());
+        let dual = sums::<Dual64>(&b, &|i| {
+            Dual64::new(b.shapes[i], b.derivatives[0].shapes[i])
+        });
+        let eps: Vec<f64> = dual.iter().map(|x| x.eps).collect();
+        let dwant = Invariants::from_flat(n, &eps, vec![0.1, 0.2, 0.3]);
+        let close = |a: &Invariants, b: &Invariants, what: &str| {
+            for (name, x, y) in [
+                ("i3", &a.i3, &b.i3),
+                ("ls", &a.ls, &b.ls),
+                ("p", &a.p, &b.p),
+                ("q", &a.q, &b.q),
+                ("v", &a.v, &b.v),
+                ("c_rot", &a.c_rot, &b.c_rot),
+                ("mww", &a.mww, &b.mww),
+            ] {
+                for (u, v) in x.iter().zip(y) {
+                    assert!((u - v).abs() < 1e-13, "{what} {name}: {u} vs {v}");
+                }
+            }
+            assert!((a.e0 - b.e0).norm() < 1e-13 && (a.s0 - b.s0).norm() < 1e-13);
+            assert!((a.j_rot - b.j_rot).norm() < 1e-13 && (a.mass - b.mass).abs() < 1e-13);
+        };
+        close(&inv, &want, "value");
+        close(&d[0], &dwant, "derivative");
+        assert_eq!(d[0].mass, 0.0);
     }
 
     #[test]
