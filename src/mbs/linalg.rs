@@ -351,19 +351,6 @@ pub fn spd_inverse(a: &mut [f64], n: usize) -> bool {
     true
 }
 
-/// `xᵀ S x` for a symmetric row-major `n × n` matrix `S` from its lower
-/// triangle: `Σ_j x_j (S_jj x_j + 2 Σ_{k<j} S_jk x_k)`, half the products
-/// of `x · (S x)`.
-#[inline]
-pub fn sym_quad(s: &[f64], n: usize, x: &[f64]) -> f64 {
-    let mut q = 0.0;
-    for j in 0..n {
-        let row = &s[j * n..j * n + j];
-        q += x[j] * (s[j * n + j] * x[j] + 2.0 * fdot(row, &x[..j]));
-    }
-    q
-}
-
 /// `out = S x` for a symmetric row-major `n × n` matrix `S`, as a sum of
 /// its rows scaled by the entries of `x` (row `j` = column `j`): vector
 /// updates, and nothing done for the zero entries of `x` (the rigid

@@ -25,8 +25,8 @@
 use super::dynamics::{pval, System, Workspace, RANK_REG, RANK_TOL, RIGID};
 use super::linalg::Factored;
 use super::linalg::{
-    fdot, gram_rows, min_degree_order, spd_factor, spd_solve, sym_quad, sym_times, CholPattern,
-    Scalar, MAX_LANES,
+    fdot, gram_rows, min_degree_order, spd_factor, spd_solve, sym_times, CholPattern, Scalar,
+    MAX_LANES,
 };
 use super::model::Param;
 use super::workspace::{BodyBlock, SolveScratch};
@@ -309,6 +309,9 @@ impl System {
                 for (x, y) in sol.r1.iter_mut().zip(&sol.tmp) {
                     *x -= y;
                 }
+                if d > 6 {
+                    quad_forms(&mp, &bb.w[..k * d], d, &mut sol.quad);
+                }
                 for (i, &r) in bb.rows.iter().enumerate() {
                     let di = &lane[i * d..(i + 1) * d];
                     let wi = &bb.w[i * d..(i + 1) * d];
@@ -318,7 +321,7 @@ impl System {
                     }
                     // D'_rr: 2 d'·w − wᵀM'w of this side.
                     let quad = if d > 6 {
-                        sym_quad(&mp, d, wi)
+                        sol.quad[i]
                     } else {
                         dm * (wi[0] * wi[0] + wi[1] * wi[1] + wi[2] * wi[2])
                     };
@@ -371,5 +374,67 @@ impl System {
         }
         let b = self.moving[s];
         pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass).lane_part(l)
+    }
+}
+
+/// `q_i = w_iᵀ S w_i` for the `k` rows `w_i` of `w` (row-major `k × d`)
+/// and a symmetric row-major `d × d` matrix `S`: one product `Y = S Wᵀ`
+/// (faer's small-matrix kernels), then a dot per row.
+fn quad_forms(s: &[f64], w: &[f64], d: usize, q: &mut Vec<f64>) {
+    let k = w.len() / d;
+    let sm = faer::MatRef::from_row_major_slice(s, d, d);
+    let wt = faer::MatRef::from_row_major_slice(w, k, d).transpose();
+    let mut y = faer::Mat::<f64>::zeros(d, k);
+    faer::linalg::matmul::matmul(
+        y.as_mut(),
+        faer::Accum::Replace,
+        sm,
+        wt,
+        1.0,
+        faer::Par::Seq,
+    );
+    q.clear();
+    q.extend((0..k).map(|i| {
+        let col = y
+            .col(i)
+            .try_as_col_major()
+            .expect("column-major")
+            .as_slice();
+        fdot(col, &w[i * d..(i + 1) * d])
+    }));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadratic_forms_of_rows_match_the_definition() {
+        // S symmetric 5 × 5, three rows w_i: q_i = Σ_jk S_jk w_ij w_ik.
+        let d = 5;
+        let f = |k: usize| ((k as f64 * 0.7548777 + 0.3).fract() - 0.5) * 3.0;
+        let mut s = vec![0.0; d * d];
+        for j in 0..d {
+            for k in 0..=j {
+                let v = f(j * d + k);
+                s[j * d + k] = v;
+                s[k * d + j] = v;
+            }
+        }
+        let w: Vec<f64> = (0..3 * d).map(|k| f(100 + k)).collect();
+        let mut q = Vec::new();
+        quad_forms(&s, &w, d, &mut q);
+        assert_eq!(q.len(), 3);
+        for (i, qi) in q.iter().enumerate() {
+            let wi = &w[i * d..(i + 1) * d];
+            let want: f64 = (0..d)
+                .flat_map(|j| (0..d).map(move |k| (j, k)))
+                .map(|(j, k)| s[j * d + k] * wi[j] * wi[k])
+                .sum();
+            assert!(
+                (qi - want).abs() < 1e-13 * (1.0 + want.abs()),
+                "{qi} vs {want}"
+            );
+        }
     }
 }

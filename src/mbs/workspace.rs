@@ -156,6 +156,8 @@ pub struct SolveScratch {
     /// One body's `r₁` and `M⁻¹r₁`.
     pub(crate) r1: Vec<f64>,
     pub(crate) u: Vec<f64>,
+    /// One body's `w_iᵀ M' w_i` per row.
+    pub(crate) quad: Vec<f64>,
 }
 
 /// Translational and rotational mode-shape rows of a node (n columns each).
