@@ -416,6 +416,7 @@ impl<T: Scalar> Workspace<T> {
             rank: 0,
             params: Vec::new(),
             segments: Vec::new(),
+            rotations: Vec::new(),
         }
     }
 }

@@ -45,7 +45,7 @@ use super::linalg::{
     cst, euler_rate, mm, mtv, mv, rotation, rotation_tangent, rotation_vector, spd_inverse,
     sym_times, Scalar,
 };
-use super::model::{Model, Param};
+use super::model::{Force, JointKind, Model, Param};
 use super::planes::ShapePlanes;
 use super::rows::joint_rows;
 pub use super::rows::{angle_of, slide_of};
@@ -290,16 +290,54 @@ impl System {
     /// Global kinematics of marker `m`.
     pub fn marker_kin<T: Scalar>(&self, kin: &[BodyKin<T>], m: usize) -> MarkerKin<T> {
         let (phi, psi) = self.marker_shapes(kin, m);
-        self.marker_kin_with(kin, m, &ShapePlanes::new(&phi, &psi))
+        self.marker_kin_with(kin, m, &ShapePlanes::new(&phi, &psi), true)
+    }
+
+    /// Which markers' node rotations something in the model reads (by
+    /// marker index): the frame, angular velocity and angular acceleration
+    /// of a marker on a flexible node enter the rows of every joint kind
+    /// but the spherical one (whose rows read the point alone, and whose
+    /// modal entries `Ψ_kᵀTᵀAᵀ(ω-block − s × v-block)` vanish: that
+    /// difference is exactly zero for a point row), the forces tied to a
+    /// joint's axes, marker loads (torques) and spring-dampers (kept for
+    /// safety). A node marker that only spherical joints use gets the
+    /// body frame's rotation in its [`MarkerKin`] instead.
+    pub fn node_rotations(&self, out: &mut Vec<bool>) {
+        out.clear();
+        out.resize(self.model.markers.len(), false);
+        for joint in &self.model.joints {
+            if !matches!(joint.kind, JointKind::Spherical) {
+                out[joint.i] = true;
+                out[joint.j] = true;
+            }
+        }
+        for force in &self.model.forces {
+            match force {
+                Force::Rotational { joint, .. } | Force::JointSpring { joint, .. } => {
+                    let jt = &self.model.joints[*joint];
+                    out[jt.i] = true;
+                    out[jt.j] = true;
+                }
+                Force::SpringDamper { i, j, .. } => {
+                    out[*i] = true;
+                    out[*j] = true;
+                }
+                Force::MarkerLoad { marker, .. } => out[*marker] = true,
+                Force::Gravity { .. } | Force::BodyLoad { .. } => {}
+            }
+        }
     }
 
     /// [`System::marker_kin`] with the marker's node shapes given (as
-    /// planes).
+    /// planes); `rotation`: whether to include a flexible node's rotation
+    /// (see [`System::node_rotations`]; without it the frame, angular
+    /// velocity, its rate term and the tangent are the body frame's).
     fn marker_kin_with<T: Scalar>(
         &self,
         kin: &[BodyKin<T>],
         m: usize,
         planes: &ShapePlanes,
+        rotation: bool,
     ) -> MarkerKin<T> {
         let mk = &self.model.markers[m];
         let pos = mk.pos.map(cst::<T>);
@@ -343,6 +381,21 @@ impl System {
                         let (vd, wd) = planes.combine(&k.qd);
                         let sg = mv(&k.a, &(pos + du));
                         let vdg = mv(&k.a, &vd);
+                        let acc = k.w.cross(&k.w.cross(&sg)) + k.w.cross(&vdg) * cst::<T>(2.0);
+                        if !rotation {
+                            return MarkerKin {
+                                slot: Some(s),
+                                x: k.r + sg,
+                                v: k.v + k.w.cross(&sg) + vdg,
+                                s: sg,
+                                frame: mm(&k.a, &frame),
+                                w: k.w,
+                                acc,
+                                alpha: Vector3::zeros(),
+                                node: Some((b, node)),
+                                tangent: Matrix3::identity(),
+                            };
+                        }
                         // Exact angular velocity of the node frame
                         // A R(θ) F₀: ω + A T(θ) θ̇, and its rate terms.
                         let (tm, tdot) = rotation_tangent(&th, &wd);
@@ -354,7 +407,7 @@ impl System {
                             s: sg,
                             frame: mm(&k.a, &mm(&rotation_vector(&th), &frame)),
                             w: k.w + wdg,
-                            acc: k.w.cross(&k.w.cross(&sg)) + k.w.cross(&vdg) * cst::<T>(2.0),
+                            acc,
                             alpha: k.w.cross(&wdg) + mv(&k.a, &tdot),
                             node: Some((b, node)),
                             tangent: tm,
@@ -395,6 +448,9 @@ impl System {
         ws.shape_seeds.resize_with(nm, || None);
         ws.planes.resize_with(nm, ShapePlanes::default);
         ws.shape_spare.resize_with(nm, Vec::new);
+        let mut rotations = std::mem::take(&mut ws.rotations);
+        self.node_rotations(&mut rotations);
+        ws.rotations = rotations;
         for m in 0..nm {
             let mk = &self.model.markers[m];
             let seeds = match (mk.node, mk.body.and_then(|b| self.slot[b])) {
@@ -427,7 +483,7 @@ impl System {
                 ws.shape_spare[m].insert(0, old);
                 ws.shape_spare[m].truncate(SEED_SPARES);
             }
-            let k = self.marker_kin_with(&ws.kin, m, &ws.planes[m]);
+            let k = self.marker_kin_with(&ws.kin, m, &ws.planes[m], ws.rotations[m]);
             ws.mk.push(k);
         }
     }
@@ -478,7 +534,13 @@ impl System {
                 if mk.node.is_some() {
                     // ∂/∂ẇ_j = (Aᵀdv)·Φ_kj + (Tᵀ Aᵀ(dw_g − s×dv))·Ψ_kj.
                     let av = mtv(&k.a, &dv);
-                    let aw = mtv(&mk.tangent, &mtv(&k.a, &(wg - mk.s.cross(&dv))));
+                    // Without the node's rotation (spherical joints only)
+                    // ω-block − s × v-block is exactly zero.
+                    let aw = if ws.rotations[row.markers[side]] {
+                        mtv(&mk.tangent, &mtv(&k.a, &(wg - mk.s.cross(&dv))))
+                    } else {
+                        Vector3::zeros()
+                    };
                     row.modal[side] = ws.mjac.len();
                     let planes = &ws.planes[row.markers[side]];
                     phidot += planes.row_entries((&av, &aw), &k.qd, &mut ws.mjac);

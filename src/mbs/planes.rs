@@ -96,7 +96,8 @@ impl ShapePlanes {
     }
 
     /// The modal entries `e_j = a·Φ_j + b·Ψ_j` of a constraint row (pushed
-    /// onto `out`) and `Σ_j e_j c_j`.
+    /// onto `out`) and `Σ_j e_j c_j` (the `Ψ` terms skipped when `b` is
+    /// exactly zero, as for the point rows of spherical joints).
     pub fn row_entries<T: Scalar>(
         &self,
         (a, b): (&Vector3<T>, &Vector3<T>),
@@ -114,13 +115,18 @@ impl ShapePlanes {
                 ab[p * 6 + k] = parts[p];
             }
         }
+        let nk = if b.iter().all(|v| v.is_exact_zero()) {
+            3
+        } else {
+            6
+        };
         let (mut e, mut cp, mut sum) = ([0.0; MAX_PLANES], [0.0; MAX_PLANES], [0.0; MAX_PLANES]);
         for (j, cj) in c.iter().enumerate().take(self.n) {
             let s0 = self.row(0, j);
-            e[0] = (0..6).map(|k| ab[k] * s0[k]).sum();
+            e[0] = (0..nk).map(|k| ab[k] * s0[k]).sum();
             for p in 1..np {
                 let sp = self.row(p, j);
-                e[p] = (0..6).map(|k| ab[p * 6 + k] * s0[k] + ab[k] * sp[k]).sum();
+                e[p] = (0..nk).map(|k| ab[p * 6 + k] * s0[k] + ab[k] * sp[k]).sum();
             }
             out.push(T::from_parts(e[0], &e[1..np]));
             split(cj, &mut cp[..np]);

@@ -123,6 +123,9 @@ pub struct Workspace<T: Scalar> {
     /// right-hand side is smooth. Empty (or an out-of-range entry): the
     /// segment is picked by the value of θ.
     pub segments: Vec<usize>,
+    /// Per marker: whether its node rotation is computed
+    /// ([`super::dynamics::System::node_rotations`]).
+    pub(crate) rotations: Vec<bool>,
 }
 
 /// One body's share of the constraint-space matrix, in real arithmetic:
