@@ -41,7 +41,8 @@
 //! respect to named design variables (the ply angles: `dΛ/dθ`, `dX/dθ`
 //! from [`crate::modal`]); node masses do not depend on them. The
 //! invariants' derivatives follow exactly (they are linear or bilinear in
-//! `X`) and are computed by one dual-number evaluation of the same sums.
+//! `X`) from the same matrix products
+//! ([`Invariants::with_derivatives`]).
 
 use crate::error::{Error, Result};
 use faer::linalg::matmul::matmul;
@@ -353,8 +354,12 @@ pub struct Invariants {
 impl Invariants {
     /// The invariants of `basis`.
     pub fn new(basis: &ModalBasis) -> Invariants {
-        let sh = ShapeMatrices::new(basis, &basis.shapes);
-        let (g, h) = (sh.gram(&sh), sh.rot_gram(&sh));
+        Invariants::of_shapes(basis, &ShapeMatrices::new(basis, &basis.shapes))
+    }
+
+    /// The invariants of `basis` from its arranged shapes `sh`.
+    fn of_shapes(basis: &ModalBasis, sh: &ShapeMatrices) -> Invariants {
+        let (g, h) = (sh.gram(sh), sh.rot_gram(sh));
         let v = flat_sums(basis, &basis.shapes, (&g, &h), true);
         Invariants::from_flat(basis.n_modes, &v, basis.eigenvalues.clone())
     }
@@ -367,9 +372,7 @@ impl Invariants {
     pub fn with_derivatives(basis: &ModalBasis) -> (Invariants, Vec<Invariants>) {
         let n = basis.n_modes;
         let sh = ShapeMatrices::new(basis, &basis.shapes);
-        let (g, h) = (sh.gram(&sh), sh.rot_gram(&sh));
-        let v = flat_sums(basis, &basis.shapes, (&g, &h), true);
-        let value = Invariants::from_flat(n, &v, basis.eigenvalues.clone());
+        let value = Invariants::of_shapes(basis, &sh);
         let sym =
             |s: Mat<f64>| Mat::<f64>::from_fn(s.nrows(), s.ncols(), |i, j| s[(i, j)] + s[(j, i)]);
         let derivs = basis

@@ -184,7 +184,13 @@ pub struct BodyKin<T: Scalar> {
     pub design: Vec<(usize, T)>,
 }
 
-/// Global kinematics of a marker.
+/// Global kinematics of a marker. On a flexible node whose rotation
+/// nothing in the model reads ([`super::dynamics::System::node_rotations`]:
+/// only spherical joints use the marker), [`System::markers_kin`]
+/// leaves the node's rotation out: `frame`, `w`, `alpha` and `tangent`
+/// are then those of the body frame.
+///
+/// [`System::markers_kin`]: super::dynamics::System::markers_kin
 #[derive(Debug, Clone, Copy)]
 pub struct MarkerKin<T: Scalar> {
     pub slot: Option<usize>,

@@ -32,7 +32,7 @@
 //! singleton the border is not needed — Nelson's reduced system is
 //! consistent — and `x' = z − x(xᵀMz)`. Every solve is checked and, where
 //! needed, refined by right-preconditioned GMRES on the exact matrix to a
-//! relative residual of [`SOLVE_TOL`] (the unpivoted `LDLᵀ` of an indefinite
+//! relative residual of 1e-11 (`SOLVE_TOL`; the unpivoted `LDLᵀ` of an indefinite
 //! matrix may meet a tiny pivot, e.g. a Sturm-sequence zero of a chain; such
 //! pivots are regularised and the refinement removes the rank-one error).
 //! One factorization per cluster serves every design variable.
