@@ -5,8 +5,8 @@
 //!
 //! Fused sensitivities ([`OdeModel::rhs_lanes`]) take one multi-lane
 //! evaluation per stage: with `np` lanes the state is `y + Σ_i ε_i s_i`
-//! and parameter `i` is `p_i + ε_i`, on [`DualN<N>`] numbers
-//! (`N` = 1, 2 or 4; more lanes go in chunks of 4). The real part of the
+//! and parameter `i` is `p_i + ε_i`, on num-dual's `Dual64` for one lane
+//! and [`DualN<N>`] for 2 or 4 (more lanes go in chunks of 4). The real part of the
 //! result is `f` itself and dual part `i` is `J s_i + ∂f/∂p_i`, so no
 //! separate `f64` evaluation is made; the real parts are computed by the
 //! same operations as the `f64` right-hand side.

@@ -12,12 +12,11 @@
 //! instead of `14 × 6` dual products per sum. For `f64` there is one plane
 //! and the sums are the plain ones.
 
-use super::linalg::Scalar;
+use super::linalg::{Scalar, MAX_LANES};
 use nalgebra::Vector3;
 
-/// Most planes a number splits into: the real part and up to 8 lanes (the
-/// kernel's duals have 1, 2 or 4).
-const MAX_PLANES: usize = 9;
+/// Most planes a number splits into: the real part and its lanes.
+const MAX_PLANES: usize = MAX_LANES + 1;
 
 /// The shape rows `(Φ_j, Ψ_j)`, `j < n`, of one node as planes: `v[(p·n +
 /// j)·6 + c]` with plane `p = 0` the real parts and `p = 1 + l` lane `l`,

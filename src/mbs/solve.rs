@@ -292,25 +292,20 @@ impl System {
                 let a = &sol.acc[o..o + d];
                 let lane = &bb.lanes[l * (k + 1) * d..(l + 1) * (k + 1) * d];
                 let dm = self.mass_lane(ws, s, l, &mut mp);
-                let mass_lane_times = |x: &[f64], out: &mut Vec<f64>| {
-                    out.clear();
-                    out.resize(d, 0.0);
-                    if d > 6 {
-                        sym_times(&mp, d, x, out);
-                    } else {
-                        for c in 0..3 {
-                            out[c] = dm * x[c];
-                        }
-                    }
-                };
+                // r₁ starts as Q' − M'v̇ (a rigid body's M' is diag(m'I, 0)).
                 sol.r1.clear();
                 sol.r1.extend_from_slice(&lane[k * d..(k + 1) * d]);
-                mass_lane_times(a, &mut sol.tmp);
-                for (x, y) in sol.r1.iter_mut().zip(&sol.tmp) {
-                    *x -= y;
-                }
                 if d > 6 {
+                    sol.tmp.resize(d, 0.0);
+                    sym_times(&mp, d, a, &mut sol.tmp);
+                    for (x, y) in sol.r1.iter_mut().zip(&sol.tmp) {
+                        *x -= y;
+                    }
                     quad_forms(&mp, &bb.w[..k * d], d, &mut sol.quad);
+                } else {
+                    for (x, v) in sol.r1.iter_mut().zip(&a[..3]) {
+                        *x -= dm * v;
+                    }
                 }
                 for (i, &r) in bb.rows.iter().enumerate() {
                     let di = &lane[i * d..(i + 1) * d];
