@@ -286,7 +286,7 @@ fn main() -> plyscape::Result<()> {
         for _ in 0..7 {
             let w0 = Instant::now();
             let t0 = cpu_ms();
-            let solver = ModalSolver::new(&k, &case.mass)?;
+            let mut solver = ModalSolver::new(&k, &case.mass)?;
             let t1 = cpu_ms();
             let w1 = Instant::now();
             let modes = solver.solve(&opts)?;

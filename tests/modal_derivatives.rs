@@ -101,7 +101,7 @@ fn distinct_modes_match_finite_differences_and_modal_expansion() {
     let k_modes = 10;
     let p = [0.3, 0.4];
     let kk = pr.k(p);
-    let solver = ModalSolver::new(&kk, &pr.mass).unwrap();
+    let mut solver = ModalSolver::new(&kk, &pr.mass).unwrap();
     let mut o = ModalOptions::new(k_modes);
     o.tol = 1e-13;
     let modes = solver.solve(&o).unwrap();
@@ -226,7 +226,7 @@ fn repeated_eigenvalue_adjacent_eigenvectors_exact() {
     );
     let d2k = assemble(n, &[]);
     let mass = vec![1.0; n];
-    let solver = ModalSolver::new(&kk, &mass).unwrap();
+    let mut solver = ModalSolver::new(&kk, &mass).unwrap();
     let modes = solver.solve(&ModalOptions::new(6)).unwrap();
     let var = [DesignDerivative {
         dk: &dk,
@@ -368,7 +368,7 @@ fn near_crossing_stays_bounded_and_matches_smooth_branch() {
     for delta in [1e-2, 1e-4, 1e-7, 1e-10, 0.0] {
         let p = 0.5 + delta;
         let kk = full(p);
-        let solver = ModalSolver::new(&kk, &mass).unwrap();
+        let mut solver = ModalSolver::new(&kk, &mass).unwrap();
         let mut o = ModalOptions::new(4);
         o.tol = 1e-13;
         let modes = solver.solve(&o).unwrap();
@@ -432,7 +432,7 @@ fn near_crossing_stays_bounded_and_matches_smooth_branch() {
 fn wrong_derivative_size_is_input_error() {
     let n = 6;
     let kk = assemble(n, &chain_springs(n, 1.0, 0, true));
-    let solver = ModalSolver::new(&kk, &vec![1.0; n]).unwrap();
+    let mut solver = ModalSolver::new(&kk, &vec![1.0; n]).unwrap();
     let modes = solver.solve(&ModalOptions::new(2)).unwrap();
     let bad = assemble(5, &chain_springs(5, 1.0, 0, true));
     let var = [DesignDerivative {
@@ -511,7 +511,7 @@ fn repeated_eigenvalue_generic_perturbation_matches_branch_fd() {
         d2k: Some(&d2k),
     }];
     let kk = k_at(0.0);
-    let solver = ModalSolver::new(&kk, &mass).unwrap();
+    let mut solver = ModalSolver::new(&kk, &mass).unwrap();
     let mut o = ModalOptions::new(4);
     o.tol = 1e-14;
     let modes = solver.solve(&o).unwrap();
@@ -612,7 +612,7 @@ fn derivatives_bitwise_deterministic() {
     }];
     let mass = vec![1.0; n];
     let run = || {
-        let solver = ModalSolver::new(&kk, &mass).unwrap();
+        let mut solver = ModalSolver::new(&kk, &mass).unwrap();
         let modes = solver.solve(&ModalOptions::new(4)).unwrap();
         solver
             .derivatives(&modes, &var, &DerivativeOptions::default())

@@ -33,6 +33,17 @@
 //! plies (the paper's [θ1/θ2/θ2/θ1] ties plies 1 & 4 and 2 & 3); its
 //! derivative is the sum over the group.
 //!
+//! # Symmetric stacks
+//! When ply `k` and its mirror `n−1−k` are equal for every `k`
+//! ([`Laminate::is_symmetric`]), their B contributions cancel and B = 0;
+//! likewise B' when the design variable moves both plies of every mirror
+//! pair it touches (the paper's θ1 on plies 1 & 4, θ2 on 2 & 3). The sum
+//! over plies leaves rounding instead (about 1e-20 of |A| on the SAR
+//! panels, from interface coordinates and summation order), so B and B'
+//! are set to exactly zero there: the shell's membrane (u, v, θz) and
+//! bending (w, θx, θy) DOFs are then uncoupled in K and K' exactly, which
+//! the modal derivatives exploit (`modal::blocks`).
+//!
 //! [`ply_stiffness_generic`] and [`stiffness_generic`] are a twin of the same
 //! mechanics written generic over the scalar with the explicit `c⁴, s²c², …`
 //! transformation polynomials (an independent route); tests drive them with
@@ -320,12 +331,30 @@ impl Laminate {
         z
     }
 
-    /// A, B, D, S (module doc).
+    /// Is the stack symmetric about its mid-plane: ply `k` and ply
+    /// `n−1−k` equal (material, thickness, angle) for every `k`?
+    pub fn is_symmetric(&self) -> bool {
+        let n = self.plies.len();
+        (0..n / 2).all(|k| self.plies[k] == self.plies[n - 1 - k])
+    }
+
+    /// Is `group` closed under the mid-plane mirror (ply `k` in it ⇒ ply
+    /// `n−1−k` in it)?
+    fn mirror_closed(&self, group: &[usize]) -> bool {
+        let n = self.plies.len();
+        group.iter().all(|&k| group.contains(&(n - 1 - k)))
+    }
+
+    /// A, B, D, S (module doc). For a mid-plane symmetric stack B is
+    /// exactly zero (module doc, "Symmetric stacks").
     pub fn stiffness(&self) -> Stiffness {
         let z = self.interfaces();
         let mut st = Stiffness::default();
         for (k, p) in self.plies.iter().enumerate() {
             st.add_ply(&p.stiffness_derivative(0), z[k], z[k + 1]);
+        }
+        if self.is_symmetric() {
+            st.b = Matrix3::zeros();
         }
         st
     }
@@ -358,11 +387,17 @@ impl Laminate {
         self.group_derivative(&map.groups[v], 2)
     }
 
+    /// Derivative with respect to the common angle of `group`; B' is
+    /// exactly zero when the stack is symmetric and the group mirror-closed
+    /// (module doc, "Symmetric stacks").
     fn group_derivative(&self, group: &[usize], order: u8) -> Stiffness {
         let z = self.interfaces();
         let mut st = Stiffness::default();
         for &k in group {
             st.add_ply(&self.plies[k].stiffness_derivative(order), z[k], z[k + 1]);
+        }
+        if self.is_symmetric() && self.mirror_closed(group) {
+            st.b = Matrix3::zeros();
         }
         st
     }
@@ -553,6 +588,62 @@ mod tests {
                 for j in 0..2 {
                     assert!((a.g[(i, j)] - g[i][j]).abs() < 1e-12 * m.g23);
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn symmetric_stacks_have_exactly_zero_coupling() {
+        // B = ½ Σ Q̄ₖ (zₖ² − zₖ₋₁²) cancels pairwise for mirror-equal plies;
+        // with 0.13 mm plies the interface coordinates are not exact binary
+        // mirrors, so the plain sum leaves rounding that must not remain.
+        let m = Orthotropic::im6_sc1081();
+        let ply = |deg: f64| Ply {
+            material: m,
+            thickness: 0.13e-3,
+            angle: deg.to_radians(),
+        };
+        let sym = Laminate::new(vec![ply(55.0), ply(-55.0), ply(-55.0), ply(55.0)]).unwrap();
+        assert!(sym.is_symmetric());
+        assert_eq!(sym.stiffness().b, Matrix3::zeros());
+        let paper = DesignMap::new(vec![vec![0, 3], vec![1, 2]], 4).unwrap();
+        for v in 0..2 {
+            assert_eq!(sym.design_derivative(&paper, v).b, Matrix3::zeros());
+            assert_eq!(
+                sym.design_second_derivative(&paper, v, v).b,
+                Matrix3::zeros()
+            );
+        }
+        // A variable on one ply of a pair breaks the symmetry: B' ≠ 0, and it
+        // equals the twin's value (hyper-dual derivative of the plain sum).
+        let per_ply = DesignMap::per_ply(4);
+        let b1 = sym.design_derivative(&per_ply, 0).b;
+        let angles: Vec<num_dual::Dual64> = sym
+            .angles()
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| num_dual::Dual64::new(t, if k == 0 { 1.0 } else { 0.0 }))
+            .collect();
+        let (_, bg, _, _) = stiffness_generic(&sym, &angles);
+        let scale = b1.abs().max();
+        assert!(scale > 1e-3, "{scale}");
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((b1[(i, j)] - bg[i][j].eps).abs() < 1e-9 * scale, "{i}{j}");
+            }
+        }
+        // An unsymmetric stack keeps its B from the sum.
+        let uns = Laminate::new(vec![ply(55.0), ply(-55.0), ply(-55.0), ply(40.0)]).unwrap();
+        assert!(!uns.is_symmetric());
+        let b = uns.stiffness().b;
+        let (_, bg, _, _) = stiffness_generic(&uns, &uns.angles());
+        assert!(b.abs().max() > 1e-3);
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!(
+                    (b[(i, j)] - bg[i][j]).abs() < 1e-9 * b.abs().max(),
+                    "{i}{j}"
+                );
             }
         }
     }

@@ -57,9 +57,10 @@
 #![allow(clippy::needless_range_loop)]
 
 use faer::sparse::SparseColMat;
-use faer::Mat;
+use faer::{Mat, MatRef};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
+use super::blocks::Blocks;
 use super::modes::{sign_normalize, Modes};
 use super::sparse::{gmres_refine, spmv, sym_mul_block, Pencil, Refine};
 use crate::error::{Error, Result};
@@ -408,18 +409,19 @@ struct ClusterSystem<'p> {
 }
 
 impl<'p> ClusterSystem<'p> {
-    /// `spare`: the factorization of a previous cluster, whose buffers are
+    /// `lambda`: the cluster's eigenvalues (its first mode is `first`);
+    /// `xc`: its eigenvectors on the pencil's DOFs (`n × r`); `spare`: the
+    /// factorization of a previous cluster on this pencil, whose buffers are
     /// reused.
     fn new(
         pencil: &'p Pencil,
-        modes: &Modes,
-        (first, r): (usize, usize),
+        (first, lambda): (usize, &[f64]),
+        xc: Mat<f64>,
         spare: Option<super::sparse::Factor<'p>>,
     ) -> Result<Self> {
-        let n = pencil.n();
+        let (n, r) = (pencil.n(), lambda.len());
         let mass = pencil.mass();
-        let lambda_bar = modes.lambda[first..first + r].iter().sum::<f64>() / r as f64;
-        let xc = Mat::<f64>::from_fn(n, r, |i, j| modes.modes[(i, first + j)]);
+        let lambda_bar = lambda.iter().sum::<f64>() / r as f64;
         let rows = pivot_rows(&xc);
         let mut is_r = vec![false; n];
         rows.iter().for_each(|&i| is_r[i] = true);
@@ -591,9 +593,45 @@ impl<'p> ClusterSystem<'p> {
     }
 }
 
-/// See the module doc.
+/// The pencil a cluster's derivative systems are solved on: the full one,
+/// or the block of [`Blocks`] that holds the cluster's eigenvectors.
+struct Restriction<'a> {
+    pencil: &'a Pencil,
+    /// The block's DOFs (`None`: all).
+    dofs: Option<&'a [usize]>,
+}
+
+impl Restriction<'_> {
+    /// Rows of `m` (`n × q`) on this pencil's DOFs.
+    fn gather(&self, m: MatRef<'_, f64>, cols: std::ops::Range<usize>) -> Mat<f64> {
+        match self.dofs {
+            None => m.subcols(cols.start, cols.len()).to_owned(),
+            Some(d) => Mat::from_fn(d.len(), cols.len(), |i, j| m[(d[i], cols.start + j)]),
+        }
+    }
+
+    /// `v` (on this pencil's DOFs) on all `n` DOFs, zero off the block.
+    fn scatter(&self, v: Mat<f64>, n: usize) -> Mat<f64> {
+        match self.dofs {
+            None => v,
+            Some(d) => {
+                let mut out = Mat::<f64>::zeros(n, v.ncols());
+                for j in 0..v.ncols() {
+                    for (i, &di) in d.iter().enumerate() {
+                        out[(di, j)] = v[(i, j)];
+                    }
+                }
+                out
+            }
+        }
+    }
+}
+
+/// See the module doc; `blocks`: the independent blocks of the pencil for
+/// this design, if it splits ([`super::blocks`]).
 pub(crate) fn compute(
     pencil: &Pencil,
+    blocks: Option<&Blocks>,
     modes: &Modes,
     vars: &[DesignDerivative<'_>],
     opts: &DerivativeOptions,
@@ -661,7 +699,9 @@ pub(crate) fn compute(
         o.dmodes = Some(Mat::<f64>::zeros(n, k));
     }
     let mass = pencil.mass();
-    let mut spare = None;
+    // Spare factorizations per pencil: the full one, then each block's.
+    let n_parts = blocks.map_or(0, |b| b.parts.len());
+    let mut spares: Vec<Option<super::sparse::Factor<'_>>> = (0..=n_parts).map(|_| None).collect();
     for (ci, &(first, r)) in clusters.iter().enumerate() {
         if r > 1 {
             if let Some(v) = vars.iter().position(|d| d.d2k.is_none()) {
@@ -676,7 +716,23 @@ pub(crate) fn compute(
                 ));
             }
         }
-        let mut sys = ClusterSystem::new(pencil, modes, (first, r), spare.take())?;
+        let cluster_modes = modes.modes.as_ref().subcols(first, r);
+        let (slot, on) = match blocks.and_then(|b| Some((b, b.holding(cluster_modes, mass)?))) {
+            Some((b, p)) => (
+                p + 1,
+                Restriction {
+                    pencil: &b.parts[p].pencil,
+                    dofs: Some(&b.parts[p].dofs),
+                },
+            ),
+            None => (0, Restriction { pencil, dofs: None }),
+        };
+        let mut sys = ClusterSystem::new(
+            on.pencil,
+            (first, &modes.lambda[first..first + r]),
+            on.gather(modes.modes.as_ref(), first..first + r),
+            spares[slot].take(),
+        )?;
         // Right-hand sides −(K' − λⱼ'M) ψⱼ for every variable and cluster member.
         let nv = vars.len();
         let mut f = Mat::<f64>::zeros(n, nv * r);
@@ -701,7 +757,7 @@ pub(crate) fn compute(
             psi_all.push(psi);
             kpsi_all.push(kpsi);
         }
-        let vsol = sys.solve(&f)?;
+        let vsol = on.scatter(sys.solve(&on.gather(f.as_ref(), 0..f.ncols()))?, n);
         for (v, d) in vars.iter().enumerate() {
             let psi = &psi_all[v];
             let kpsi = &kpsi_all[v];
@@ -756,7 +812,7 @@ pub(crate) fn compute(
                 }
             }
         }
-        spare = Some(sys.factor);
+        spares[slot] = Some(sys.factor);
     }
     Ok(out)
 }

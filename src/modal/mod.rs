@@ -83,6 +83,7 @@
 //! [`ModalOptions`], [`Modes`], [`DesignDerivative`], [`DerivativeOptions`],
 //! [`VariableDerivatives`], [`ModeShapeRow`] / [`mode_shape_rows`].
 
+mod blocks;
 pub mod derivatives;
 mod export;
 mod lanczos;

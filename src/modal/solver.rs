@@ -3,7 +3,10 @@
 //! ([`super::lanczos`]) and their design derivatives
 //! ([`super::derivatives`]).
 
-use super::derivatives::{self, DerivativeOptions, DesignDerivative, VariableDerivatives};
+use super::blocks::Blocks;
+use super::derivatives::{
+    self, DerivativeOptions, DesignDerivative, ModeUpdate, VariableDerivatives,
+};
 use super::lanczos;
 use super::modes::{sign_normalize, ModalOptions, ModalStats, Modes};
 use super::sparse::Pencil;
@@ -16,6 +19,9 @@ use faer::Mat;
 /// and reused by every numeric factorization (shift-invert and Nelson).
 pub struct ModalSolver {
     pencil: Pencil,
+    /// The independent blocks of the last design with derivatives
+    /// ([`super::blocks`]).
+    blocks: Option<Blocks>,
 }
 
 impl ModalSolver {
@@ -24,6 +30,7 @@ impl ModalSolver {
     pub fn new(k: &SparseColMat<usize, f64>, mass: &[f64]) -> Result<Self> {
         Ok(ModalSolver {
             pencil: Pencil::new(k, mass)?,
+            blocks: None,
         })
     }
 
@@ -120,12 +127,22 @@ impl ModalSolver {
 
     /// Eigenvalue (and, in the updated-mode approach, eigenvector)
     /// derivatives of `modes` for each design variable; see [`derivatives`].
+    /// Where `K` and the `K'ᵥ` split into independent blocks (e.g. the
+    /// membrane and bending DOFs of a symmetric laminate's flat shell),
+    /// each mode's systems are solved on its block.
     pub fn derivatives(
-        &self,
+        &mut self,
         modes: &Modes,
         vars: &[DesignDerivative<'_>],
         opts: &DerivativeOptions,
     ) -> Result<Vec<VariableDerivatives>> {
-        derivatives::compute(&self.pencil, modes, vars, opts)
+        let blocks = if opts.update == ModeUpdate::Updated {
+            let dk: Vec<_> = vars.iter().map(|d| d.dk).collect();
+            Blocks::refresh(&mut self.blocks, &self.pencil, &dk)?;
+            self.blocks.as_ref()
+        } else {
+            None
+        };
+        derivatives::compute(&self.pencil, blocks, modes, vars, opts)
     }
 }

@@ -265,6 +265,16 @@ struct InputMap {
 }
 
 impl InputMap {
+    /// No map: [`Pencil::set_stiffness`] takes the full path.
+    fn empty() -> Self {
+        InputMap {
+            col_ptr: Vec::new(),
+            row_idx: Vec::new(),
+            dest: Vec::new(),
+            transpose: Vec::new(),
+        }
+    }
+
     fn build(k: &SparseColMat<usize, f64>, col_ptr: &[usize], row_idx: &[usize]) -> Option<Self> {
         let kr = k.as_ref();
         if kr.col_nnz().is_some() {
@@ -507,12 +517,7 @@ impl Pencil {
             ..
         } = pat;
         let (ordered, symbolic) = Ordered::build(n, &col_ptr, &row_idx)?;
-        let input = InputMap::build(k, &col_ptr, &row_idx).unwrap_or(InputMap {
-            col_ptr: Vec::new(),
-            row_idx: Vec::new(),
-            dest: Vec::new(),
-            transpose: Vec::new(),
-        });
+        let input = InputMap::build(k, &col_ptr, &row_idx).unwrap_or_else(InputMap::empty);
         Ok(Pencil {
             n,
             col_ptr,
@@ -591,6 +596,51 @@ impl Pencil {
         self.k_val = val;
         self.k_max = k_max;
         true
+    }
+
+    /// The pencil restricted to `dofs` (ascending): `K_BB` and `M_B` on the
+    /// pattern's rows and columns `dofs`, with its own AMD ordering and
+    /// symbolic factorization, and for each of its stored entries the
+    /// position of the same entry in `self` (for [`Self::gather_values`]).
+    pub(crate) fn block(&self, dofs: &[usize]) -> Result<(Pencil, Vec<usize>)> {
+        let mut local = vec![usize::MAX; self.n];
+        for (l, &d) in dofs.iter().enumerate() {
+            local[d] = l;
+        }
+        let nb = dofs.len();
+        let (mut col_ptr, mut row_idx, mut map) = (vec![0usize], Vec::new(), Vec::new());
+        for &j in dofs {
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let l = local[self.row_idx[p]];
+                if l != usize::MAX {
+                    row_idx.push(l);
+                    map.push(p);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let (ordered, symbolic) = Ordered::build(nb, &col_ptr, &row_idx)?;
+        let mut block = Pencil {
+            n: nb,
+            col_ptr,
+            row_idx,
+            k_val: Vec::new(),
+            mass: dofs.iter().map(|&d| self.mass[d]).collect(),
+            ordered,
+            input: InputMap::empty(),
+            symbolic,
+            k_max: 0.0,
+        };
+        block.gather_values(self, &map);
+        Ok((block, map))
+    }
+
+    /// Take the values of `K` from `full` through `map` (from
+    /// [`Self::block`]): the block of a new design's stiffness.
+    pub(crate) fn gather_values(&mut self, full: &Pencil, map: &[usize]) {
+        self.k_val.clear();
+        self.k_val.extend(map.iter().map(|&p| full.k_val[p]));
+        self.k_max = self.k_val.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     }
 
     /// Column `j` of `K` (rows, values); by symmetry also row `j`.
