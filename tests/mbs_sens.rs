@@ -98,10 +98,13 @@ fn sensitivities_match_central_differences() {
         Param::Mass(0),
         Param::Anchor(act, 0),
     ];
-    // Both forms of the sensitivities: staggered (every method) and fused
-    // (explicit methods: J s + ∂f/∂p in one dual evaluation per lane).
+    // Both forms of the sensitivities: staggered and fused (J s + ∂f/∂p in
+    // one dual evaluation per lane and stage or Newton iterate; the
+    // implicit methods with the block-diagonal Newton matrix).
     for (method, form) in [
         (Method::Bdf, SensitivityForm::Staggered),
+        (Method::Bdf, SensitivityForm::Fused),
+        (Method::Esdirk34, SensitivityForm::Fused),
         (Method::Tsit45, SensitivityForm::Staggered),
         (Method::Tsit45, SensitivityForm::Fused),
     ] {

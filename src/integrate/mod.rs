@@ -35,6 +35,7 @@
 //! The trait's switching surfaces do not depend on the parameters
 //! (`g_p = 0`), and `g_y v` is [`OdeModel::crossing_dir`].
 
+mod block_lu;
 mod fused;
 mod legs;
 mod ode;

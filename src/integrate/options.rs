@@ -34,18 +34,19 @@ pub enum SensitivityForm {
     /// directional derivatives per lane and stage; every method.
     Staggered,
     /// The lanes ride in the state and `J s_i + ∂f/∂p_i` is one
-    /// directional derivative per lane and stage; explicit methods
-    /// (tsit45) only.
+    /// directional derivative per lane and stage (or Newton iterate);
+    /// every method (implicit ones with the block-diagonal Newton matrix of
+    /// `super::block_lu`).
     Fused,
 }
 
 impl SensitivityForm {
-    /// The default form for `method`: fused for the explicit method,
-    /// staggered for the implicit ones.
+    /// The default form for `method`: fused, for every method (cheaper:
+    /// one multi-lane evaluation per stage or Newton iterate, against two
+    /// single-lane ones per lane for the staggered form; the same steps).
     pub fn default_for(method: Method) -> SensitivityForm {
         match method {
-            Method::Tsit45 => SensitivityForm::Fused,
-            Method::Bdf | Method::Esdirk34 => SensitivityForm::Staggered,
+            Method::Tsit45 | Method::Bdf | Method::Esdirk34 => SensitivityForm::Fused,
         }
     }
 
@@ -88,8 +89,7 @@ pub struct Options {
     /// wall at rtol 1e-4, +10–25 % at 1e-6, −6 to +14 % at 1e-8). Scenes
     /// that cross no breakpoint (SAR 0–3 s) are bit-identical either way.
     pub events: bool,
-    /// The form of forward sensitivities ([`SensitivityForm`]); `Fused`
-    /// needs an explicit method.
+    /// The form of forward sensitivities ([`SensitivityForm`]).
     pub sensitivity: SensitivityForm,
 }
 
@@ -120,16 +120,6 @@ impl Options {
                 "integrator.t_end",
                 format!("t0 = {}, outputs {:?}..", self.t0, self.times.first()),
                 "an end time > start time with increasing output times",
-            ));
-        }
-        if self.sensitivity == SensitivityForm::Fused && self.method != Method::Tsit45 {
-            return Err(Error::input(
-                "integrator.sensitivity_form",
-                "fused",
-                format!(
-                    "\"staggered\" with method {} (the fused form is for explicit methods: tsit45)",
-                    self.method.name()
-                ),
             ));
         }
         Ok(())

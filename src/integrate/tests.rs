@@ -75,6 +75,8 @@ fn piecewise_ramp_and_its_sensitivity_through_the_trait() {
         (Method::Tsit45, SensitivityForm::Staggered),
         (Method::Tsit45, SensitivityForm::Fused),
         (Method::Bdf, SensitivityForm::Staggered),
+        (Method::Bdf, SensitivityForm::Fused),
+        (Method::Esdirk34, SensitivityForm::Fused),
     ] {
         let opts = Options {
             method,

@@ -5,7 +5,7 @@
 //! absolute tolerance scaled with it, keeping the scene's ratio), the
 //! scene is simulated without sensitivities (`plain`) and with all its
 //! sensitivity parameters in each listed form (`fused`: the lanes ride in
-//! the state, one dual evaluation per lane and stage, tsit45 only;
+//! the state, one dual evaluation per lane and stage or Newton iterate;
 //! `staggered`: diffsol's sensitivity equations, two), `repeats` times
 //! after one untimed warm-up. Reported per case, medians over the repeats
 //! on one thread: the integrator's wall time
@@ -20,7 +20,7 @@
 //! [sens_bench]
 //! repeats = 7                      # timed runs per case (medians)
 //! rtols = [1e-6, 1e-8, 1e-10]      # default: the scene's rtol
-//! forms = ["fused", "staggered"]   # default: both with tsit45, else staggered
+//! forms = ["fused", "staggered"]   # default: both
 //! ```
 //!
 //! Output: `sens_bench.csv` in the study's output folder (columns:
@@ -28,7 +28,7 @@
 
 use super::stats::median;
 use crate::error::Result;
-use crate::integrate::{Method, SensitivityForm, Stats};
+use crate::integrate::{SensitivityForm, Stats};
 use crate::mbs::responses::ResponseValue;
 use crate::report::csv::{num, Table};
 use crate::scene::{load_scene, Scene};
@@ -155,15 +155,14 @@ pub fn run_sens_bench(
 ) -> Result<(Vec<String>, Vec<Vec<String>>)> {
     let mut scene = load_scene(study)?;
     let params = std::mem::take(&mut scene.params);
-    validate(study, spec, &scene, params.is_empty())?;
+    validate(study, spec, params.is_empty())?;
     let rtols = match spec.rtols.as_slice() {
         [] => vec![scene.options.rtol],
         r => r.to_vec(),
     };
-    let forms = match (spec.forms.as_slice(), scene.options.method) {
-        ([], Method::Tsit45) => vec![SensitivityForm::Fused, SensitivityForm::Staggered],
-        ([], _) => vec![SensitivityForm::Staggered],
-        (f, _) => f.to_vec(),
+    let forms = match spec.forms.as_slice() {
+        [] => vec![SensitivityForm::Fused, SensitivityForm::Staggered],
+        f => f.to_vec(),
     };
     let mut header: Vec<String> = HEADERS.iter().map(|h| h.to_string()).collect();
     header.extend(params.iter().map(|(p, _)| format!("d/d({p})")));
@@ -190,9 +189,8 @@ pub fn run_sens_bench(
     Ok((header, rows))
 }
 
-/// Repeats ≥ 1, tolerances in range, a scene with sensitivity parameters,
-/// the fused form only with tsit45.
-fn validate(study: &Study, spec: &SensBenchSpec, scene: &Scene, no_params: bool) -> Result<()> {
+/// Repeats ≥ 1, tolerances in range, a scene with sensitivity parameters.
+fn validate(study: &Study, spec: &SensBenchSpec, no_params: bool) -> Result<()> {
     if spec.repeats == 0 {
         return Err(study.error("sens_bench.repeats", 0, "at least 1 repetition"));
     }
@@ -206,17 +204,6 @@ fn validate(study: &Study, spec: &SensBenchSpec, scene: &Scene, no_params: bool)
             "scene.sensitivities",
             "[]",
             "at least one sensitivity parameter (the [sens_bench] section times them)",
-        ));
-    }
-    let method = scene.options.method;
-    if method != Method::Tsit45 && spec.forms.contains(&SensitivityForm::Fused) {
-        return Err(study.error(
-            "sens_bench.forms",
-            "fused",
-            format!(
-                "\"staggered\" with method {} (fused needs tsit45)",
-                method.name()
-            ),
         ));
     }
     Ok(())
