@@ -331,6 +331,22 @@ fn evaluations_compute_only_what_they_are_asked() {
         .sum();
         assert!(total > 0.0 && parts <= total * 1.01 + 0.01, "{r:?}");
     }
+    assert!(rows.iter().all(|r| col(r, "method") == "tsit45"));
+    // The same problem with BDF (`methods`): f has Jacobian columns, f+g
+    // fused the same two lanes and the same steps as f (the lanes weigh
+    // nothing in the error norm).
+    let bench = format!("{bench}methods = [\"bdf\"]\nforms = [\"fused\"]\n");
+    std::fs::write(&path, bench).unwrap();
+    let study = Study::load(&path).unwrap();
+    let spec: plyscape::sections::eval_bench::EvalBenchSpec =
+        study.require_section("eval_bench", "").unwrap();
+    let rows = plyscape::sections::eval_bench::run_eval_bench(&study, &spec, |_| {}).unwrap();
+    assert_eq!(rows.len(), 2);
+    let (f, fg) = (&rows[0], &rows[1]);
+    assert_eq!([col(f, "method"), col(fg, "mode")], ["bdf", "f+g fused"]);
+    assert!(col(f, "jvp_calls").parse::<u64>().unwrap() > 0);
+    assert_eq!(col(fg, "lanes"), "2");
+    assert_eq!(col(f, "steps"), col(fg, "steps"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

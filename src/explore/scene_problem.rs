@@ -280,6 +280,16 @@ impl SceneProblem {
         self.plan.set_sensitivity_form(form);
     }
 
+    /// Integrate with `method` from now on (overrides the scene's).
+    pub fn set_method(&mut self, method: crate::integrate::Method) {
+        self.plan.set_method(method);
+    }
+
+    /// The integration method the evaluations use.
+    pub fn method(&self) -> crate::integrate::Method {
+        self.plan.spec().integrator.method
+    }
+
     /// Compute the panels' mode derivatives by `update` from now on
     /// (fixed: Eq. 19, eigenvalue derivatives only; updated: Eq. 18).
     pub fn set_mode_update(&mut self, update: crate::modal::ModeUpdate) {

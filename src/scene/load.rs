@@ -88,6 +88,12 @@ impl ScenePlan {
         &self.spec
     }
 
+    /// Integrate with `method` from now on (overrides
+    /// `[scene.integrator] method`).
+    pub fn set_method(&mut self, method: crate::integrate::Method) {
+        self.spec.integrator.method = method;
+    }
+
     /// Integrate forward sensitivities in `form` from now on (overrides
     /// `[scene.integrator] sensitivity_form`).
     pub fn set_sensitivity_form(&mut self, form: SensitivityForm) {

@@ -374,12 +374,12 @@ pub struct IntegratorSpec {
     /// ([`crate::integrate::Options::events`], default `true`).
     #[serde(default = "default_events")]
     pub events: bool,
-    /// Form of the forward sensitivities: `fused` (the lanes ride in the
-    /// state, one directional derivative per lane and stage; explicit
-    /// methods only; the default with tsit45) or `staggered` (diffsol's
-    /// sensitivity equations, two per lane and stage; every method; the
-    /// default otherwise). Both control the error of the states alone and
-    /// agree to about 1e-11 (tests/explore_scene.rs).
+    /// Form of the forward sensitivities: `fused` (the default: the lanes
+    /// ride in the state, one directional derivative per lane and stage or
+    /// Newton iterate) or `staggered` (diffsol's sensitivity equations, two
+    /// per lane and stage). Both control the error of the states alone;
+    /// with tsit45 they agree to about 1e-11 (tests/explore_scene.rs), with
+    /// the implicit methods to the lanes' integration error.
     pub sensitivity_form: Option<SensitivityForm>,
 }
 fn default_events() -> bool {

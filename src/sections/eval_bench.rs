@@ -1,8 +1,9 @@
 //! `[eval_bench]`: what one design evaluation of a scene problem costs and
 //! where its time goes (issue 14's benchmark).
 //!
-//! For every listed study with a scene problem (`[problem] name = "scene"`)
-//! and every design (default: the problem's start), the evaluation is run
+//! For every listed study with a scene problem (`[problem] name = "scene"`),
+//! every integration method listed in `methods` (default: the problem's
+//! own) and every design (default: the problem's start), the evaluation is run
 //! without gradients (`f`) and with them (`f+g`, once per sensitivity
 //! form listed in `forms`, e.g. `f+g fused`), `repeats` times each
 //! after one untimed warm-up of each kind (which makes the pooled panel
@@ -27,7 +28,7 @@
 use super::stats::median;
 use crate::error::Result;
 use crate::explore::scene_problem::{EvalProfile, SceneProblem};
-use crate::integrate::SensitivityForm;
+use crate::integrate::{Method, SensitivityForm};
 use crate::optimize::Problem;
 use crate::report::clock::{load_average, thread_cpu_seconds};
 use crate::report::csv::Table;
@@ -52,11 +53,16 @@ pub struct EvalBenchSpec {
     /// problem's own).
     #[serde(default)]
     pub forms: Vec<SensitivityForm>,
+    /// Integration methods to run each problem with (default: the
+    /// problem's own).
+    #[serde(default)]
+    pub methods: Vec<Method>,
 }
 
 /// Column headers of `eval_bench.csv`.
-pub const HEADERS: [&str; 19] = [
+pub const HEADERS: [&str; 20] = [
     "problem",
+    "method",
     "design [deg]",
     "mode",
     "setup [ms]",
@@ -86,7 +92,7 @@ struct Timed {
 
 /// The medians of one case.
 fn row(
-    name: &str,
+    (name, method): (&str, &str),
     x: &[f64],
     (mode, load): (&str, Option<f64>),
     setup: f64,
@@ -101,6 +107,7 @@ fn row(
     let per_rhs = med(&|r| r.integrate_seconds / r.rhs_calls.max(1) as f64);
     vec![
         name.to_string(),
+        method.to_string(),
         design.join(" "),
         mode.to_string(),
         format!("{:.1}", 1e3 * setup),
@@ -151,7 +158,18 @@ pub fn run_eval_bench(
         } else {
             spec.designs.clone()
         };
-        for (j, x) in designs.iter().enumerate() {
+        let methods: Vec<Option<Method>> = match spec.methods.as_slice() {
+            [] => vec![None],
+            m => m.iter().copied().map(Some).collect(),
+        };
+        for (method, (j, x)) in methods
+            .iter()
+            .flat_map(|m| designs.iter().enumerate().map(move |d| (m, d)))
+        {
+            if let Some(m) = method {
+                problem.set_method(*m);
+            }
+            let method_name = problem.method().name();
             if x.len() != problem.variables().len() {
                 return Err(study.error(
                     format!("eval_bench.designs[{j}]"),
@@ -181,7 +199,7 @@ pub fn run_eval_bench(
                         Ok(Timed { profile, cpu })
                     })
                     .collect::<Result<Vec<_>>>()?;
-                let r = row(&inner.name(), x, (&mode, load), setup, &runs);
+                let r = row((&inner.name(), method_name), x, (&mode, load), setup, &runs);
                 progress(&r);
                 rows.push(r);
             }
