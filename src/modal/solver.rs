@@ -43,7 +43,11 @@ impl ModalSolver {
     /// design); the symbolic factorization is kept. A different pattern
     /// rebuilds it.
     pub fn set_stiffness(&mut self, k: &SparseColMat<usize, f64>) -> Result<()> {
-        self.pencil.set_stiffness(k)
+        if self.pencil.set_stiffness(k)? {
+            // The blocks map entries of the old pattern.
+            self.blocks = None;
+        }
+        Ok(())
     }
 
     /// The `opts.n_modes` lowest modes. Errors: `n_modes` = 0 or > n →

@@ -249,6 +249,9 @@ pub(crate) struct Pencil {
     symbolic: SymbolicCholesky<usize>,
     /// Largest |K_ij|, used to scale pivot reports.
     k_max: f64,
+    /// For a block ([`Self::block`]): the full pencil's DOF of each of its
+    /// DOFs, for messages (empty: the pencil's own numbering).
+    global: Vec<usize>,
 }
 
 /// The input stiffness pattern and where its entries go on the pattern of
@@ -528,12 +531,14 @@ impl Pencil {
             input,
             symbolic,
             k_max,
+            global: Vec::new(),
         })
     }
 
     /// Replace `K` by a matrix of the same size; the symbolic structure is
-    /// kept when the pattern is unchanged and rebuilt otherwise.
-    pub(crate) fn set_stiffness(&mut self, k: &SparseColMat<usize, f64>) -> Result<()> {
+    /// kept when the pattern is unchanged and rebuilt otherwise. Returns
+    /// whether it was rebuilt (the positions of the stored entries moved).
+    pub(crate) fn set_stiffness(&mut self, k: &SparseColMat<usize, f64>) -> Result<bool> {
         if k.nrows() != self.n || k.ncols() != self.n {
             return Err(Error::input(
                 "stiffness",
@@ -542,17 +547,17 @@ impl Pencil {
             ));
         }
         if self.fast_values(k) {
-            return Ok(());
+            return Ok(false);
         }
         let pat = Pattern::build(k)?;
         if pat.col_ptr == self.col_ptr && pat.row_idx == self.row_idx {
             self.k_val = pat.k_val;
             self.k_max = pat.k_max;
-            Ok(())
+            Ok(false)
         } else {
             let mass = std::mem::take(&mut self.mass);
             *self = Pencil::new(k, &mass)?;
-            Ok(())
+            Ok(true)
         }
     }
 
@@ -630,6 +635,7 @@ impl Pencil {
             input: InputMap::empty(),
             symbolic,
             k_max: 0.0,
+            global: dofs.to_vec(),
         };
         block.gather_values(self, &map);
         Ok((block, map))
@@ -880,9 +886,11 @@ impl Pencil {
         }
     }
 
-    /// Original DOF of elimination step `index` (AMD permutation).
+    /// Original DOF of elimination step `index` (AMD permutation; for a
+    /// block, the full pencil's DOF).
     fn original_dof(&self, index: usize) -> usize {
-        self.ordered.fwd.get(index).copied().unwrap_or(index)
+        let d = self.ordered.fwd.get(index).copied().unwrap_or(index);
+        self.global.get(d).copied().unwrap_or(d)
     }
 }
 

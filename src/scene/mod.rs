@@ -50,7 +50,7 @@
 //! type = "load"; body | marker; frame = "global" | "body"; force, torque
 //!                                  # or table = [[t, fx, fy, fz, tx, ty, tz], ..]
 //! [scene.integrator]  method = "bdf", rtol, atol, t_end, dt_out, events = true,
-//!                     sensitivity_form = "fused" | "staggered"   # default: fused with tsit45
+//!                     sensitivity_form = "fused" | "staggered"   # default: fused
 //! [scene.outputs]  quantities = ["R3.angle", "R3.rate", "R3.reaction", "energy", "violation",
 //!                                "B3.strain_energy", "B3.modal", "<marker>.deflection",
 //!                                "slide.displacement", "slide.velocity",
