@@ -81,18 +81,18 @@ impl Default for BlockLu {
 }
 
 impl BlockLu {
-    fn block_size(&self, len: usize) -> Result<usize, LaError> {
-        if !len.is_multiple_of(self.blocks) {
+    /// The size of each of `blocks` equal blocks of `len` rows.
+    fn block_size(blocks: usize, len: usize) -> Result<usize, LaError> {
+        if !len.is_multiple_of(blocks) {
             return Err(LaError::Other(format!(
-                "fused Newton matrix: {len} rows do not split into {} equal blocks",
-                self.blocks
+                "fused Newton matrix: {len} rows do not split into {blocks} equal blocks"
             )));
         }
-        Ok(len / self.blocks)
+        Ok(len / blocks)
     }
 
     fn apply(&self, x: &mut FaerVec<f64>, transpose: bool) -> Result<(), LaError> {
-        let n = self.block_size(x.len())?;
+        let n = Self::block_size(self.blocks, x.len())?;
         let (lu, row, col) = self
             .lu
             .as_ref()
@@ -154,11 +154,9 @@ impl LinearSolver<FaerMat<f64>> for BlockLu {
             return; // the solves report the missing LU
         };
         op.matrix_inplace(matrix);
-        let len = matrix.nrows();
-        if !len.is_multiple_of(self.blocks) {
+        let Ok(n) = Self::block_size(self.blocks, matrix.nrows()) else {
             return; // the solves report the block mismatch
-        }
-        let n = len / self.blocks;
+        };
         let mut lu = matrix.inner().subrows(0, n).subcols(0, n).to_owned();
         let (mut rf, mut rb, mut cf, mut cb) = (vec![0; n], vec![0; n], vec![0; n], vec![0; n]);
         factor::lu_in_place(

@@ -348,15 +348,8 @@ impl Laminate {
     /// A, B, D, S (module doc). For a mid-plane symmetric stack B is
     /// exactly zero (module doc, "Symmetric stacks").
     pub fn stiffness(&self) -> Stiffness {
-        let z = self.interfaces();
-        let mut st = Stiffness::default();
-        for (k, p) in self.plies.iter().enumerate() {
-            st.add_ply(&p.stiffness_derivative(0), z[k], z[k + 1]);
-        }
-        if self.is_symmetric() {
-            st.b = Matrix3::zeros();
-        }
-        st
+        let all: Vec<usize> = (0..self.plies.len()).collect();
+        self.group_derivative(&all, 0)
     }
 
     /// `order`-th derivative (1 or 2) of A, B, D, S with respect to the
@@ -387,9 +380,10 @@ impl Laminate {
         self.group_derivative(&map.groups[v], 2)
     }
 
-    /// Derivative with respect to the common angle of `group`; B' is
-    /// exactly zero when the stack is symmetric and the group mirror-closed
-    /// (module doc, "Symmetric stacks").
+    /// `order`-th derivative with respect to the common angle of `group`
+    /// (order 0 over all plies: the stiffness itself); B' is exactly zero
+    /// when the stack is symmetric and the group mirror-closed (module doc,
+    /// "Symmetric stacks").
     fn group_derivative(&self, group: &[usize], order: u8) -> Stiffness {
         let z = self.interfaces();
         let mut st = Stiffness::default();

@@ -185,19 +185,12 @@ pub fn spd_solve(
     cholesky_solve(a, (scale, &sc.pattern), f.accepted, b, &mut sc.tmp);
 }
 
-/// One body's block of the constraint-space matrix: for the
-/// `k = rows.len() / n` vectors `b_i` (row-major `k × n`: the body's
-/// constraint rows and its applied force) and the inverse mass `minv`
-/// (`n × n`, symmetric), `w_i = M⁻¹ b_i` into `w` (`k × n`) and the Gram
-/// block `g_ij = b_i · w_j`, `j ≤ i`, into `g` (row-major `k × k`, lower
-/// triangle).
-pub fn gram_rows(minv: &[f64], n: usize, rows: &[f64], w: &mut Vec<f64>, g: &mut Vec<f64>) {
+/// The Gram block `g_ij = b_i · w_j`, `j ≤ i` (row-major `k × k`, lower
+/// triangle) of the `k` rows `b_i` of `rows` and `w_i` of `w` (both
+/// row-major `k × n`): with `w_i = M⁻¹ b_i`, one body's block of the
+/// constraint-space matrix (its constraint rows and applied force).
+pub fn gram(rows: &[f64], w: &[f64], n: usize, g: &mut Vec<f64>) {
     let k = rows.len() / n;
-    w.clear();
-    w.resize(k * n, 0.0);
-    for (b, wi) in rows.chunks_exact(n).zip(w.chunks_exact_mut(n)) {
-        sym_times(minv, n, b, wi);
-    }
     g.clear();
     g.resize(k * k, 0.0);
     for i in 0..k {
@@ -921,7 +914,7 @@ mod tests {
     #[test]
     fn inverse_mass_and_gram_blocks() {
         // The explicit inverse of dense_factor against A·A⁻¹ = I, the Gram
-        // block of gram_rows against triangular solves (dense_cholesky)
+        // block of gram against triangular solves (dense_cholesky)
         // and plain dot products, and the dual form: real parts the
         // inverse of the real matrix, lanes the matrix's derivative A'
         // (what the tangent of the constraint-space solve reads).
@@ -950,8 +943,11 @@ mod tests {
             .enumerate()
             .map(|(k, v)| if k < n { *v } else { 2.0 * v })
             .collect();
-        let (mut w, mut g) = (Vec::new(), Vec::new());
-        gram_rows(&inv, n, &rows, &mut w, &mut g);
+        let (mut w, mut g) = (vec![0.0; 2 * n], Vec::new());
+        for (b, wi) in rows.chunks_exact(n).zip(w.chunks_exact_mut(n)) {
+            sym_times(&inv, n, b, wi);
+        }
+        gram(&rows, &w, n, &mut g);
         let bx: f64 = (0..n).map(|k| b0[k] * x[k]).sum();
         for k in 0..n {
             assert!((w[k] - x[k]).abs() < 1e-12 * (1.0 + x[k].abs()));

@@ -25,8 +25,7 @@
 use super::dynamics::{pval, System, Workspace, RANK_REG, RANK_TOL, RIGID};
 use super::linalg::Factored;
 use super::linalg::{
-    fdot, gram_rows, min_degree_order, spd_factor, spd_solve, sym_times, CholPattern, Scalar,
-    MAX_LANES,
+    fdot, gram, min_degree_order, spd_factor, spd_solve, sym_times, CholPattern, Scalar, MAX_LANES,
 };
 use super::model::Param;
 use super::workspace::{BodyBlock, SolveScratch};
@@ -90,27 +89,19 @@ impl System {
             if self.modes[s] > 0 {
                 bb.minv.clear();
                 bb.minv.extend(ws.mfac[s].iter().map(T::re_part));
-                gram_rows(&bb.minv, d, &bb.b, &mut bb.w, &mut bb.g);
-                continue;
+            } else {
+                let b = self.moving[s];
+                let mass = pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass);
+                bb.inv_mass = 1.0 / mass.re_part();
             }
-            let b = self.moving[s];
-            let mass = pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass);
-            bb.inv_mass = 1.0 / mass.re_part();
-            let k = bb.rows.len() + 1;
-            bb.w.clear();
-            bb.w.resize(k * d, 0.0);
-            for i in 0..k {
-                let (x, mut out) = (&bb.b[i * d..(i + 1) * d], [0.0; 6]);
-                self.minv_times(bb, s, x, &mut out);
-                bb.w[i * d..(i + 1) * d].copy_from_slice(&out);
+            let mut w = std::mem::take(&mut bb.w);
+            w.clear();
+            w.resize(bb.b.len(), 0.0);
+            for (x, out) in bb.b.chunks_exact(d).zip(w.chunks_exact_mut(d)) {
+                self.minv_times(bb, s, x, out);
             }
-            bb.g.clear();
-            bb.g.resize(k * k, 0.0);
-            for i in 0..k {
-                for j in 0..=i {
-                    bb.g[i * k + j] = fdot(&bb.b[i * d..(i + 1) * d], &bb.w[j * d..(j + 1) * d]);
-                }
-            }
+            gram(&bb.b, &w, d, &mut bb.g);
+            bb.w = w;
         }
         ws.blocks = blocks;
         ws.gather = vecs;
@@ -276,9 +267,11 @@ impl System {
         sol.dlam.resize(nl * m, 0.0);
         sol.dacc.clear();
         sol.dacc.resize(nl * nv, 0.0);
-        let (mut rhs, mut dd) = (vec![0.0; m], vec![0.0; m]);
-        let mut dlam = Vec::new();
-        let mut mp = Vec::new();
+        let take = std::mem::take::<Vec<f64>>;
+        let (mut rhs, mut dd) = (take(&mut sol.lane_rhs), take(&mut sol.dd));
+        let (mut dlam, mut mp) = (take(&mut sol.lane_lam), take(&mut sol.mp));
+        rhs.resize(m, 0.0);
+        dd.resize(m, 0.0);
         for l in 0..nl {
             // r₂ = γ' − G'v̇ and, per body, r₁ = Q' − M'v̇ + G'ᵀλ, u = M⁻¹r₁;
             // the right-hand side r₂ − G u − εD'λ.
@@ -349,6 +342,7 @@ impl System {
             }
             sol.dlam[l * m..(l + 1) * m].copy_from_slice(&dlam);
         }
+        (sol.lane_rhs, sol.dd, sol.lane_lam, sol.mp) = (rhs, dd, dlam, mp);
     }
 
     /// Lane `l` of slot `s`'s mass matrix: a flexible body's `M'_l` into

@@ -161,6 +161,12 @@ pub struct SolveScratch {
     pub(crate) u: Vec<f64>,
     /// One body's `w_iᵀ M' w_i` per row.
     pub(crate) quad: Vec<f64>,
+    /// One lane's right-hand side for λ', `D'` diagonal and λ' (`m`
+    /// each), and a flexible body's `M'` (`dof²`).
+    pub(crate) lane_rhs: Vec<f64>,
+    pub(crate) dd: Vec<f64>,
+    pub(crate) lane_lam: Vec<f64>,
+    pub(crate) mp: Vec<f64>,
 }
 
 /// Translational and rotational mode-shape rows of a node (n columns each).

@@ -135,18 +135,18 @@ fn components(pencil: &Pencil, dk: &[&SparseColMat<usize, f64>]) -> Vec<usize> {
             parent[a.max(b)] = a.min(b);
         }
     };
+    let dk: Vec<_> = dk
+        .iter()
+        .filter(|m| m.nrows() == n && m.ncols() == n)
+        .map(|m| m.as_ref())
+        .collect();
     for j in 0..n {
-        let (rows, vals) = pencil.k_col(j);
-        for (&i, &v) in rows.iter().zip(vals) {
-            if i != j && v != 0.0 {
-                join(i, j);
-            }
-        }
-    }
-    for m in dk.iter().filter(|m| m.nrows() == n && m.ncols() == n) {
-        let mr = m.as_ref();
-        for j in 0..n {
-            for (&i, &v) in mr.row_idx_of_col_raw(j).iter().zip(mr.val_of_col(j)) {
+        let columns = std::iter::once(pencil.k_col(j)).chain(
+            dk.iter()
+                .map(|m| (m.row_idx_of_col_raw(j), m.val_of_col(j))),
+        );
+        for (rows, vals) in columns {
+            for (&i, &v) in rows.iter().zip(vals) {
                 if i != j && v != 0.0 {
                     join(i, j);
                 }

@@ -319,7 +319,6 @@ fn refined_solve(
     (rows, is_r): (&[usize], &[bool]),
     b: &Mat<f64>,
 ) -> Result<Mat<f64>> {
-    const TOL: f64 = SOLVE_TOL;
     let (n, q) = (b.nrows(), b.ncols());
     let mass = pencil.mass();
     let mut x = b.clone();
@@ -334,7 +333,7 @@ fn refined_solve(
             res[(i, j)] = b[(i, j)] - res[(i, j)];
         }
         let (beta, bn) = (norm(&res, j), norm(b, j).max(f64::MIN_POSITIVE));
-        if beta > TOL * bn {
+        if beta > SOLVE_TOL * bn {
             todo.push((j, beta));
         }
     }
@@ -365,7 +364,7 @@ fn refined_solve(
         let mut xj: Vec<f64> = x.col(j).iter().copied().collect();
         let job = Refine {
             b: &bj,
-            tol: TOL,
+            tol: SOLVE_TOL,
             max_iter: 40,
             residual: Some(res.col(j).iter().copied().collect()),
             first: Some((
