@@ -66,13 +66,15 @@ fn section<T: DeserializeOwned>(p: &RefCell<Probe>, name: &str) {
             let mut s = p.borrow_mut();
             s.changed = false;
             s.blame = None;
+            s.pending = None;
         }
         let result = T::deserialize(Rec {
             path: name.to_string(),
             probe: p,
         });
         let mut s = p.borrow_mut();
-        if result.is_err() {
+        if let Err(err) = &result {
+            s.absorb(err);
             if let Some(b) = s.blame.take().filter(|b| !b.is_empty()) {
                 if s.skip.insert(b) {
                     s.changed = true;
@@ -104,6 +106,10 @@ struct Probe {
     enums: BTreeMap<String, (usize, usize)>,
     /// Where the pass failed (empty: failed on purpose, in a probe).
     blame: Option<String>,
+    /// A probe whose "any" value was taken as is: an internally tagged
+    /// enum reads its variant from the buffered value after
+    /// `deserialize_any` returns, so the error to read comes later.
+    pending: Option<(String, Read)>,
     /// Did this pass learn anything?
     changed: bool,
 }
@@ -112,6 +118,74 @@ impl Probe {
     fn key(&mut self, path: String) {
         if self.keys.insert(path) {
             self.changed = true;
+        }
+    }
+
+    /// Learn from the error `err` that the probe `read` at `path` raised,
+    /// queue the probes it calls for, and mark the pass as failed on
+    /// purpose (nothing to skip).
+    fn read(&mut self, path: &str, read: &Read, err: &PErr) {
+        self.blame = Some(String::new());
+        let mut learnt = Vec::new();
+        let queue = self.any.entry(path.to_string()).or_default();
+        match (read, err) {
+            (Read::Tag, PErr::MissingField(tag)) => {
+                learnt.push(format!("{path}.{tag}"));
+                queue.push_back(AnyProbe::map(
+                    vec![(tag.to_string(), PVal::Str(PROBE.into()))],
+                    Read::Variants(tag.to_string()),
+                ));
+            }
+            (Read::Tag, PErr::UnknownField(fields)) => {
+                learnt.extend(fields.iter().map(|f| format!("{path}.{f}")));
+            }
+            (Read::Variants(tag), PErr::UnknownVariant(variants)) => {
+                for variant in variants {
+                    queue.push_back(AnyProbe::map(
+                        vec![
+                            (tag.clone(), PVal::Str(variant.to_string())),
+                            (PROBE.into(), PVal::Unit),
+                        ],
+                        Read::Fields {
+                            tag: tag.clone(),
+                            variant: variant.to_string(),
+                        },
+                    ));
+                }
+            }
+            (Read::Fields { tag, variant }, PErr::UnknownField(fields)) => {
+                for f in fields.iter().filter(|f| **f != tag) {
+                    learnt.push(format!("{path}.{f}"));
+                    let nested = Read::Nested(format!("{path}.{f}"));
+                    let tagged = |value: PVal| {
+                        vec![
+                            (tag.clone(), PVal::Str(variant.clone())),
+                            (f.to_string(), value),
+                        ]
+                    };
+                    // A table, or an array of tables, under the field.
+                    queue.push_back(AnyProbe::map(tagged(AnyProbe::unknown()), nested.clone()));
+                    queue.push_back(AnyProbe::map(
+                        tagged(PVal::Seq(vec![AnyProbe::unknown()])),
+                        nested,
+                    ));
+                }
+            }
+            (Read::Nested(prefix), PErr::UnknownField(fields)) => {
+                learnt.extend(fields.iter().map(|f| format!("{prefix}.{f}")));
+            }
+            _ => {}
+        }
+        for k in learnt {
+            self.key(k);
+        }
+    }
+
+    /// An error that reached a field or the section: if a probe was taken
+    /// as is before it, the error is that probe's answer.
+    fn absorb(&mut self, err: &PErr) {
+        if let Some((path, read)) = self.pending.take() {
+            self.read(&path, &read, err);
         }
     }
 
@@ -172,7 +246,14 @@ enum PErr {
 
 impl fmt::Display for PErr {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{self:?}")
+        match self {
+            PErr::UnknownField(fields) => write!(f, "unknown field, expected one of {fields:?}"),
+            PErr::UnknownVariant(variants) => {
+                write!(f, "unknown variant, expected one of {variants:?}")
+            }
+            PErr::MissingField(field) => write!(f, "missing field `{field}`"),
+            PErr::Other(msg) => f.write_str(msg),
+        }
     }
 }
 impl std::error::Error for PErr {}
@@ -299,63 +380,10 @@ impl<'p> Rec<'p> {
             .into_iter(),
         ));
         let Err(err) = result else {
+            self.probe.borrow_mut().pending = Some((self.path, probe.read));
             return result;
         };
-        let mut s = self.probe.borrow_mut();
-        s.blame = Some(String::new());
-        let mut learnt = Vec::new();
-        let queue = s.any.get_mut(&self.path).expect("queue made above");
-        match (&probe.read, &err) {
-            (Read::Tag, PErr::MissingField(tag)) => {
-                learnt.push(format!("{}.{tag}", self.path));
-                queue.push_back(AnyProbe::map(
-                    vec![(tag.to_string(), PVal::Str(PROBE.into()))],
-                    Read::Variants(tag.to_string()),
-                ));
-            }
-            (Read::Tag, PErr::UnknownField(fields)) => {
-                learnt.extend(fields.iter().map(|f| format!("{}.{f}", self.path)));
-            }
-            (Read::Variants(tag), PErr::UnknownVariant(variants)) => {
-                for variant in variants {
-                    queue.push_back(AnyProbe::map(
-                        vec![
-                            (tag.clone(), PVal::Str(variant.to_string())),
-                            (PROBE.into(), PVal::Unit),
-                        ],
-                        Read::Fields {
-                            tag: tag.clone(),
-                            variant: variant.to_string(),
-                        },
-                    ));
-                }
-            }
-            (Read::Fields { tag, variant }, PErr::UnknownField(fields)) => {
-                for f in fields.iter().filter(|f| **f != tag) {
-                    learnt.push(format!("{}.{f}", self.path));
-                    let nested = Read::Nested(format!("{}.{f}", self.path));
-                    let tagged = |value: PVal| {
-                        vec![
-                            (tag.clone(), PVal::Str(variant.clone())),
-                            (f.to_string(), value),
-                        ]
-                    };
-                    // A table, or an array of tables, under the field.
-                    queue.push_back(AnyProbe::map(tagged(AnyProbe::unknown()), nested.clone()));
-                    queue.push_back(AnyProbe::map(
-                        tagged(PVal::Seq(vec![AnyProbe::unknown()])),
-                        nested,
-                    ));
-                }
-            }
-            (Read::Nested(prefix), PErr::UnknownField(fields)) => {
-                learnt.extend(fields.iter().map(|f| format!("{prefix}.{f}")));
-            }
-            _ => {}
-        }
-        for k in learnt {
-            s.key(k);
-        }
+        self.probe.borrow_mut().read(&self.path, &probe.read, &err);
         Err(err)
     }
 }
@@ -389,12 +417,19 @@ impl<'de> de::MapAccess<'de> for Fields<'_> {
             path: path.clone(),
             probe: self.probe,
         };
-        seed.deserialize(rec).inspect_err(|_| {
-            let mut s = self.probe.borrow_mut();
-            if s.blame.is_none() {
-                s.blame = Some(path);
+        let result = seed.deserialize(rec);
+        let mut s = self.probe.borrow_mut();
+        match &result {
+            // The value took the probe: nothing to read.
+            Ok(_) => s.pending = None,
+            Err(err) => {
+                s.absorb(err);
+                if s.blame.is_none() {
+                    s.blame = Some(path);
+                }
             }
-        })
+        }
+        result
     }
 }
 
@@ -414,8 +449,11 @@ impl<'de> de::SeqAccess<'de> for Elements<'_> {
             return Ok(None);
         }
         self.left -= 1;
-        seed.deserialize(self.rec.at(self.rec.path.clone()))
-            .map(Some)
+        let result = seed.deserialize(self.rec.at(self.rec.path.clone()));
+        if result.is_ok() {
+            self.rec.probe.borrow_mut().pending = None;
+        }
+        result.map(Some)
     }
 }
 
