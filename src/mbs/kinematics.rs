@@ -126,11 +126,13 @@ impl System {
     /// Which markers' node rotations something in the model reads (by
     /// marker index): the frame, angular velocity and angular acceleration
     /// of a marker on a flexible node enter the rows of every joint kind
-    /// but the spherical one (whose rows read the point alone, and whose
-    /// modal entries `Ψ_kᵀTᵀAᵀ(ω-block − s × v-block)` vanish: that
-    /// difference is exactly zero for a point row), the forces tied to a
-    /// joint's axes, marker loads (torques) and spring-dampers (kept for
-    /// safety). A node marker that only spherical joints use gets the
+    /// whose row blocks read the marker frames
+    /// ([`JointKind::reads_frames`](crate::mbs::JointKind::reads_frames):
+    /// all but the spherical one, whose point rows read the point alone
+    /// and whose modal entries `Ψ_kᵀTᵀAᵀ(ω-block − s × v-block)` vanish:
+    /// that difference is exactly zero for a point row), the forces tied
+    /// to a joint's axes, marker loads (torques) and spring-dampers (kept
+    /// for safety). A node marker that only point-row joints use gets the
     /// body frame's rotation in its [`MarkerKin`] instead.
     pub fn node_rotations(&self, out: &mut Vec<bool>) {
         out.clear();

@@ -21,9 +21,11 @@
 //!   segment changes as its events.
 //! - [`post`]: projection onto the constraints, loads, reactions, momenta,
 //!   deflections, energy sums, responses and their sensitivity lanes.
-//! - [`dynamics`]: the right-hand side `ẏ = f(t, y)`, the flexible
-//!   bodies' mass matrices and inertia forces, energy terms of integrals.
-//! - [`forces`]: applied generalized forces of the force elements.
+//! - [`dynamics`]: the right-hand side `ẏ = f(t, y)` and the energy
+//!   terms of integrated states.
+//! - [`forces`]: applied generalized forces: the flexible bodies' mass
+//!   matrices with their inertia, elastic and damping forces, the force
+//!   elements.
 //! - [`constraints`]: the rows of the joint kinds' row blocks, their
 //!   assembly with Baumgarte stabilisation, the constraint-space solve.
 //! - [`kinematics`]: body and marker kinematics at a state, joint angles
@@ -69,7 +71,7 @@
 //!   [`RowBlock::names`]) and its row function in [`constraints::rows`].
 //!   The scene then names the kind (`crate::scene`, the joint `type`).
 //! - A force element: a [`Force`] variant (data, `model/force.rs`) and
-//!   its generalized forces in [`forces`] (`System::applied`); if it
+//!   its generalized forces in [`forces::elements`] (`System::applied`); if it
 //!   reads a marker's rotation on a flexible node, list it in
 //!   `System::node_rotations` ([`kinematics`]); the scene names it
 //!   (`crate::scene::forces`).

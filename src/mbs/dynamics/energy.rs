@@ -10,7 +10,7 @@
 //! - rigid body, frame at the centre of mass:
 //!   `T = ½ m |ṙ|² + ½ ω'ᵀ J ω'` (m read through [`Param::Mass`]);
 //! - floating-frame flexible body: `T = ½ vᵀ M(w) v` with the mass
-//!   matrix of [`super::flexbody`] (configuration-dependent through the
+//!   matrix of [`crate::mbs::forces::flexbody`] (configuration-dependent through the
 //!   modal coordinates `w`, design-dependent through the lifted
 //!   invariants), taken before it is factored (`System::flex_bodies`).
 //!

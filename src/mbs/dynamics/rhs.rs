@@ -10,7 +10,7 @@
 //!
 //! The equations are `M v̇ = Q + Gᵀλ` with `M` block diagonal (per body:
 //! `diag(m I, J')` for a rigid body with its frame at the centre of mass,
-//! the dense `(6+n)²` matrix of [`super::flexbody`] for a flexible one),
+//! the dense `(6+n)²` matrix of [`crate::mbs::forces::flexbody`] for a flexible one),
 //! and the constraints imposed at acceleration level with Baumgarte
 //! stabilisation: `G v̇ = γ − 2αΦ̇ − α²Φ`. Because `M` is block diagonal,
 //! `v̇ = M⁻¹(Q + Gᵀλ)` and `λ` solves the constraint-space system

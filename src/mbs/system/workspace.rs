@@ -185,7 +185,7 @@ pub struct BodyKin<T: Scalar> {
 
 /// Global kinematics of a marker. On a flexible node whose rotation
 /// nothing in the model reads ([`System::node_rotations`](crate::mbs::System::node_rotations):
-/// only spherical joints use the marker), [`System::markers_kin`]
+/// only point-row joints use the marker), [`System::markers_kin`]
 /// leaves the node's rotation out: `frame`, `w`, `alpha` and `tangent`
 /// are then those of the body frame.
 ///

@@ -1,6 +1,6 @@
 //! Applied generalized forces of [`System`]: the gyroscopic terms of
 //! rigid bodies, the inertia, elastic and damping forces of flexible
-//! bodies ([`crate::mbs::dynamics::flexbody`]), and the force elements of
+//! bodies ([`super::flexbody`]), and the force elements of
 //! [`Model::forces`](crate::mbs::Model) (gravity, loads, the Eq. 32
 //! actuator, spring-dampers between markers and along joints), one
 //! function per element. Forces are
