@@ -1,7 +1,7 @@
 //! Constraint rows of the joints: value, Jacobian blocks per body and the
 //! velocity-dependent part `γ` of the constraint accelerations, one
 //! function per row type, and the rows of each [`RowBlock`] of a joint
-//! kind ([`joint_rows`]; the kinds' table is `crate::mbs::model::joint`).
+//! kind (`joint_rows`; the kinds' table is `crate::mbs::model::joint`).
 //!
 //! Every row's rate is written as `P·v_point + W·ω_marker` of the two
 //! markers (point velocity, marker frame angular velocity), which

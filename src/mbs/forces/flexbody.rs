@@ -29,7 +29,7 @@
 //! above conserve energy exactly, which the tests check.
 
 //!
-//! [`System::flex_bodies`] builds these terms for every flexible body of
+//! `System::flex_bodies` builds these terms for every flexible body of
 //! an evaluation, with the invariants lifted at the design seeds
 //! (`crate::mbs::system::invariants`), and factors the mass matrices.
 

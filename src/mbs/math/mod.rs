@@ -1,6 +1,6 @@
 //! Numbers and small linear algebra of the kernel: the scalar trait over
 //! `f64` and dual numbers ([`scalar`], [`dual`], with their lanes in
-//! `lanes`), rotations and 3 × 3 products ([`rotation`]), dense SPD
+//! `lanes`), rotations and 3 × 3 products ([`mod@rotation`]), dense SPD
 //! kernels ([`dense`]), the sparse rank-counting Cholesky ([`sparse`]) and
 //! real planes of dual mode shapes ([`planes`]). Nothing here knows of
 //! bodies or joints.

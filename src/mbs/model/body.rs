@@ -23,7 +23,7 @@ pub struct Flex {
     /// zero unless the scene lists the `damping` effect.
     pub zeta: f64,
     /// Current values of the basis's design variables (rad), for
-    /// [`Param::Design`].
+    /// [`Param::Design`](crate::mbs::Param::Design).
     pub design: Vec<f64>,
 }
 
@@ -130,7 +130,7 @@ impl Body {
 #[derive(Debug, Clone)]
 pub struct Marker {
     pub name: String,
-    /// Body index into [`Model::bodies`]; `None` = ground.
+    /// Body index into [`Model::bodies`](crate::mbs::Model::bodies); `None` = ground.
     pub body: Option<usize>,
     /// Position in body axes relative to the centre of mass (m), or the
     /// global position for ground markers.

@@ -24,7 +24,7 @@ pub struct Model {
     /// that their sensitivities come with the integration
     /// (docs/numerics.md, "Responses and optimization").
     pub integrals: Vec<Integral>,
-    /// Groups of `(body, design variable)` that [`Param::Tied`] lanes move
+    /// Groups of `(body, design variable)` that [`Param::Tied`](crate::mbs::Param::Tied) lanes move
     /// together.
     pub ties: Vec<Vec<(usize, usize)>>,
 }
@@ -58,7 +58,7 @@ impl Model {
     }
     /// Label of constraint row `r` (rows are assembled joint by joint in
     /// the order of [`Model::joints`]): `<joint>.<equation>` with the
-    /// equation named by [`JointKind::row_names`], e.g. `S3.z`; `None`
+    /// equation named by [`JointKind::row_names`](crate::mbs::JointKind::row_names), e.g. `S3.z`; `None`
     /// past the last row.
     pub fn row_label(&self, r: usize) -> Option<String> {
         let mut first = 0;
