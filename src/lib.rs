@@ -70,6 +70,8 @@
 //! - [`mbs`]: the multibody kernel: bodies (rigid, floating-frame flexible
 //!   with a [`mbs::ModalBasis`]), joints, forces, equations of motion and
 //!   their constraint-space solve, outputs; no files.
+//! - [`beams`]: closed-form Euler–Bernoulli cantilever beams as a
+//!   [`mbs::ModalBasis`] (reference flexible bodies).
 //! - [`panels`]: a panel's modal analysis reused across lay-ups and its
 //!   modes as a [`mbs::ModalBasis`] ([`panels::BasisBuilder`]).
 //! - [`scene`]: the `[scene]` section: parsed data → model
@@ -85,9 +87,9 @@
 //! - [`report`]: every writer: CSV tables, SVG plots, manifest, progress.
 //! - [`cli`]: the command line.
 //!
-//! Where to add things: a joint type in [`mbs::model`] (kind and
-//! equations) and [`mbs::rows`] (its constraint rows), named in
-//! [`scene::build`]; an output or response in [`scene::quantity`] (parsed
+//! Where to add things: a joint type in [`mbs::model::joint`] (its row
+//! blocks; see [`mbs`]), named in [`scene::build`]; a force element in
+//! [`mbs::model::force`] and [`mbs::forces`]; an output or response in [`scene::quantity`] (parsed
 //! in [`scene::parts`]) and evaluated in [`simulate`]; a study section in
 //! [`sections`] with its entry in [`cli`]; an optimizer in [`optimize`]
 //! behind [`optimize::Problem`], selectable in [`explore::solvers`].
@@ -102,6 +104,7 @@
 //! - The SAR geometry is a reconstruction (see `studies/` and the README):
 //!   results are comparable with the paper in shape, not digit by digit.
 
+pub mod beams;
 pub mod cli;
 pub mod error;
 pub mod explore;

@@ -5,7 +5,7 @@
 //! differences, the effects switches, and input errors.
 
 use num_dual::Dual64;
-use plyscape::mbs::beam::{Beam, Plane};
+use plyscape::beams::{Beam, Plane};
 use plyscape::mbs::{System, Workspace};
 use plyscape::scene::load_scene;
 use plyscape::simulate::simulate;

@@ -1,17 +1,41 @@
 //! Flexible multibody kernel (issue 3): rigid spatial bodies with Euler
 //! parameters, floating-frame flexible bodies with modal coordinates
-//! (paper Eqs. 5–6; [`flex`], [`flexdyn`], bases from closed-form beams
-//! [`beam`] or from composite panels `crate::panels::panel_basis`),
-//! markers (on flexible bodies: on mesh nodes, moving and rotating with the
-//! modes), joints (spherical, revolute, driven/locked revolute, fixed,
-//! prismatic, cylindrical), force elements ([`forces`]: gravity, the
-//! paper's Eq. 32 spring-damper-actuator, linear spring-dampers between
-//! markers or along a sliding joint, constant or time-tabulated loads at
-//! a centre of mass or a marker, in global or body axes), the equations
-//! of motion with Lagrange multipliers, consistent initial conditions,
-//! energies ([`energy`]: kinetic and strain, as outputs and response
-//! terms) and outputs. It knows nothing of files: scenes are built by
-//! [`crate::scene`], simulated by [`crate::simulate`].
+//! (paper Eqs. 5–6; bases from closed-form beams `crate::beams` or from
+//! composite panels `crate::panels::panel_basis`), markers (on flexible
+//! bodies: on mesh nodes, moving and rotating with the modes), joints
+//! (spherical, revolute, driven/locked revolute, fixed, prismatic,
+//! cylindrical), force elements (gravity, the paper's Eq. 32
+//! spring-damper-actuator, linear spring-dampers between markers or along
+//! a sliding joint, constant or time-tabulated loads at a centre of mass
+//! or a marker, in global or body axes), the equations of motion with
+//! Lagrange multipliers, consistent initial conditions, energies (kinetic
+//! and strain, as outputs and response terms) and outputs. It knows
+//! nothing of files: scenes are built by [`crate::scene`], simulated by
+//! [`crate::simulate`].
+//!
+//! ## Layers
+//! Top-down; every file imports only layers below it (methods of
+//! [`System`] are added by the layers above [`system`]):
+//! - [`ode`], [`segments`]: the system as an [`crate::integrate::OdeModel`]
+//!   (plain, directional and multi-lane right-hand sides) and the Eq. 32
+//!   segment changes as its events.
+//! - [`post`]: projection onto the constraints, loads, reactions, momenta,
+//!   deflections, energy sums, responses and their sensitivity lanes.
+//! - [`dynamics`]: the right-hand side `ẏ = f(t, y)` and the energy
+//!   terms of integrated states.
+//! - [`forces`]: applied generalized forces: the flexible bodies' mass
+//!   matrices with their inertia, elastic and damping forces, the force
+//!   elements.
+//! - [`constraints`]: the rows of the joint kinds' row blocks, their
+//!   assembly with Baumgarte stabilisation, the constraint-space solve.
+//! - [`kinematics`]: body and marker kinematics at a state, joint angles
+//!   and slides.
+//! - [`system`]: [`System`] (the model, its state layout, counters) and
+//!   the [`Workspace`] of one evaluation.
+//! - [`model`]: bodies, markers, joints (the table of joint kinds), forces,
+//!   parameters and energy terms as data; modal bases and invariants.
+//! - [`math`]: scalar and dual-number traits, rotations and 3 × 3 helpers,
+//!   dense and sparse Cholesky.
 //!
 //! ## Method
 //! The equations of motion are the index-3 DAE of the paper (Eqs. 2–4, 6),
@@ -29,7 +53,7 @@
 //! which keeps the state an ordinary ODE for any integrator (BDF, explicit
 //! and SDIRK Runge–Kutta), unlike projection, which would have to restart
 //! multistep histories. Initial conditions are projected onto the
-//! constraints ([`analysis`]). Forward sensitivities (stiffness, damping,
+//! constraints ([`post::analysis`]). Forward sensitivities (stiffness, damping,
 //! mass, Eq. 32 breakpoints, ply angles of flexible bodies through
 //! `dΛ/dθ` and `dX/dθ`, one angle shared by several bodies as a tied
 //! lane: [`Param`]) come from [`crate::integrate::integrate_sens`], with
@@ -37,10 +61,20 @@
 //! side; the system is an [`crate::integrate::OdeModel`] ([`ode`]) and its
 //! Eq. 32 segment changes are the model's events ([`segments`]).
 //!
-//! Where things go: a new joint type is a [`JointKind`] variant with its
-//! equation count in [`model`] and its constraint rows in [`rows`]
-//! (assembled in [`dynamics`]); a new force element is a [`Force`] variant
-//! applied in [`forces`]; the scene names both ([`crate::scene`]).
+//! ## Where to add things
+//! - A joint kind: a [`JointKind`] variant and its list of row blocks in
+//!   [`JointKind::blocks`] (`model/joint.rs`, the one match over the
+//!   kinds): the equation count, row names, the angle and slide flags and
+//!   the node rotations it needs follow from the blocks, and
+//!   [`constraints::rows`] assembles each block. A kind that needs a new
+//!   kind of row adds a [`RowBlock`] variant (its names in
+//!   [`RowBlock::names`]) and its row function in [`constraints::rows`].
+//!   The scene then names the kind (`crate::scene`, the joint `type`).
+//! - A force element: a [`Force`] variant (data, `model/force.rs`) and
+//!   its generalized forces in [`forces::elements`] (`System::applied`); if it
+//!   reads a marker's rotation on a flexible node, list it in
+//!   `System::node_rotations` ([`kinematics`]); the scene names it
+//!   (`crate::scene::forces`).
 //!
 //! ## Limitations
 //! - Linear elasticity in a floating frame: no geometric stiffening, so a
@@ -58,29 +92,23 @@
 //! - Sensitivities assume an initial state independent of the
 //!   parameters.
 
-pub mod analysis;
-pub mod beam;
-pub mod dual;
+pub mod constraints;
 pub mod dynamics;
-pub mod energy;
-pub mod flex;
-pub mod flexdyn;
 pub mod forces;
-pub mod linalg;
+pub mod kinematics;
+pub mod math;
 pub mod model;
 pub mod ode;
-pub mod planes;
-pub mod responses;
-pub mod rows;
+pub mod post;
 pub mod segments;
-pub mod solve;
-pub mod workspace;
+pub mod system;
 
-pub use analysis::{Projection, Reaction};
-pub use dynamics::{System, Workspace};
-pub use energy::Energy;
-pub use flex::{BasisDerivative, DroppedMode, Invariants, ModalBasis, RigidScreen};
+pub use math::DualN;
 pub use model::{
-    Body, Drive, Force, Joint, JointKind, Load, LoadFrame, Marker, Model, Param, PiecewiseLaw,
-    Segment,
+    BasisDerivative, Body, Drive, DroppedMode, Energy, Flex, Force, Integral, Invariants, Joint,
+    JointKind, Load, LoadFrame, Marker, ModalBasis, Model, Param, PiecewiseLaw, RigidScreen,
+    RowBlock, Segment,
 };
+pub use post::analysis::{Projection, Reaction};
+pub use post::responses;
+pub use system::{System, Workspace};

@@ -11,13 +11,11 @@
 //! separate `f64` evaluation is made; the real parts are computed by the
 //! same operations as the `f64` right-hand side.
 
-use super::dual::DualN;
-use super::dynamics::System;
-use super::linalg::{Scalar, MAX_LANES};
-use super::model::Param;
 use super::segments::{Crossing, Events};
-use super::workspace::{BodyKin, Workspace};
 use crate::integrate::OdeModel;
+use crate::mbs::math::{DualN, Scalar, MAX_LANES};
+use crate::mbs::model::Param;
+use crate::mbs::system::{BodyKin, System, Workspace};
 use num_dual::Dual64;
 
 /// Scratch of dual-number evaluations with `D`: workspace and state

@@ -46,9 +46,8 @@
 //! does not depend on a ply angle either), and `g_y v` is one dual-number
 //! evaluation of θ at `y + ε v`.
 
-use super::dynamics::System;
-use super::model::{Force, PiecewiseLaw};
-use super::workspace::BodyKin;
+use crate::mbs::model::{Force, PiecewiseLaw};
+use crate::mbs::system::{BodyKin, System};
 use num_dual::Dual64;
 
 /// One actuator law whose segment can change.

@@ -10,9 +10,8 @@ use super::quantity::{Quantity, Response};
 use super::spec::{Effect, JointSpec, SceneSpec};
 use crate::error::{Error, Result};
 use crate::integrate::{Options, SensitivityForm};
-use crate::mbs::model::{
-    axis_angle, frame_from_axis, Body, Drive, Integral, Joint, JointKind, Model, Param,
-};
+use crate::mbs::math::{axis_angle, frame_from_axis};
+use crate::mbs::model::{Body, Drive, Integral, Joint, JointKind, Model, Param};
 use nalgebra::{Matrix3, Vector3};
 
 /// A built scene: the system model, integrator options and outputs.
@@ -447,10 +446,11 @@ fn joint_kind(key: &str, j: &JointSpec) -> Result<JointKind> {
     })
 }
 
-/// The unit-free axis of joint `j` (any vector for a spherical joint).
+/// The unit-free axis of joint `j` (any vector for a kind whose rows read
+/// no marker frame: a spherical joint).
 fn joint_axis(key: &str, j: &JointSpec, kind: &JointKind) -> Result<Vector3<f64>> {
     Ok(match (kind, j.axis) {
-        (JointKind::Spherical, _) => Vector3::z(),
+        (k, _) if !k.reads_frames() => Vector3::z(),
         (_, Some(a)) => {
             let a = finite3(format!("{key}.axis"), a)?;
             if a.norm() < 1e-12 {

@@ -9,8 +9,8 @@
 //! that does not depend on the ply angles and takes a design as numbers).
 //!
 //! Where things go: a new joint type is a [`crate::mbs::JointKind`]
-//! variant (rows in `mbs::rows`), given a `type` name in [`build`]
-//! (`joint_kind`); a new output or response is a [`Quantity`] /
+//! variant with its row blocks (`JointKind::blocks`, see [`crate::mbs`]),
+//! given a `type` name in [`build`] (`joint_kind`); a new output or response is a [`Quantity`] /
 //! [`Response`] variant parsed in [`parts`] and evaluated in
 //! [`crate::simulate`].
 //!

@@ -4,10 +4,10 @@
 
 use super::quantity::Quantity;
 use super::spec::{FlexKind, FlexSpec, ForceSpec};
+use crate::beams::Beam;
 use crate::error::{Error, Result};
-use crate::mbs::beam::Beam;
-use crate::mbs::flex::ModalBasis;
-use crate::mbs::linalg::euler_from_rotation;
+use crate::mbs::math::euler_from_rotation;
+use crate::mbs::model::ModalBasis;
 use crate::mbs::model::{Body, Flex, Force, Marker, Model, Param};
 use crate::mbs::Energy;
 use crate::modal::ModeUpdate;

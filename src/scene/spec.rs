@@ -228,7 +228,7 @@ pub struct FlexSpec {
 /// Where a flexible body's modes come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FlexKind {
-    /// Closed-form Euler–Bernoulli cantilever modes ([`crate::mbs::beam`]).
+    /// Closed-form Euler–Bernoulli cantilever modes ([`crate::beams`]).
     Beam,
     /// Finite element modes of a `[[panels]]` entry ([`crate::panels`]).
     Panel,

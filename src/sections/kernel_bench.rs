@@ -311,7 +311,7 @@ pub const PIECES: [&str; 7] = [
 /// it, so the pieces (without the "of which" lines) add up to the whole.
 /// "node shapes" is every node marker's `(Φ_k, Ψ_k)` rows once (the
 /// kinematics, constraint and force pieces each fetch them).
-pub fn rhs_pieces<T: crate::mbs::linalg::Scalar>(sys: &System, t: f64, y: &[T]) -> Vec<f64> {
+pub fn rhs_pieces<T: crate::mbs::math::Scalar>(sys: &System, t: f64, y: &[T]) -> Vec<f64> {
     let mut ws = Workspace::<T>::empty();
     let mut dy = vec![T::zero(); y.len()];
     let whole = fastest_us(&mut || sys.rhs(t, y, &mut dy, &mut ws));

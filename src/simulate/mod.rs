@@ -4,8 +4,8 @@
 
 use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Stats};
-use crate::mbs::analysis::Projection;
 use crate::mbs::responses::{energy_lanes, peak, ResponseKind, ResponseValue};
+use crate::mbs::Projection;
 use crate::mbs::{Energy, Param, Reaction, System, Workspace};
 use crate::report::csv::{sci, write_table};
 use crate::report::{line_plot, Axes, Curve};

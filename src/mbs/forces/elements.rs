@@ -1,7 +1,7 @@
 //! Applied generalized forces of [`System`]: the gyroscopic terms of
 //! rigid bodies, the inertia, elastic and damping forces of flexible
-//! bodies ([`super::flexdyn`]), and the force elements of
-//! [`Model::forces`](super::model::Model) (gravity, loads, the Eq. 32
+//! bodies ([`super::flexbody`]), and the force elements of
+//! [`Model::forces`](crate::mbs::Model) (gravity, loads, the Eq. 32
 //! actuator, spring-dampers between markers and along joints), one
 //! function per element. Forces are
 //! accumulated in the velocity layout of the state (`[ṙ, ω', ẇ]` per
@@ -13,9 +13,10 @@
 //! Every value a sensitivity parameter can replace is read through
 //! `pval`, so a dual-number evaluation differentiates it exactly.
 
-use super::dynamics::{angle_of, bump, pval, slide_of, System, Workspace};
-use super::linalg::{cst, mtv, mv, Scalar};
-use super::model::{Force, Load, LoadFrame, Param, PiecewiseLaw};
+use crate::mbs::kinematics::{angle_of, slide_of};
+use crate::mbs::math::{cst, mtv, mv, Scalar};
+use crate::mbs::model::{Force, Load, LoadFrame, Param, PiecewiseLaw};
+use crate::mbs::system::{bump, pval, System, Workspace};
 use nalgebra::Vector3;
 
 impl System {

@@ -1,12 +1,12 @@
 //! The per-evaluation linear algebra of [`System`]: the constraint-space
 //! solve for the multipliers and accelerations, body by body (the method
-//! is in [`super::dynamics`]), in real arithmetic, and its tangent for
+//! is in [`crate::mbs::dynamics`]), in real arithmetic, and its tangent for
 //! the lanes of a dual-number evaluation.
 //!
 //! # Tangent
 //! The solve gives `v̇ = M⁻¹(Q + Gᵀλ)` with `(A + εD) λ = γ − G M⁻¹ Q`,
 //! `A = G M⁻¹ Gᵀ`, `D = diag(A)` and `ε` = [`RANK_REG`] (the regularised
-//! system that [`super::linalg::ordered_cholesky`] factors). A dual
+//! system that [`crate::mbs::math::ordered_cholesky`] factors). A dual
 //! evaluation carries, per lane, the derivatives `G'`, `M'`, `Q'`, `γ'`
 //! of the assembled quantities. Differentiating `M v̇ = Q + Gᵀλ` and the
 //! equation for λ gives, with `r₁ = Q' − M' v̇ + G'ᵀλ` and
@@ -22,13 +22,14 @@
 //! lane costs one product with each `M'_b`, `M_b⁻¹` and the rows, and one
 //! constraint-space solve.
 
-use super::dynamics::{pval, System, Workspace, RANK_REG, RANK_TOL, RIGID};
-use super::linalg::Factored;
-use super::linalg::{
+use crate::mbs::math::Factored;
+use crate::mbs::math::{
     fdot, gram, min_degree_order, spd_factor, spd_solve, sym_times, CholPattern, Scalar, MAX_LANES,
 };
-use super::model::Param;
-use super::workspace::{BodyBlock, SolveScratch};
+use crate::mbs::model::Param;
+use crate::mbs::system::{
+    pval, BodyBlock, SolveScratch, System, Workspace, RANK_REG, RANK_TOL, RIGID,
+};
 
 impl System {
     /// `M⁻¹ x` of slot `s` in real arithmetic (into `out`): a flexible
@@ -143,7 +144,7 @@ impl System {
     /// the matrix is scattered into a fill-reducing order, whose symbolic
     /// factorization ([`CholPattern`]) is computed once per workspace, and
     /// factored on that pattern by the rank-counting Cholesky of
-    /// [`super::linalg`].
+    /// [`crate::mbs::math::sparse`].
     pub(crate) fn solve<T: Scalar>(&self, ws: &mut Workspace<T>) -> Vec<T> {
         let m = ws.rows.len();
         self.body_blocks(ws);

@@ -16,7 +16,7 @@
 //! Conventions (those of num-dual, which the kernel was written against):
 //! - comparisons (`==`, `<`, `max`, …) and `Zero::is_zero` look at the
 //!   real part only, so a branch taken on a value is taken by its
-//!   derivatives too ([`super::linalg::Scalar::is_exact_zero`] compares
+//!   derivatives too ([`super::scalar::Scalar::is_exact_zero`] compares
 //!   every component);
 //! - functions that are not differentiable at a point (`abs` at 0,
 //!   `floor`, …) take the derivative of the branch the real part selects.

@@ -1,6 +1,6 @@
 //! Mass matrix and generalized inertia and elastic forces of a
 //! floating-frame flexible body (paper Eq. 6), from the inertia
-//! invariants of [`super::flex`].
+//! invariants of [`crate::mbs::model::flex`].
 //!
 //! Velocities are `v = [ṙ (global), ω' (frame axes), ẇ]` (`6 + n`). With
 //! `S = s0 + i3·w` (first moment), `E = e0 + Σ_j w_j (P_j + P_jᵀ) +
@@ -28,92 +28,16 @@
 //! the linear finite element model); with that kinetic energy the terms
 //! above conserve energy exactly, which the tests check.
 
+//!
+//! `System::flex_bodies` builds these terms for every flexible body of
+//! an evaluation, with the invariants lifted at the design seeds
+//! (`crate::mbs::system::invariants`), and factors the mass matrices.
+
 #![allow(clippy::needless_range_loop)] // index-heavy small dense kernels
 
-use super::flex::Invariants;
-use super::linalg::{cst, mm, mv, Scalar};
-use super::model::Flex;
+use crate::mbs::math::{cst, mm, mv, quadratic_form, spd_inverse, sym_times, Scalar};
+use crate::mbs::system::{bump, same_seeds, InvT, System, Workspace, SEED_SPARES};
 use nalgebra::{Matrix3, Vector3};
-
-/// The invariants in the scalar type of an evaluation, with the design
-/// derivatives folded in: each entry is `x + Σ_v (∂x/∂b_v) δ_v` where
-/// `δ_v` is the dual part of design variable `v` (zero in plain
-/// evaluations, which never build this lifted copy).
-#[derive(Debug, Clone)]
-pub struct InvT<T: Scalar> {
-    pub n: usize,
-    pub mass: T,
-    pub s0: Vector3<T>,
-    pub e0: Matrix3<T>,
-    pub i3: Vec<T>,
-    pub ls: Vec<T>,
-    pub p: Vec<T>,
-    pub q: Vec<T>,
-    pub v: Vec<T>,
-    pub j_rot: Matrix3<T>,
-    pub c_rot: Vec<T>,
-    pub mww: Vec<T>,
-    pub lambda: Vec<T>,
-}
-
-impl<T: Scalar> InvT<T> {
-    /// Lift the invariants of `flex` with the design seeds `deltas`
-    /// (`(variable, δ)` pairs).
-    pub fn lift(flex: &Flex, deltas: &[(usize, T)]) -> InvT<T> {
-        let inv = &flex.inv;
-        let d: Vec<(&Invariants, T)> = deltas.iter().map(|(k, t)| (&flex.dinv[*k], *t)).collect();
-        let vec = |f: &dyn Fn(&Invariants) -> &Vec<f64>| -> Vec<T> {
-            let base = f(inv);
-            (0..base.len())
-                .map(|i| {
-                    d.iter().fold(cst::<T>(base[i]), |acc, (di, t)| {
-                        acc + cst::<T>(f(di)[i]) * *t
-                    })
-                })
-                .collect()
-        };
-        let m3 = |f: &dyn Fn(&Invariants) -> Matrix3<f64>| -> Matrix3<T> {
-            d.iter().fold(f(inv).map(cst::<T>), |acc, (di, t)| {
-                acc + f(di).map(cst::<T>) * *t
-            })
-        };
-        InvT {
-            n: inv.n,
-            mass: cst::<T>(inv.mass),
-            s0: inv.s0.map(cst::<T>),
-            e0: m3(&|i| i.e0),
-            i3: vec(&|i| &i.i3),
-            ls: vec(&|i| &i.ls),
-            p: vec(&|i| &i.p),
-            q: vec(&|i| &i.q),
-            v: vec(&|i| &i.v),
-            j_rot: m3(&|i| i.j_rot),
-            c_rot: vec(&|i| &i.c_rot),
-            mww: vec(&|i| &i.mww),
-            lambda: vec(&|i| &i.lambda),
-        }
-    }
-
-    /// First moment `S = s0 + i3·w` (frame axes).
-    pub fn first_moment(&self, w: &[T]) -> Vector3<T> {
-        let n = self.n;
-        let mut s = self.s0;
-        for c in 0..3 {
-            for j in 0..n {
-                s[c] += self.i3[c * n + j] * w[j];
-            }
-        }
-        s
-    }
-
-    /// `i3ᵀ g` (length n) for a frame-axes vector `g`.
-    pub fn i3t(&self, g: &Vector3<T>) -> Vec<T> {
-        let n = self.n;
-        (0..n)
-            .map(|j| self.i3[j] * g[0] + self.i3[n + j] * g[1] + self.i3[2 * n + j] * g[2])
-            .collect()
-    }
-}
 
 /// Which terms to include.
 #[derive(Debug, Clone, Copy)]
@@ -255,5 +179,112 @@ pub fn flex_terms<T: Scalar>(
     for c in 0..3 {
         force[c] -= qr[c];
         force[3 + c] -= qw[c];
+    }
+}
+
+impl System {
+    /// The invariants of flexible slot `s` in `T`, lifted again only when
+    /// the design seeds differ from those of the current copy and of the
+    /// `SEED_SPARES` copies lifted before.
+    fn invariants<T: Scalar>(&self, s: usize, ws: &mut Workspace<T>) {
+        let flex = self.model.bodies[self.moving[s]].flex.as_ref();
+        let Some(flex) = flex else { return };
+        ws.inv.resize_with(self.nb(), || None);
+        ws.inv_seeds.resize_with(self.nb(), Vec::new);
+        ws.inv_spare.resize_with(self.nb(), Vec::new);
+        let design = &ws.kin[s].design;
+        if ws.inv[s].is_some() && same_seeds(&ws.inv_seeds[s], design) {
+            return;
+        }
+        // Earlier lifts are kept for evaluations that cycle through a few
+        // sets of seeds (the staggered sensitivities: J·s without design
+        // seeds, ∂f/∂p with one variable's).
+        let spare = &mut ws.inv_spare[s];
+        let (seeds, inv) = match spare.iter().position(|(sd, _)| same_seeds(sd, design)) {
+            Some(i) => spare.remove(i),
+            None => (design.clone(), InvT::lift(flex, design)),
+        };
+        let old_seeds = std::mem::replace(&mut ws.inv_seeds[s], seeds);
+        if let Some(old) = ws.inv[s].replace(inv) {
+            ws.inv_spare[s].insert(0, (old_seeds, old));
+            ws.inv_spare[s].truncate(SEED_SPARES);
+        }
+    }
+
+    /// Mass matrices of the flexible bodies (factored into `ws.mfac`) and,
+    /// when `forces` is set, their inertia, elastic and damping forces
+    /// (added to `ws.q`). `ws.q` must be sized.
+    pub(crate) fn flex_bodies<T: Scalar>(&self, ws: &mut Workspace<T>, forces: bool) {
+        ws.mfac.resize_with(self.nb(), Vec::new);
+        ws.kinetic.resize(self.nb(), T::zero());
+        for s in 0..self.nb() {
+            let n = self.modes[s];
+            if n == 0 {
+                continue;
+            }
+            bump(&self.counters.flexible);
+            self.invariants(s, ws);
+            let body = &self.model.bodies[self.moving[s]];
+            let zeta = body.flex.as_ref().map_or(0.0, |f| f.zeta);
+            let eff = FlexEffects {
+                quadratic: self.model.quadratic_velocity && forces,
+                zeta: if forces { zeta } else { 0.0 },
+            };
+            if eff.quadratic {
+                bump(&self.counters.quadratic);
+            }
+            if eff.zeta != 0.0 {
+                bump(&self.counters.modal_damping);
+            }
+            let d = 6 + n;
+            let o = self.vel_local(s);
+            let mut fq = vec![T::zero(); d];
+            let mut mass = std::mem::take(&mut ws.mfac[s]);
+            {
+                let k = &ws.kin[s];
+                let inv = ws.inv[s].as_ref().expect("invariants built above");
+                let st = FlexState {
+                    a: &k.a,
+                    wb: &k.wb,
+                    w: &k.q,
+                    wd: &k.qd,
+                };
+                flex_terms(inv, &st, eff, &mut mass, &mut fq);
+                let v: Vec<T> = (k.v.iter().chain(k.wb.iter()).chain(&k.qd))
+                    .copied()
+                    .collect();
+                ws.kinetic[s] = quadratic_form(&mass, &v, d);
+            }
+            // A non-positive pivot leaves a NaN in the factor, which the
+            // integrator reports with the time.
+            if !T::dense_factor(&mut mass, d) {
+                mass[0] = cst::<T>(f64::NAN);
+            }
+            ws.mfac[s] = mass;
+            if forces {
+                for (q, f) in ws.q[o..o + d].iter_mut().zip(&fq) {
+                    *q += *f;
+                }
+            }
+        }
+    }
+
+    /// Factored mass matrices of the flexible bodies at the kinematics in
+    /// `ws` (no forces).
+    pub(crate) fn mass_factors<T: Scalar>(&self, ws: &mut Workspace<T>) {
+        self.flex_bodies(ws, false);
+    }
+
+    /// `M v` of flexible slot `s` from its factor, which holds `M⁻¹`
+    /// ([`Scalar::dense_factor`]): `M` is that inverse inverted again (a
+    /// diagnostic, used for the angular momentum; `M` is well conditioned,
+    /// so the round trip costs a few ulps).
+    pub(crate) fn flex_mass_times(&self, s: usize, ws: &Workspace<f64>, v: &[f64]) -> Vec<f64> {
+        let d = self.dof(s);
+        let mut m = ws.mfac[s].clone();
+        spd_inverse(&mut m, d);
+        let mut out = vec![0.0; d];
+        sym_times(&m, d, v, &mut out);
+        out
     }
 }

@@ -46,7 +46,7 @@
 //! Gauss–Legendre rule (`segments` equal segments × [`GAUSS_POINTS`]
 //! points, exact for polynomials of degree 11 on each segment) with
 //! weights `ρA w_i`, so that every invariant of
-//! [`crate::mbs::flex::Invariants`] is the Gauss quadrature of the
+//! [`crate::mbs::Invariants`] is the Gauss quadrature of the
 //! corresponding integral of the continuous modes (`mww = I`,
 //! `mass = ρA L`, `∫ ρA x φ_j dx`, …) to ~1e-12 when the segments resolve
 //! the highest mode ([`Beam::segments_for`]). Zero-mass nodes carry the
@@ -67,8 +67,8 @@
 //! sense of rotation), for checking
 //! slow-loading simulations against statics.
 
-use super::flex::ModalBasis;
 use crate::error::{Error, Result};
+use crate::mbs::ModalBasis;
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 
@@ -281,7 +281,7 @@ impl Beam {
             .position(|l| !(l.is_finite() && *l > 0.0))
         {
             return Err(Error::numerical(
-                "mbs::beam::basis",
+                "beams::basis",
                 format!(
                     "eigenvalue {j} = {} out of range (L = {l} m, EI_y = {}, EI_z = {} N·m², ρA = {} kg/m)",
                     eigenvalues[j], self.ei_y, self.ei_z, self.rho_a
@@ -290,7 +290,7 @@ impl Beam {
         }
         if let Some(i) = shapes.iter().position(|v| !v.is_finite()) {
             return Err(Error::numerical(
-                "mbs::beam::basis",
+                "beams::basis",
                 format!(
                     "mode shape entry {i} = {} (L = {l} m, ρA = {} kg/m)",
                     shapes[i], self.rho_a
@@ -305,7 +305,7 @@ impl Beam {
             shapes,
             eigenvalues,
             derivatives: Vec::new(),
-            rigid: super::flex::RigidScreen::default(),
+            rigid: crate::mbs::RigidScreen::default(),
         })
     }
 
@@ -492,7 +492,7 @@ impl ModeFn {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mbs::flex::Invariants;
+    use crate::mbs::Invariants;
 
     /// A beam with unequal stiffnesses so that the two planes interleave
     /// (ω_Z/ω_Y = √2.5).

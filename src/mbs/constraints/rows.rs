@@ -1,27 +1,30 @@
 //! Constraint rows of the joints: value, Jacobian blocks per body and the
-//! velocity-dependent part `γ` of the constraint accelerations, and the
-//! rows each joint kind is made of (`joint_rows`).
+//! velocity-dependent part `γ` of the constraint accelerations, one
+//! function per row type, and the rows of each [`RowBlock`] of a joint
+//! kind (`joint_rows`; the kinds' table is `crate::mbs::model::joint`).
 //!
 //! Every row's rate is written as `P·v_point + W·ω_marker` of the two
 //! markers (point velocity, marker frame angular velocity), which
-//! [`super::dynamics`] turns into body and modal Jacobian entries.
+//! [`System::constraints`](crate::mbs::System::constraints) turns into
+//! body and modal Jacobian entries.
 
-use super::linalg::{cst, Scalar};
-use super::model::JointKind;
-use super::workspace::{MarkerKin, Row, RIGID};
+use crate::mbs::kinematics::angle_of;
+use crate::mbs::math::{cst, Scalar};
+use crate::mbs::model::{JointKind, RowBlock};
+use crate::mbs::system::{MarkerKin, Row, RIGID};
 use nalgebra::Vector3;
 
 /// The constraint rows of a joint of kind `kind` between markers `mi` and
-/// `mj` at time `t`, appended to `rows`:
+/// `mj` at time `t`, appended to `rows`, block by block
+/// ([`JointKind::blocks`]):
 ///
-/// | kind | rows |
+/// | block | rows |
 /// |---|---|
-/// | spherical | `x_i − x_j = 0` (3) |
-/// | revolute | + `x_i·z_j = 0`, `y_i·z_j = 0` (5) |
-/// | driven | + `θ − f(t) = 0` (6) |
-/// | fixed | revolute + `x_i·y_j = 0` (6) |
-/// | cylindrical | `x_i·d = 0`, `y_i·d = 0` with `d = x_j − x_i`, + `x_i·z_j = 0`, `y_i·z_j = 0` (4) |
-/// | prismatic | cylindrical + `x_i·y_j = 0` (5) |
+/// | point | `x_i − x_j = 0` ([`point_row`], 3) |
+/// | line | `x_i·d = 0`, `y_i·d = 0` with `d = x_j − x_i` ([`line_row`], 2) |
+/// | parallel | `x_i·z_j = 0`, `y_i·z_j = 0` ([`dot_row`], 2) |
+/// | twist | `x_i·y_j = 0` ([`dot_row`], 1) |
+/// | angle | `θ − f(t) = 0` ([`angle_row`], 1) |
 pub(crate) fn joint_rows<T: Scalar>(
     kind: &JointKind,
     (mi, mj): (&MarkerKin<T>, &MarkerKin<T>),
@@ -31,44 +34,28 @@ pub(crate) fn joint_rows<T: Scalar>(
     let col = |m: &MarkerKin<T>, c: usize| -> Vector3<T> { m.frame.column(c).into() };
     let (xi, yi) = (col(mi, 0), col(mi, 1));
     let (yj, zj) = (col(mj, 1), col(mj, 2));
-    if kind.has_slide() {
-        rows.push(line_row(mi, mj, &xi));
-        rows.push(line_row(mi, mj, &yi));
-    } else {
-        for k in 0..3 {
-            rows.push(point_row(mi, mj, k));
+    for block in kind.blocks() {
+        match block {
+            RowBlock::Point => {
+                for k in 0..3 {
+                    rows.push(point_row(mi, mj, k));
+                }
+            }
+            RowBlock::Line => {
+                rows.push(line_row(mi, mj, &xi));
+                rows.push(line_row(mi, mj, &yi));
+            }
+            RowBlock::Parallel => {
+                rows.push(dot_row(mi, mj, &xi, &zj));
+                rows.push(dot_row(mi, mj, &yi, &zj));
+            }
+            RowBlock::Twist => rows.push(dot_row(mi, mj, &xi, &yj)),
+            RowBlock::Angle => {
+                let drive = kind.drive().expect("an angle block has a drive");
+                rows.push(angle_row(mi, mj, drive.eval(t)));
+            }
         }
     }
-    if matches!(kind, JointKind::Spherical) {
-        return;
-    }
-    // Parallel z axes.
-    rows.push(dot_row(mi, mj, &xi, &zj));
-    rows.push(dot_row(mi, mj, &yi, &zj));
-    match kind {
-        JointKind::Fixed | JointKind::Prismatic => rows.push(dot_row(mi, mj, &xi, &yj)),
-        JointKind::Driven(drive) => rows.push(angle_row(mi, mj, drive.eval(t))),
-        _ => {}
-    }
-}
-
-/// Displacement along the axis `s = z_i·(x_j − x_i)` (m) and its rate
-/// `ṡ = (ω_i×z_i)·(x_j − x_i) + z_i·(v_j − v_i)` (m/s), with `ω_i` the
-/// angular velocity of marker i's frame. Zero at the start of a scene
-/// joint, whose two markers are made at the joint point.
-pub fn slide_of<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>) -> (T, T) {
-    let zi: Vector3<T> = mi.frame.column(2).into();
-    let d = mj.x - mi.x;
-    (zi.dot(&d), mi.w.cross(&zi).dot(&d) + zi.dot(&(mj.v - mi.v)))
-}
-
-/// `θ = atan2(z_i·(x_i × x_j), x_i·x_j)` and `θ̇ = z_i·(ω_j − ω_i)`.
-pub fn angle_of<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>) -> (T, T) {
-    let xi: Vector3<T> = mi.frame.column(0).into();
-    let zi: Vector3<T> = mi.frame.column(2).into();
-    let xj: Vector3<T> = mj.frame.column(0).into();
-    let th = zi.dot(&xi.cross(&xj)).atan2(xi.dot(&xj));
-    (th, zi.dot(&(mj.w - mi.w)))
 }
 
 /// Block of a row for a marker: `(slot, [∂/∂ṙ, ∂/∂ω_global])`.

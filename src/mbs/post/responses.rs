@@ -21,9 +21,8 @@
 //! - **Final values** are the sum at the end time, with the derivative
 //!   `dE/dp = ∂E/∂y · s(t_end) + ∂E/∂p` ([`energy_lanes`]).
 
-use super::dynamics::{System, Workspace};
-use super::energy::Energy;
-use super::model::Param;
+use crate::mbs::model::{Energy, Param};
+use crate::mbs::system::{System, Workspace};
 use num_dual::Dual64;
 
 /// The kind of a response functional (paper Eqs. 33–34).

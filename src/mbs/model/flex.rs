@@ -578,7 +578,7 @@ fn flat_sums(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mbs::linalg::Scalar;
+    use crate::mbs::math::Scalar;
     use num_dual::Dual64;
 
     /// The definitions node by node (the table of the module doc), in any

@@ -2,11 +2,11 @@
 //! per-state outputs: joint angles and rates, reactions, energy and
 //! constraint violation.
 
-use super::dynamics::{angle_of, slide_of, BodyKin, System, Workspace, RANK_REG, RANK_TOL};
-use super::energy::Energy;
-use super::linalg::Scalar;
-use super::model::{Force, JointKind};
 use crate::error::{Error, Result};
+use crate::mbs::kinematics::{angle_of, slide_of};
+use crate::mbs::math::Scalar;
+use crate::mbs::model::{Energy, Force, JointKind};
+use crate::mbs::system::{BodyKin, System, Workspace, RANK_REG, RANK_TOL};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// Sizes of the corrections made by [`System::project`].
@@ -259,29 +259,6 @@ impl System {
             .fold(Vector3::zeros(), |acc, (p, w)| acc + p * *w)
     }
 
-    /// Strain energy of flexible slot `s` in any scalar, with design seeds
-    /// `(variable, δ)` applied to Λ.
-    pub fn strain_energy_dual<T: Scalar>(&self, y: &[T], s: usize, design: &[(usize, T)]) -> T {
-        let b = self.moving[s];
-        let Some(flex) = self.model.bodies[b].flex.as_ref() else {
-            return T::zero();
-        };
-        let p = self.pos_off(s) + 7;
-        let half = nalgebra::convert::<f64, T>(0.5);
-        (0..self.modes[s]).fold(T::zero(), |acc, j| {
-            let mut l = nalgebra::convert::<f64, T>(flex.inv.lambda[j]);
-            for (var, d) in design {
-                l += nalgebra::convert::<f64, T>(flex.dinv[*var].lambda[j]) * *d;
-            }
-            acc + half * l * y[p + j] * y[p + j]
-        })
-    }
-
-    /// Strain energy `½ wᵀΛw` of flexible slot `s` (J).
-    pub fn strain_energy(&self, y: &[f64], s: usize) -> f64 {
-        self.strain_energy_dual(y, s, &[])
-    }
-
     /// Whether [`System::energy`] is conserved by the exact flow: no
     /// dampers, actuators, loads or driven joints.
     pub fn conservative(&self) -> bool {
@@ -383,40 +360,5 @@ impl System {
             r0 += ne;
         }
         out
-    }
-}
-
-impl<T: Scalar> Workspace<T> {
-    /// An empty workspace (buffers grow on first use).
-    pub fn empty() -> Self {
-        Workspace {
-            rows: Vec::new(),
-            a: Vec::new(),
-            rhs: Vec::new(),
-            scale: Vec::new(),
-            sol: Default::default(),
-            kin: Vec::new(),
-            mk: Vec::new(),
-            shapes: Vec::new(),
-            shape_seeds: Vec::new(),
-            planes: Vec::new(),
-            shape_spare: Vec::new(),
-            blocks: Vec::new(),
-            gather: Vec::new(),
-            perm: Vec::new(),
-            mjac: Vec::new(),
-            mfac: Vec::new(),
-            inv: Vec::new(),
-            inv_seeds: Vec::new(),
-            inv_spare: Vec::new(),
-            kinetic: Vec::new(),
-            inv_order: Vec::new(),
-            spd: Default::default(),
-            q: Vec::new(),
-            rank: 0,
-            params: Vec::new(),
-            segments: Vec::new(),
-            rotations: Vec::new(),
-        }
     }
 }

@@ -1,13 +1,12 @@
 //! The data of one right-hand-side evaluation: constraint rows, body and
 //! marker kinematics, scratch storage reused across evaluations (one per
-//! scalar type), evaluation counters, and the rank constants of the
-//! constraint-space solve ([`super::dynamics`] has the method).
+//! scalar type, [`Workspace`]), and the rank constants of the
+//! constraint-space solve (`crate::mbs::constraints::solve`).
 
-use super::flexdyn::InvT;
-use super::linalg::{Scalar, SpdScratch};
-use super::model::Param;
+use super::invariants::InvT;
+use crate::mbs::math::{Scalar, ShapePlanes, SpdScratch};
+use crate::mbs::model::Param;
 use nalgebra::{Matrix3, Vector3};
-use std::cell::Cell;
 
 /// Relative pivot threshold for counting the rank of the constraint-space
 /// matrix (unit-diagonal scaled): an exactly dependent row gives a pivot at
@@ -65,20 +64,14 @@ pub struct Workspace<T: Scalar> {
     /// The design seeds each marker's `shapes` were built with (`None`
     /// for markers not on a flexible node).
     pub(crate) shape_seeds: Vec<Option<Vec<(usize, T)>>>,
-    /// The same shapes as real planes ([`super::planes`]), for the sums
+    /// The same shapes as real planes ([`crate::mbs::math::planes`]), for the sums
     /// over the modes.
-    pub(crate) planes: Vec<super::planes::ShapePlanes>,
+    pub(crate) planes: Vec<ShapePlanes>,
     /// Per marker: shapes (seeds, rows, planes) built before the current
     /// ones, most recent first, for evaluations that cycle through a few
     /// sets of design seeds.
     #[allow(clippy::type_complexity)]
-    pub(crate) shape_spare: Vec<
-        Vec<(
-            Option<Vec<(usize, T)>>,
-            NodeShapes<T>,
-            super::planes::ShapePlanes,
-        )>,
-    >,
+    pub(crate) shape_spare: Vec<Vec<(Option<Vec<(usize, T)>>, NodeShapes<T>, ShapePlanes)>>,
     /// Per moving body: the constraint rows touching it and their
     /// products with its inverse mass ([`BodyBlock`]).
     pub(crate) blocks: Vec<BodyBlock>,
@@ -110,7 +103,7 @@ pub struct Workspace<T: Scalar> {
     pub(crate) inv_spare: Vec<Vec<(Vec<(usize, T)>, InvT<T>)>>,
     /// Per moving body: the kinetic energy `½ vᵀMv` of a flexible body,
     /// from its mass matrix before the factorization (zero for rigid
-    /// bodies, whose energy [`super::energy`] computes directly).
+    /// bodies, whose energy [`crate::mbs::dynamics::energy`] computes directly).
     pub(crate) kinetic: Vec<T>,
     /// Rank of the last factorization.
     pub rank: usize,
@@ -118,13 +111,13 @@ pub struct Workspace<T: Scalar> {
     /// empty for plain evaluations.
     pub params: Vec<(Param, T)>,
     /// Frozen segment of each actuator's Eq. 32 law, by force index, while
-    /// the integrator treats segment changes as events ([`super::segments`]):
+    /// the integrator treats segment changes as events ([`crate::mbs::segments`]):
     /// the segment's line then extends past its breakpoints, so the
     /// right-hand side is smooth. Empty (or an out-of-range entry): the
     /// segment is picked by the value of θ.
     pub segments: Vec<usize>,
     /// Per marker: whether its node rotation is computed
-    /// ([`super::dynamics::System::node_rotations`]).
+    /// ([`System::node_rotations`](crate::mbs::System::node_rotations)).
     pub(crate) rotations: Vec<bool>,
 }
 
@@ -146,7 +139,7 @@ pub struct BodyBlock {
     pub(crate) inv_mass: f64,
 }
 
-/// Real scratch of the constraint-space solve ([`super::solve`]).
+/// Real scratch of the constraint-space solve ([`crate::mbs::constraints::solve`]).
 #[derive(Debug, Clone, Default)]
 pub struct SolveScratch {
     pub(crate) rhs: Vec<f64>,
@@ -191,12 +184,12 @@ pub struct BodyKin<T: Scalar> {
 }
 
 /// Global kinematics of a marker. On a flexible node whose rotation
-/// nothing in the model reads ([`super::dynamics::System::node_rotations`]:
-/// only spherical joints use the marker), [`System::markers_kin`]
+/// nothing in the model reads ([`System::node_rotations`](crate::mbs::System::node_rotations):
+/// only point-row joints use the marker), [`System::markers_kin`]
 /// leaves the node's rotation out: `frame`, `w`, `alpha` and `tangent`
 /// are then those of the body frame.
 ///
-/// [`System::markers_kin`]: super::dynamics::System::markers_kin
+/// [`System::markers_kin`]: crate::mbs::System::markers_kin
 #[derive(Debug, Clone, Copy)]
 pub struct MarkerKin<T: Scalar> {
     pub slot: Option<usize>,
@@ -223,18 +216,37 @@ pub struct MarkerKin<T: Scalar> {
     pub tangent: Matrix3<T>,
 }
 
-/// Evaluation counters (what is not built is never evaluated).
-#[derive(Debug, Default)]
-pub struct Counters {
-    pub rhs: Cell<u64>,
-    pub gravity: Cell<u64>,
-    pub actuators: Cell<u64>,
-    pub springs: Cell<u64>,
-    pub loads: Cell<u64>,
-    /// Flexible-body mass matrices and elastic forces built.
-    pub flexible: Cell<u64>,
-    /// Quadratic-velocity terms evaluated (per body).
-    pub quadratic: Cell<u64>,
-    /// Modal damping forces evaluated (per flexible body).
-    pub modal_damping: Cell<u64>,
+impl<T: Scalar> Workspace<T> {
+    /// An empty workspace (buffers grow on first use).
+    pub fn empty() -> Self {
+        Workspace {
+            rows: Vec::new(),
+            a: Vec::new(),
+            rhs: Vec::new(),
+            scale: Vec::new(),
+            sol: Default::default(),
+            kin: Vec::new(),
+            mk: Vec::new(),
+            shapes: Vec::new(),
+            shape_seeds: Vec::new(),
+            planes: Vec::new(),
+            shape_spare: Vec::new(),
+            blocks: Vec::new(),
+            gather: Vec::new(),
+            perm: Vec::new(),
+            mjac: Vec::new(),
+            mfac: Vec::new(),
+            inv: Vec::new(),
+            inv_seeds: Vec::new(),
+            inv_spare: Vec::new(),
+            kinetic: Vec::new(),
+            inv_order: Vec::new(),
+            spd: Default::default(),
+            q: Vec::new(),
+            rank: 0,
+            params: Vec::new(),
+            segments: Vec::new(),
+            rotations: Vec::new(),
+        }
+    }
 }

@@ -12,7 +12,7 @@
 //! instead of `14 × 6` dual products per sum. For `f64` there is one plane
 //! and the sums are the plain ones.
 
-use super::linalg::{Scalar, MAX_LANES};
+use super::scalar::{Scalar, MAX_LANES};
 use nalgebra::Vector3;
 
 /// Most planes a number splits into: the real part and its lanes.
@@ -141,7 +141,7 @@ impl ShapePlanes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mbs::dual::DualN;
+    use crate::mbs::math::DualN;
 
     type D = DualN<2>;
 

@@ -1,0 +1,183 @@
+//! Force elements as data: gravity, the paper's Eq. 32
+//! spring-damper-actuator with its piecewise-linear law, linear
+//! spring-dampers between markers or along a sliding joint, and constant
+//! or time-tabulated loads (SI units). They are applied by
+//! `crate::mbs::forces`.
+
+use crate::error::{Error, Result};
+use nalgebra::Vector3;
+
+/// One segment of a piecewise-linear law, written as in the paper's Eq. 32:
+/// on `lower < θ ≤ upper` the value is `value + slope·(anchor − θ)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Segment {
+    pub lower: f64,
+    pub upper: f64,
+    pub value: f64,
+    pub slope: f64,
+    pub anchor: f64,
+}
+
+/// Piecewise-linear law `M(θ)` (Eq. 32 without the damping term). Outside
+/// the union of the segments the nearest boundary segment extends its line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PiecewiseLaw {
+    /// Segments sorted by `lower`.
+    pub segments: Vec<Segment>,
+}
+
+impl PiecewiseLaw {
+    /// Validates (non-empty, `lower < upper`, finite) and sorts.
+    pub fn new(key: &str, mut segments: Vec<Segment>) -> Result<PiecewiseLaw> {
+        if segments.is_empty() {
+            return Err(Error::input(key, "[]", "at least one segment"));
+        }
+        for (k, s) in segments.iter().enumerate() {
+            let finite = [s.value, s.slope, s.anchor].iter().all(|v| v.is_finite());
+            if s.lower.partial_cmp(&s.upper) != Some(std::cmp::Ordering::Less) || !finite {
+                return Err(Error::input(
+                    format!("{key}[{k}]"),
+                    format!("{s:?}"),
+                    "lower < upper and finite value, slope, anchor",
+                ));
+            }
+        }
+        segments.sort_by(|a, b| a.lower.total_cmp(&b.lower));
+        Ok(PiecewiseLaw { segments })
+    }
+
+    /// The segment that applies at `θ` (real value).
+    pub fn segment(&self, theta: f64) -> &Segment {
+        &self.segments[self.segment_index(theta)]
+    }
+
+    /// Index of the segment that applies at `θ`.
+    pub fn segment_index(&self, theta: f64) -> usize {
+        let segs = &self.segments;
+        if let Some(k) = segs
+            .iter()
+            .position(|s| theta > s.lower && theta <= s.upper)
+        {
+            return k;
+        }
+        if theta <= segs[0].lower {
+            return 0;
+        }
+        if theta > segs[segs.len() - 1].upper {
+            return segs.len() - 1;
+        }
+        // A gap between segments: the nearest one below.
+        segs.iter().rposition(|s| s.upper < theta).unwrap_or(0)
+    }
+}
+
+/// Force elements. Only those the scene's `effects` list asks for exist.
+#[derive(Debug, Clone)]
+pub enum Force {
+    /// Uniform gravity `g` (m/s²) on every moving body.
+    Gravity { g: Vector3<f64> },
+    /// Rotational spring-damper-actuator on a revolute joint (paper Eq. 32):
+    /// torque on marker j about `z_i`: `τ = −(c·θ̇ + law(θ))` (N·m), the
+    /// reaction on marker i. `damping` = c (N·m·s), `law` may be absent.
+    Rotational {
+        joint: usize,
+        law: Option<PiecewiseLaw>,
+        damping: f64,
+    },
+    /// Linear spring-damper between markers i and j: tension
+    /// `F = k(l − l0) + c·l̇` (N), pulling the points together when > 0.
+    SpringDamper {
+        i: usize,
+        j: usize,
+        stiffness: f64,
+        damping: f64,
+        length: f64,
+    },
+    /// Translational spring-damper-actuator along the axis `z_i` of the
+    /// prismatic or cylindrical joint `joint`: tension
+    /// `T = k(s − s0) − f + c·ṡ` (N) with `s` the joint displacement, `s0`
+    /// = `length` and `f` = `force` a constant actuator force pushing the
+    /// markers apart along `z_i`; `−T z_i` on marker j, `+T z_i` on marker
+    /// i and the torque `−T z_i×(x_j − x_i)` on marker i, which makes the
+    /// spring the exact gradient of `½k(s − s0)²` also off the axis.
+    JointSpring {
+        joint: usize,
+        stiffness: f64,
+        damping: f64,
+        length: f64,
+        force: f64,
+    },
+    /// Force (N) at the centre of mass and torque (N·m) on a body,
+    /// constant or tabulated in time, with components in global or body
+    /// axes (`frame`). On a flexible body the force is distributed in
+    /// proportion to mass (as a uniform acceleration field `f/m`, so it
+    /// also loads the modes through `i3ᵀ`); the torque acts on the frame.
+    BodyLoad {
+        body: usize,
+        load: Load,
+        frame: LoadFrame,
+    },
+    /// Force (N) at the point of a marker and torque (N·m) on its body,
+    /// constant or tabulated in time, with components in global or body
+    /// axes: on the body, the force `f` and the moment `s × f` of the
+    /// marker's lever arm `s`, plus the torque; on a flexible node, also
+    /// the modal forces `Φ_kᵀAᵀf` and `Ψ_kᵀ(…)τ` of the node.
+    MarkerLoad {
+        marker: usize,
+        load: Load,
+        frame: LoadFrame,
+    },
+}
+
+/// The axes a load's components are given in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoadFrame {
+    /// Global axes: the load keeps its direction in space.
+    Global,
+    /// The body's frame axes (`A` of the rigid body or of the flexible
+    /// body's floating frame): a follower load turning with the body.
+    Body,
+}
+
+/// A force and torque, constant or piecewise linear in time.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Load {
+    Constant {
+        force: Vector3<f64>,
+        torque: Vector3<f64>,
+    },
+    /// Rows `(t, [fx, fy, fz, tx, ty, tz])` with increasing `t`; linear
+    /// between rows, held at the first and last row outside them.
+    Table(Vec<(f64, [f64; 6])>),
+}
+
+impl Load {
+    /// Force and torque at time `t` (s).
+    pub fn eval(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let split = |v: &[f64; 6]| {
+            (
+                Vector3::new(v[0], v[1], v[2]),
+                Vector3::new(v[3], v[4], v[5]),
+            )
+        };
+        match self {
+            Load::Constant { force, torque } => (*force, *torque),
+            Load::Table(rows) => {
+                let k = rows.partition_point(|(tk, _)| *tk <= t);
+                if k == 0 {
+                    return split(&rows[0].1);
+                }
+                if k == rows.len() {
+                    return split(&rows[k - 1].1);
+                }
+                let ((t0, a), (t1, b)) = (&rows[k - 1], &rows[k]);
+                let f = (t - t0) / (t1 - t0);
+                let mut v = [0.0; 6];
+                for c in 0..6 {
+                    v[c] = a[c] + f * (b[c] - a[c]);
+                }
+                split(&v)
+            }
+        }
+    }
+}

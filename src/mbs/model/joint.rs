@@ -1,0 +1,193 @@
+//! Joints as data, and the one table of joint kinds.
+//!
+//! A joint connects marker `i` to marker `j`. Revolute axes are the
+//! markers' z axes; the relative angle `θ` is the rotation of `j`
+//! relative to `i` about `z_i`, `θ = atan2(z_i·(x_i × x_j), x_i·x_j)`.
+//! Prismatic and cylindrical joints slide along marker i's z axis; the
+//! displacement is `s = z_i·(x_j − x_i)` (m), zero at the start (a scene
+//! makes both markers at the joint point).
+//!
+//! Every kind is a list of row blocks ([`JointKind::blocks`], the only
+//! match over the kinds): its equation count, row names and flags
+//! ([`JointKind::has_angle`], [`JointKind::has_slide`],
+//! [`JointKind::reads_frames`]) follow from that list, and the constraint
+//! layer turns each block into its rows (`crate::mbs::constraints::rows`).
+//!
+//! | kind | blocks | rows |
+//! |---|---|---|
+//! | spherical | point | `x_i − x_j = 0` (3) |
+//! | revolute | point, parallel | + `x_i·z_j = 0`, `y_i·z_j = 0` (5) |
+//! | driven | point, parallel, angle | + `θ − f(t) = 0` (6) |
+//! | fixed | point, parallel, twist | revolute + `x_i·y_j = 0` (6) |
+//! | cylindrical | line, parallel | `x_i·d = 0`, `y_i·d = 0` with `d = x_j − x_i`, + `x_i·z_j = 0`, `y_i·z_j = 0` (4) |
+//! | prismatic | line, parallel, twist | cylindrical + `x_i·y_j = 0` (5) |
+
+/// A prescribed relative angle `θ(t) = Σ c_k t^k` (rad, t in s); a locked
+/// revolute joint is the constant polynomial.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Drive {
+    pub coefficients: Vec<f64>,
+}
+
+impl Drive {
+    /// `(θ, θ̇, θ̈)` at time `t`.
+    pub fn eval(&self, t: f64) -> (f64, f64, f64) {
+        let (mut f, mut d, mut dd) = (0.0, 0.0, 0.0);
+        for &c in self.coefficients.iter().rev() {
+            dd = dd * t + d * 2.0;
+            d = d * t + f;
+            f = f * t + c;
+        }
+        (f, d, dd)
+    }
+}
+
+/// A block of constraint rows between two markers: the unit joint kinds
+/// are made of. The rows of a block are named (for labels of reactions
+/// and redundant rows) by [`RowBlock::names`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RowBlock {
+    /// Coincident points `x_i − x_j = 0`, global components `x`, `y`, `z`.
+    Point,
+    /// Point j on the line of marker i's z axis: `x_i·d = 0`, `y_i·d = 0`
+    /// with `d = x_j − x_i` (`xi.d`, `yi.d`).
+    Line,
+    /// Parallel z axes: `x_i·z_j = 0`, `y_i·z_j = 0` (`xi.zj`, `yi.zj`).
+    Parallel,
+    /// No twist about the z axes: `x_i·y_j = 0` (`xi.yj`).
+    Twist,
+    /// The relative angle prescribed by the joint's [`Drive`]:
+    /// `θ − f(t) = 0` (`angle`).
+    Angle,
+}
+
+impl RowBlock {
+    /// Names of the block's rows, in the order they are assembled.
+    pub fn names(self) -> &'static [&'static str] {
+        match self {
+            RowBlock::Point => &["x", "y", "z"],
+            RowBlock::Line => &["xi.d", "yi.d"],
+            RowBlock::Parallel => &["xi.zj", "yi.zj"],
+            RowBlock::Twist => &["xi.yj"],
+            RowBlock::Angle => &["angle"],
+        }
+    }
+}
+
+/// Joint types.
+#[derive(Debug, Clone, PartialEq)]
+pub enum JointKind {
+    /// Coincident points (3 equations).
+    Spherical,
+    /// Coincident points and parallel z axes (5 equations).
+    Revolute,
+    /// Revolute with the relative angle prescribed (6 equations).
+    Driven(Drive),
+    /// Coincident points and frames (6 equations).
+    Fixed,
+    /// Translation along `z_i` only: frames parallel, point j on the line
+    /// of marker i's z axis (5 equations).
+    Prismatic,
+    /// Translation along and rotation about `z_i`: parallel z axes, point
+    /// j on the line of marker i's z axis (4 equations).
+    Cylindrical,
+}
+
+impl JointKind {
+    /// The row blocks of this kind, in the order they are assembled: the
+    /// table every other property of a kind follows from (the module
+    /// docs show it).
+    pub fn blocks(&self) -> &'static [RowBlock] {
+        use RowBlock::{Angle, Line, Parallel, Point, Twist};
+        match self {
+            JointKind::Spherical => &[Point],
+            JointKind::Revolute => &[Point, Parallel],
+            JointKind::Driven(_) => &[Point, Parallel, Angle],
+            JointKind::Fixed => &[Point, Parallel, Twist],
+            JointKind::Cylindrical => &[Line, Parallel],
+            JointKind::Prismatic => &[Line, Parallel, Twist],
+        }
+    }
+    /// The prescribed angle of a kind with an [`RowBlock::Angle`] block.
+    pub fn drive(&self) -> Option<&Drive> {
+        match self {
+            JointKind::Driven(d) => Some(d),
+            _ => None,
+        }
+    }
+    /// Number of constraint equations (rows of all blocks).
+    pub fn equations(&self) -> usize {
+        self.blocks().iter().map(|b| b.names().len()).sum()
+    }
+    /// Names of the constraint equations, in assembly order: the
+    /// [`RowBlock::names`] of every block. As many names as
+    /// [`JointKind::equations`].
+    pub fn row_names(&self) -> impl Iterator<Item = &'static str> {
+        self.blocks().iter().flat_map(|b| b.names().iter().copied())
+    }
+    /// Whether the joint has a relative rotation angle about z: its z
+    /// axes are kept parallel ([`RowBlock::Parallel`]) and no twist row
+    /// locks the rotation about them (a driven angle is still an angle).
+    pub fn has_angle(&self) -> bool {
+        let b = self.blocks();
+        b.contains(&RowBlock::Parallel) && !b.contains(&RowBlock::Twist)
+    }
+    /// Whether the joint has a displacement along z: point j is kept on
+    /// marker i's z line ([`RowBlock::Line`]) rather than at its point.
+    pub fn has_slide(&self) -> bool {
+        self.blocks().contains(&RowBlock::Line)
+    }
+    /// Whether the joint's rows read the marker frames (every block but
+    /// [`RowBlock::Point`]): the joint then needs an axis, and a marker
+    /// on a flexible node needs its node rotation.
+    pub fn reads_frames(&self) -> bool {
+        self.blocks().iter().any(|b| *b != RowBlock::Point)
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct Joint {
+    pub name: String,
+    pub kind: JointKind,
+    pub i: usize,
+    pub j: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn drive_polynomial_derivatives() {
+        // θ = 1 + 2t + 3t²: closed form derived in this test.
+        let d = Drive {
+            coefficients: vec![1.0, 2.0, 3.0],
+        };
+        let (f, df, ddf) = d.eval(0.5);
+        assert!((f - 2.75).abs() < 1e-15);
+        assert!((df - 5.0).abs() < 1e-15);
+        assert!((ddf - 6.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn flags_follow_from_the_blocks() {
+        let driven = JointKind::Driven(Drive {
+            coefficients: vec![0.0],
+        });
+        let angle = [true, true, false, true, false, false];
+        let slide = [false, false, false, true, true, false];
+        let kinds = [
+            JointKind::Revolute,
+            driven,
+            JointKind::Fixed,
+            JointKind::Cylindrical,
+            JointKind::Prismatic,
+            JointKind::Spherical,
+        ];
+        for (k, kind) in kinds.iter().enumerate() {
+            assert_eq!(kind.has_angle(), angle[k], "{kind:?}");
+            assert_eq!(kind.has_slide(), slide[k], "{kind:?}");
+            assert_eq!(kind.reads_frames(), k < 5, "{kind:?}");
+        }
+    }
+}

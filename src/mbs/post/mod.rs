@@ -1,0 +1,8 @@
+//! After the solve: consistent initial conditions (projection), loads,
+//! violations, reactions, momenta and deflections ([`analysis`]), energy
+//! sums ([`energy`]) and the response functionals with their sensitivity
+//! lanes ([`responses`]).
+
+pub mod analysis;
+pub mod energy;
+pub mod responses;

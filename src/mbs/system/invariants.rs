@@ -1,0 +1,89 @@
+//! The inertia invariants of a flexible body in the scalar type of an
+//! evaluation, with the design derivatives folded in (the lift a dual
+//! evaluation seeds with the ply-angle lanes).
+
+#![allow(clippy::needless_range_loop)] // index-heavy small dense kernels
+
+use crate::mbs::math::{cst, Scalar};
+use crate::mbs::model::{Flex, Invariants};
+use nalgebra::{Matrix3, Vector3};
+
+/// The invariants in the scalar type of an evaluation, with the design
+/// derivatives folded in: each entry is `x + Σ_v (∂x/∂b_v) δ_v` where
+/// `δ_v` is the dual part of design variable `v` (zero in plain
+/// evaluations, which never build this lifted copy).
+#[derive(Debug, Clone)]
+pub struct InvT<T: Scalar> {
+    pub n: usize,
+    pub mass: T,
+    pub s0: Vector3<T>,
+    pub e0: Matrix3<T>,
+    pub i3: Vec<T>,
+    pub ls: Vec<T>,
+    pub p: Vec<T>,
+    pub q: Vec<T>,
+    pub v: Vec<T>,
+    pub j_rot: Matrix3<T>,
+    pub c_rot: Vec<T>,
+    pub mww: Vec<T>,
+    pub lambda: Vec<T>,
+}
+
+impl<T: Scalar> InvT<T> {
+    /// Lift the invariants of `flex` with the design seeds `deltas`
+    /// (`(variable, δ)` pairs).
+    pub fn lift(flex: &Flex, deltas: &[(usize, T)]) -> InvT<T> {
+        let inv = &flex.inv;
+        let d: Vec<(&Invariants, T)> = deltas.iter().map(|(k, t)| (&flex.dinv[*k], *t)).collect();
+        let vec = |f: &dyn Fn(&Invariants) -> &Vec<f64>| -> Vec<T> {
+            let base = f(inv);
+            (0..base.len())
+                .map(|i| {
+                    d.iter().fold(cst::<T>(base[i]), |acc, (di, t)| {
+                        acc + cst::<T>(f(di)[i]) * *t
+                    })
+                })
+                .collect()
+        };
+        let m3 = |f: &dyn Fn(&Invariants) -> Matrix3<f64>| -> Matrix3<T> {
+            d.iter().fold(f(inv).map(cst::<T>), |acc, (di, t)| {
+                acc + f(di).map(cst::<T>) * *t
+            })
+        };
+        InvT {
+            n: inv.n,
+            mass: cst::<T>(inv.mass),
+            s0: inv.s0.map(cst::<T>),
+            e0: m3(&|i| i.e0),
+            i3: vec(&|i| &i.i3),
+            ls: vec(&|i| &i.ls),
+            p: vec(&|i| &i.p),
+            q: vec(&|i| &i.q),
+            v: vec(&|i| &i.v),
+            j_rot: m3(&|i| i.j_rot),
+            c_rot: vec(&|i| &i.c_rot),
+            mww: vec(&|i| &i.mww),
+            lambda: vec(&|i| &i.lambda),
+        }
+    }
+
+    /// First moment `S = s0 + i3·w` (frame axes).
+    pub fn first_moment(&self, w: &[T]) -> Vector3<T> {
+        let n = self.n;
+        let mut s = self.s0;
+        for c in 0..3 {
+            for j in 0..n {
+                s[c] += self.i3[c * n + j] * w[j];
+            }
+        }
+        s
+    }
+
+    /// `i3ᵀ g` (length n) for a frame-axes vector `g`.
+    pub fn i3t(&self, g: &Vector3<T>) -> Vec<T> {
+        let n = self.n;
+        (0..n)
+            .map(|j| self.i3[j] * g[0] + self.i3[n + j] * g[1] + self.i3[2 * n + j] * g[2])
+            .collect()
+    }
+}
