@@ -104,8 +104,8 @@ pub fn line_plot(path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()> {
 }
 
 /// [`line_plot`] of curves whose values were raised to a positive `floor`
-/// (a gap that reached zero, shown on a log axis): the points at the floor
-/// also get a hollow triangle in their curve's colour, and the legend
+/// (a gap that reached zero, shown on a log axis): where a curve reaches
+/// the floor, a hollow downward triangle in its colour, and the legend
 /// says `≤ <floor> (floor)`, so a floor is not read as convergence to it.
 pub fn line_plot_floored(path: &Path, axes: &Axes, curves: &[Curve], floor: f64) -> Result<()> {
     draw_lines(path, axes, curves, Some(floor))
@@ -185,9 +185,9 @@ fn draw_lines(path: &Path, axes: &Axes, curves: &[Curve], floor: Option<f64>) ->
     root.present().map_err(|e| plot_err(path, e))
 }
 
-/// Hollow triangles on the points of `curves` whose value is at (or
-/// below) `floor`, and one legend entry for them (none when no point is
-/// there).
+/// Hollow triangles on the points where a curve comes down to `floor`
+/// (the first of each run of points at or below it), and one legend entry
+/// for them (none when no point is there).
 fn mark_floor<DB: DrawingBackend>(
     path: &Path,
     chart: &mut ChartContext<DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
@@ -199,7 +199,10 @@ fn mark_floor<DB: DrawingBackend>(
         .iter()
         .map(|c| Curve {
             label: String::new(),
-            points: c.points.iter().copied().filter(|p| p.1 <= floor).collect(),
+            points: (c.points.iter().enumerate())
+                .filter(|&(k, p)| p.1 <= floor && (k == 0 || c.points[k - 1].1 > floor))
+                .map(|(_, &p)| p)
+                .collect(),
         })
         .collect();
     if at_floor.iter().all(|c| c.points.is_empty()) {
@@ -265,7 +268,7 @@ struct ColourScale {
 }
 
 /// Decades of a logarithmic colour scale below its largest value.
-const LOG_DECADES: f64 = 4.0;
+const LOG_DECADES: f64 = 3.0;
 
 impl ColourScale {
     /// The scale for values in `[vmin, vmax]`: logarithmic when they are
@@ -382,8 +385,8 @@ fn greyed(c: RGBColor) -> RGBColor {
 
 /// Draw a heat map SVG. The colour follows `f` on a linear scale, or
 /// `log10 f` when the values are non-negative and span more than two
-/// decades (the basins stay visible next to tall peaks; values more than
-/// four decades below the largest share the bottom colour); the colour
+/// decades (the basins stay visible next to tall peaks; values below
+/// `10^(⌊log10 max⌋ − 3)` share the bottom colour); the colour
 /// bar says which. Infeasible cells are greyed and, when there are any,
 /// named in the legend.
 pub fn heat_map(path: &Path, map: &HeatMap) -> Result<()> {
@@ -509,6 +512,76 @@ mod tests {
         .unwrap();
         let svg = std::fs::read_to_string(&path).unwrap();
         assert!(svg.contains("5.00e-6"), "{svg}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn colour_scale_is_log_only_over_decades() {
+        // Himmelblau's range: log10 f, floor three decades below 10^2.
+        let s = ColourScale::new(0.0, 890.0);
+        assert!((s.log_floor.unwrap() - 0.1).abs() < 1e-17);
+        assert!(s.clipped && (s.lo + 1.0).abs() < 1e-15 && s.hi == 890f64.log10());
+        assert_eq!((s.position(0.0), s.position(890.0)), (0.0, 1.0));
+        assert!((s.position(10.0) - 2.0 / (1.0 + 890f64.log10())).abs() < 1e-14);
+        assert!(s
+            .label("f [-]")
+            .starts_with("log10 of f [-]; values below 1e-1"));
+        // Within two decades: linear in f, labelled with f itself.
+        let s = ColourScale::new(1.0, 50.0);
+        assert_eq!((s.log_floor, s.lo, s.hi), (None, 1.0, 50.0));
+        assert_eq!((s.position(25.5), s.label("f [-]")), (0.5, "f [-]".into()));
+        // Positive, above the floor: log10 f, nothing clipped.
+        let s = ColourScale::new(20.0, 1e4);
+        assert_eq!((s.lo, s.clipped), (20f64.log10(), false));
+        assert_eq!(s.label("f [-]"), "log10 of f [-]");
+        // Negative values: linear.
+        assert_eq!(ColourScale::new(-1.0, 1e6).log_floor, None);
+    }
+
+    #[test]
+    fn floor_and_infeasible_cells_are_named() {
+        let dir = std::env::temp_dir().join(format!("plyscape-floor-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let axes = Axes {
+            title: "gap",
+            x: "calls [-]",
+            y: "gap [-]",
+            scale: Scale::LogLog,
+        };
+        let curve = |ys: &[f64]| Curve {
+            label: "c".into(),
+            points: ys
+                .iter()
+                .enumerate()
+                .map(|(k, &y)| (k as f64 + 1.0, y))
+                .collect(),
+        };
+        let path = dir.join("floor.svg");
+        line_plot_floored(&path, &axes, &[curve(&[1.0, 1e-3, 1e-12, 1e-12])], 1e-12).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(svg.contains("≤ 1e-12 (floor)"), "{svg}");
+        line_plot_floored(&path, &axes, &[curve(&[1.0, 1e-3])], 1e-12).unwrap();
+        assert!(!std::fs::read_to_string(&path).unwrap().contains("(floor)"));
+        let (xs, ys) = ([0.0, 1.0], [0.0, 1.0]);
+        let map = |infeasible: &'static [bool]| HeatMap {
+            title: "t",
+            subtitle: "held at x3 = 0.5",
+            names: ("x1 [-]", "x2 [-]"),
+            value_label: "f [-]",
+            xs: &xs,
+            ys: &ys,
+            values: &[1.0, 2.0, 3.0, 4.0],
+            infeasible,
+            marks: Vec::new(),
+        };
+        let path = dir.join("map.svg");
+        heat_map(&path, &map(&[false, true, false, false])).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(svg.contains("grey: infeasible") && svg.contains("held at x3 = 0.5"));
+        heat_map(&path, &map(&[false; 4])).unwrap();
+        assert!(!std::fs::read_to_string(&path)
+            .unwrap()
+            .contains("infeasible"));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
