@@ -24,24 +24,38 @@ pub type Result<T> = std::result::Result<T, Error>;
 pub enum Error {
     /// Bad input. `file` may be empty when the value came through the API.
     Input {
+        /// The study file (empty when not known yet).
         file: String,
+        /// The dotted key of the value, e.g. `panels[0].plies[2].thickness`.
         key: String,
+        /// The offending value as written.
         value: String,
+        /// What was expected instead.
         expected: String,
     },
     /// A numerical failure with its place, time (if any) and the numbers.
     Numerical {
+        /// Module and object where it failed, e.g. `explore::map`.
         place: String,
+        /// Simulated time \[s\] when the failure happened during a simulation.
         time: Option<f64>,
+        /// What failed, with the numbers.
         detail: String,
     },
     /// A file could not be read or written.
     Io {
+        /// The file or folder.
         path: PathBuf,
+        /// The operating system's error.
         source: std::io::Error,
     },
     /// A CSV file could not be read or written, or is corrupt.
-    Csv { path: PathBuf, detail: String },
+    Csv {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, with the row or column where known.
+        detail: String,
+    },
 }
 
 impl Error {

@@ -104,6 +104,8 @@
 //! - The SAR geometry is a reconstruction (see `studies/` and the README):
 //!   results are comparable with the paper in shape, not digit by digit.
 
+#![warn(missing_docs)]
+
 pub mod beams;
 pub mod cli;
 pub mod error;

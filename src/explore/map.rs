@@ -140,19 +140,17 @@ pub fn run(
                 )
             })
             .collect();
-        let title = if n == 2 {
-            format!("{}: f over ({na}, {nb}); grey = infeasible", problem.name())
-        } else {
-            format!(
-                "{}: f over ({na}, {nb}) through the best design",
-                problem.name()
-            )
-        };
+        let title = format!("{}: f over ({na}, {nb})", problem.name());
+        let (la, lb) = (
+            problem.variable_label(pair.0),
+            problem.variable_label(pair.1),
+        );
         heat_map(
             &dir.join(format!("{stem}.svg")),
             &HeatMap {
                 title: &title,
-                names: (na, nb),
+                subtitle: &fixed_values(problem, pair, &req.base),
+                names: (&la, &lb),
                 value_label: &problem.objective_label(),
                 xs: &slice.xs,
                 ys: &slice.ys,
@@ -164,6 +162,25 @@ pub fn run(
         out.push(slice);
     }
     Ok(out)
+}
+
+/// The variables a slice holds fixed and their values, for its plot
+/// (empty with two variables): `held at x3 = 1, x4 = -0.5`.
+pub fn fixed_values(problem: &dyn Problem, pair: (usize, usize), base: &[f64]) -> String {
+    let held: Vec<String> = (problem.variables().iter().zip(base).enumerate())
+        .filter(|&(k, _)| k != pair.0 && k != pair.1)
+        .map(|(_, (v, x))| format!("{} = {}", v.name, round6(*x)))
+        .collect();
+    if held.is_empty() {
+        String::new()
+    } else {
+        format!("held at {}", held.join(", "))
+    }
+}
+
+/// `x` rounded to six significant digits (for titles; files keep `x`).
+fn round6(x: f64) -> f64 {
+    format!("{x:.5e}").parse().unwrap_or(x)
 }
 
 #[cfg(test)]

@@ -836,7 +836,8 @@ fn convergence_plot(
         });
     }
     // Log–log: the gap of each best-so-far to the lowest f any method
-    // found, with a floor so that the final point of the winner shows.
+    // found, raised to a floor (marked in the plot) so that a gap of zero,
+    // the winner's final point, shows.
     let lowest = curves
         .iter()
         .flat_map(|c| c.points.iter().map(|p| p.1))
@@ -844,14 +845,14 @@ fn convergence_plot(
     let floor = 1e-12 * lowest.abs().max(1.0);
     for c in &mut curves {
         for p in &mut c.points {
-            p.1 = p.1 - lowest + floor;
+            p.1 = (p.1 - lowest).max(floor);
         }
     }
     let y = format!(
-        "best f − lowest f found ({lowest:.6e}) + {floor:.0e}, {}",
+        "best f − lowest f found ({lowest:.6e}), {}",
         problem.objective_label()
     );
-    crate::report::line_plot(
+    crate::report::line_plot_floored(
         &dir.join("convergence.svg"),
         &crate::report::Axes {
             title: &format!(
@@ -863,6 +864,7 @@ fn convergence_plot(
             scale: crate::report::Scale::LogLog,
         },
         &curves,
+        floor,
     )
 }
 
@@ -912,7 +914,16 @@ pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
         marks,
     };
     let slices = map::run(problem.as_ref(), &req, ctx.threads, &dir)?;
-    ctx.manifest(&dir, "map", json!({"resolution": sec.resolution}))?;
+    let mut entry = json!({"resolution": sec.resolution});
+    if n > 2 {
+        // The design the slices pass through (the other variables' values).
+        let base = vars
+            .iter()
+            .zip(&req.base)
+            .map(|(v, &x)| (v.name.clone(), json!(x)));
+        entry["slices_through"] = serde_json::Value::Object(base.collect());
+    }
+    ctx.manifest(&dir, "map", entry)?;
     if !ctx.quiet {
         println!(
             "map of {}: {} slice(s) of {}^2 points in {}",

@@ -161,6 +161,8 @@ pub struct SceneProblem {
     /// Constraint responses and bounds `c`.
     constraints: Vec<(String, f64)>,
     start: Vec<f64>,
+    /// The study's name, for reports.
+    study: String,
 }
 
 /// Raw response values (and their gradients per degree of each variable).
@@ -206,6 +208,7 @@ impl SceneProblem {
             objective: (spec.objective.response.clone(), 1.0),
             constraints: Vec::new(),
             start: spec.start.clone(),
+            study: study.name(),
         };
         problem.set_references(study, &spec)?;
         Ok(problem)
@@ -741,7 +744,16 @@ impl Problem for SceneProblem {
         Ok(self.evaluate_profiled(x, gradients)?.0)
     }
     fn name(&self) -> &str {
-        "scene"
+        &self.study
+    }
+    /// Ply angles in degrees: `theta1_deg` is `θ1 [deg]`.
+    fn variable_label(&self, i: usize) -> String {
+        let name = &self.vars[i].name;
+        let name = name.strip_suffix("_deg").unwrap_or(name);
+        match name.strip_prefix("theta") {
+            Some(rest) => format!("θ{rest} [deg]"),
+            None => format!("{name} [deg]"),
+        }
     }
     fn objective_label(&self) -> String {
         let (response, divisor) = &self.objective;

@@ -62,6 +62,7 @@ impl SensitivityForm {
 /// Integration settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Options {
+    /// The integration method.
     pub method: Method,
     /// Relative tolerance (0 < rtol < 1).
     pub rtol: f64,
@@ -129,6 +130,7 @@ impl Options {
 /// Integrator statistics.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Stats {
+    /// Accepted steps.
     pub steps: usize,
     /// Right-hand-side evaluations (f64), counted by the system.
     pub rhs_calls: u64,
@@ -136,8 +138,12 @@ pub struct Stats {
     pub jvp_calls: u64,
     /// Jacobian / LU set-ups.
     pub jacobians: usize,
+    /// Steps rejected by the local error test (retried smaller).
     pub error_test_failures: usize,
+    /// Nonlinear-solver (Newton) iterations, as diffsol counts them.
     pub nonlinear_iterations: usize,
+    /// Nonlinear-solver failures, as diffsol counts them (each retried
+    /// with a smaller step).
     pub nonlinear_failures: usize,
     /// Wall time of the integration without the observer (s).
     pub wall: f64,

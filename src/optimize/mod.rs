@@ -142,6 +142,11 @@ pub trait Problem: Sync {
     fn objective_label(&self) -> String {
         "f [-]".into()
     }
+    /// Variable `i` with its unit, for plot axes (default: its name, a
+    /// dimensionless test variable).
+    fn variable_label(&self, i: usize) -> String {
+        format!("{} [-]", self.variables()[i].name)
+    }
 }
 
 /// Counts every evaluation of the wrapped problem. A call with gradients
@@ -188,6 +193,12 @@ impl Problem for Counted<'_> {
     }
     fn name(&self) -> &str {
         self.inner.name()
+    }
+    fn objective_label(&self) -> String {
+        self.inner.objective_label()
+    }
+    fn variable_label(&self, i: usize) -> String {
+        self.inner.variable_label(i)
     }
 }
 

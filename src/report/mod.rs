@@ -10,7 +10,7 @@ pub mod csv;
 pub mod lock;
 pub mod plot;
 
-pub use plot::{heat_map, line_plot, Axes, Curve, HeatMap, Scale};
+pub use plot::{heat_map, line_plot, line_plot_floored, Axes, Curve, HeatMap, Scale};
 
 use crate::error::{Error, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};

@@ -4,6 +4,7 @@
 //! with tick labels in the data's own values.
 
 use crate::error::{Error, Result};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -99,6 +100,19 @@ fn drawn_points(curves: &[Curve], scale: Scale) -> Vec<Vec<(f64, f64)>> {
 
 /// Draw curves into an SVG (legend; linear or logarithmic axes).
 pub fn line_plot(path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()> {
+    draw_lines(path, axes, curves, None)
+}
+
+/// [`line_plot`] of curves whose values were raised to a positive `floor`
+/// (a gap that reached zero, shown on a log axis): where a curve reaches
+/// the floor, a hollow downward triangle in its colour, and the legend
+/// says `≤ <floor> (floor)`, so a floor is not read as convergence to it.
+pub fn line_plot_floored(path: &Path, axes: &Axes, curves: &[Curve], floor: f64) -> Result<()> {
+    draw_lines(path, axes, curves, Some(floor))
+}
+
+/// [`line_plot`], with the points at `floor` marked when given.
+fn draw_lines(path: &Path, axes: &Axes, curves: &[Curve], floor: Option<f64>) -> Result<()> {
     let drawn = drawn_points(curves, axes.scale);
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
@@ -159,6 +173,9 @@ pub fn line_plot(path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()> {
                 PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
             });
     }
+    if let Some(floor) = floor {
+        mark_floor(path, &mut chart, curves, axes.scale, floor)?;
+    }
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
@@ -168,11 +185,58 @@ pub fn line_plot(path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()> {
     root.present().map_err(|e| plot_err(path, e))
 }
 
+/// Hollow triangles on the points where a curve comes down to `floor`
+/// (the first of each run of points at or below it), and one legend entry
+/// for them (none when no point is there).
+fn mark_floor<DB: DrawingBackend>(
+    path: &Path,
+    chart: &mut ChartContext<DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    curves: &[Curve],
+    scale: Scale,
+    floor: f64,
+) -> Result<()> {
+    let at_floor: Vec<Curve> = curves
+        .iter()
+        .map(|c| Curve {
+            label: String::new(),
+            points: (c.points.iter().enumerate())
+                .filter(|&(k, p)| p.1 <= floor && (k == 0 || c.points[k - 1].1 > floor))
+                .map(|(_, &p)| p)
+                .collect(),
+        })
+        .collect();
+    if at_floor.iter().all(|c| c.points.is_empty()) {
+        return Ok(());
+    }
+    for (i, pts) in drawn_points(&at_floor, scale).into_iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        chart
+            .draw_series(pts.into_iter().map(|p| {
+                EmptyElement::at(p) + PathElement::new(down_triangle(0, 0), color.stroke_width(2))
+            }))
+            .map_err(|e| plot_err(path, e))?;
+    }
+    chart
+        .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+        .map_err(|e| plot_err(path, e))?
+        .label(format!("≤ {floor:.0e} (floor)"))
+        .legend(|(x, y)| PathElement::new(down_triangle(x + 10, y), BLACK.stroke_width(2)));
+    Ok(())
+}
+
+/// Outline of a downward triangle (`≤`) around the pixel `(x, y)`.
+fn down_triangle(x: i32, y: i32) -> Vec<(i32, i32)> {
+    vec![(x - 7, y - 5), (x + 7, y - 5), (x, y + 7), (x - 7, y - 5)]
+}
+
 /// A heat map: a regular grid of values, cells that violate constraints,
 /// and marked points.
 pub struct HeatMap<'a> {
     /// Title.
     pub title: &'a str,
+    /// Second line under the title (empty: none), e.g. the values of the
+    /// variables a slice holds fixed.
+    pub subtitle: &'a str,
     /// Axis names (with units).
     pub names: (&'a str, &'a str),
     /// What the colours show (with its unit), written on the colour scale.
@@ -189,36 +253,108 @@ pub struct HeatMap<'a> {
     pub marks: Vec<(String, Vec<(f64, f64)>)>,
 }
 
-/// The colour scale of a heat map in `area`: the ramp from `t = 0` (bottom)
-/// to `t = 1` (top), labelled with the values `value_at(t)` and `label`.
+/// How a heat map's values become colours: the colour coordinate `c(v)`
+/// runs linearly along the colour bar from `lo` (bottom) to `hi` (top).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ColourScale {
+    /// `c = log10(max(v, floor))` when `Some(floor)`, else `c = v`.
+    log_floor: Option<f64>,
+    /// Bottom of the bar, `c` of the smallest value.
+    lo: f64,
+    /// Top of the bar, `c` of the largest value.
+    hi: f64,
+    /// Are some values below the log floor (drawn in the bottom colour)?
+    clipped: bool,
+}
+
+/// Decades of a logarithmic colour scale below its largest value.
+const LOG_DECADES: f64 = 3.0;
+
+impl ColourScale {
+    /// The scale for values in `[vmin, vmax]`: logarithmic when they are
+    /// non-negative and span more than two decades (tall peaks beside the
+    /// basins), with a floor at the power of ten [`LOG_DECADES`] decades
+    /// below the largest; linear otherwise.
+    fn new(vmin: f64, vmax: f64) -> ColourScale {
+        if vmin >= 0.0 && vmax > 100.0 * vmin {
+            let floor = 10f64.powf(vmax.log10().floor() - LOG_DECADES).max(vmin);
+            return ColourScale {
+                log_floor: Some(floor),
+                lo: floor.log10(),
+                hi: vmax.log10(),
+                clipped: vmin < floor,
+            };
+        }
+        let (lo, hi) = if vmax > vmin {
+            (vmin, vmax)
+        } else {
+            (vmin - 0.5, vmin + 0.5)
+        };
+        ColourScale {
+            log_floor: None,
+            lo,
+            hi,
+            clipped: false,
+        }
+    }
+
+    /// The colour coordinate of `v`.
+    fn coord(&self, v: f64) -> f64 {
+        match self.log_floor {
+            Some(floor) => v.max(floor).log10(),
+            None => v,
+        }
+    }
+
+    /// Position of `v` on the ramp, in `[0, 1]`.
+    fn position(&self, v: f64) -> f64 {
+        (self.coord(v) - self.lo) / (self.hi - self.lo)
+    }
+
+    /// The colour bar's label: what `c` is, from the values' label.
+    fn label(&self, value_label: &str) -> String {
+        match self.log_floor {
+            Some(floor) if self.clipped => {
+                format!("log10 of {value_label}; values below {floor:.0e} in the bottom colour")
+            }
+            Some(_) => format!("log10 of {value_label}"),
+            None => value_label.to_string(),
+        }
+    }
+}
+
+/// The colour scale of a heat map in `area`: the ramp from `scale.lo`
+/// (bottom) to `scale.hi` (top) on a linear axis of the colour coordinate,
+/// evenly spaced round ticks, and `label`.
 fn colour_bar<DB: DrawingBackend>(
     path: &Path,
     area: &DrawingArea<DB, plotters::coord::Shift>,
     label: &str,
-    value_at: &dyn Fn(f64) -> f64,
+    scale: &ColourScale,
 ) -> Result<()> {
     let mut bar = ChartBuilder::on(area)
-        .margin_top(40)
+        .margin_top(10)
         .margin_bottom(50)
         .margin_right(5)
         .y_label_area_size(95)
-        .build_cartesian_2d(0.0..1.0, 0.0..1.0)
+        .build_cartesian_2d(0.0..1.0, scale.lo..scale.hi)
         .map_err(|e| plot_err(path, e))?;
-    let fmt = |t: &f64| format!("{:.3e}", value_at(*t));
-    bar.configure_mesh()
-        .disable_mesh()
+    let mut mesh = bar.configure_mesh();
+    mesh.disable_mesh()
         .disable_x_axis()
         .y_desc(label)
         .y_label_style(("sans-serif", 12))
         .axis_desc_style(("sans-serif", 14))
-        .y_label_formatter(&fmt)
-        .y_labels(8)
-        .draw()
-        .map_err(|e| plot_err(path, e))?;
+        .y_labels(8);
+    if scale.log_floor.is_none() && needs_sci(scale.lo, scale.hi) {
+        mesh.y_label_formatter(&sci_tick);
+    }
+    mesh.draw().map_err(|e| plot_err(path, e))?;
     const STEPS: usize = 200;
+    let at = |k: usize| scale.lo + (scale.hi - scale.lo) * k as f64 / STEPS as f64;
     bar.draw_series((0..STEPS).map(|k| {
-        let (a, b) = (k as f64 / STEPS as f64, (k + 1) as f64 / STEPS as f64);
-        Rectangle::new([(0.0, a), (1.0, b)], ramp(0.5 * (a + b)).filled())
+        let t = (k as f64 + 0.5) / STEPS as f64;
+        Rectangle::new([(0.0, at(k)), (1.0, at(k + 1))], ramp(t).filled())
     }))
     .map_err(|e| plot_err(path, e))?;
     Ok(())
@@ -241,8 +377,18 @@ fn ramp(t: f64) -> RGBColor {
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
-/// Draw a heat map SVG. Colours follow `log(1 + (v - min) / s)` with
-/// `s = (max - min) / 1000`, so the basins stay visible next to tall peaks.
+/// `c` greyed: two thirds of the way to light grey (infeasible cells).
+fn greyed(c: RGBColor) -> RGBColor {
+    let grey = |u: u8| ((u as f64 + 2.0 * 200.0) / 3.0) as u8;
+    RGBColor(grey(c.0), grey(c.1), grey(c.2))
+}
+
+/// Draw a heat map SVG. The colour follows `f` on a linear scale, or
+/// `log10 f` when the values are non-negative and span more than two
+/// decades (the basins stay visible next to tall peaks; values below
+/// `10^(⌊log10 max⌋ − 3)` share the bottom colour); the colour
+/// bar says which. Infeasible cells are greyed and, when there are any,
+/// named in the legend.
 pub fn heat_map(path: &Path, map: &HeatMap) -> Result<()> {
     let (nx, ny) = (map.xs.len(), map.ys.len());
     if nx < 2 || ny < 2 || map.values.len() != nx * ny {
@@ -250,8 +396,7 @@ pub fn heat_map(path: &Path, map: &HeatMap) -> Result<()> {
     }
     let vmin = map.values.iter().copied().fold(f64::INFINITY, f64::min);
     let vmax = map.values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let s = ((vmax - vmin) / 1000.0).max(1e-300);
-    let top = (1.0 + (vmax - vmin) / s).ln().max(1e-300);
+    let scale = ColourScale::new(vmin, vmax);
     let half = |c: &[f64], i: usize| {
         let lo = if i == 0 {
             c[0]
@@ -267,11 +412,17 @@ pub fn heat_map(path: &Path, map: &HeatMap) -> Result<()> {
     };
     let root = SVGBackend::new(path, (900, 700)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+    let mut root = root
+        .titled(map.title, ("sans-serif", 20))
+        .map_err(|e| plot_err(path, e))?;
+    if !map.subtitle.is_empty() {
+        root = root
+            .titled(map.subtitle, ("sans-serif", 14))
+            .map_err(|e| plot_err(path, e))?;
+    }
     let (root, bar) = root.split_horizontally(760);
-    let value_at = |t: f64| vmin + s * ((t * top).exp() - 1.0);
-    colour_bar(path, &bar, map.value_label, &value_at)?;
+    colour_bar(path, &bar, &scale.label(map.value_label), &scale)?;
     let mut chart = ChartBuilder::on(&root)
-        .caption(map.title, ("sans-serif", 20))
         .margin(10)
         .x_label_area_size(40)
         .y_label_area_size(60)
@@ -285,13 +436,13 @@ pub fn heat_map(path: &Path, map: &HeatMap) -> Result<()> {
         .draw()
         .map_err(|e| plot_err(path, e))?;
     let mut cells = Vec::with_capacity(nx * ny);
+    let mut any_infeasible = false;
     for i in 0..nx {
         for j in 0..ny {
-            let v = map.values[i * ny + j];
-            let mut c = ramp((1.0 + (v - vmin) / s).ln() / top);
+            let mut c = ramp(scale.position(map.values[i * ny + j]));
             if map.infeasible.get(i * ny + j).copied().unwrap_or(false) {
-                let grey = |u: u8| ((u as f64 + 2.0 * 200.0) / 3.0) as u8;
-                c = RGBColor(grey(c.0), grey(c.1), grey(c.2));
+                c = greyed(c);
+                any_infeasible = true;
             }
             let ((x0, x1), (y0, y1)) = (half(map.xs, i), half(map.ys, j));
             cells.push(Rectangle::new([(x0, y0), (x1, y1)], c.filled()));
@@ -307,7 +458,18 @@ pub fn heat_map(path: &Path, map: &HeatMap) -> Result<()> {
             .label(label.clone())
             .legend(move |(x, y)| Cross::new((x + 8, y), 5, color.stroke_width(3)));
     }
-    if !map.marks.is_empty() {
+    if any_infeasible {
+        // A legend entry only: no cell is drawn by this series.
+        let swatch = greyed(ramp(0.5));
+        chart
+            .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
+            .map_err(|e| plot_err(path, e))?
+            .label("grey: infeasible (some g > 0)")
+            .legend(move |(x, y)| {
+                Rectangle::new([(x + 2, y - 6), (x + 14, y + 6)], swatch.filled())
+            });
+    }
+    if !map.marks.is_empty() || any_infeasible {
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.8))
@@ -350,6 +512,76 @@ mod tests {
         .unwrap();
         let svg = std::fs::read_to_string(&path).unwrap();
         assert!(svg.contains("5.00e-6"), "{svg}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn colour_scale_is_log_only_over_decades() {
+        // Himmelblau's range: log10 f, floor three decades below 10^2.
+        let s = ColourScale::new(0.0, 890.0);
+        assert!((s.log_floor.unwrap() - 0.1).abs() < 1e-17);
+        assert!(s.clipped && (s.lo + 1.0).abs() < 1e-15 && s.hi == 890f64.log10());
+        assert_eq!((s.position(0.0), s.position(890.0)), (0.0, 1.0));
+        assert!((s.position(10.0) - 2.0 / (1.0 + 890f64.log10())).abs() < 1e-14);
+        assert!(s
+            .label("f [-]")
+            .starts_with("log10 of f [-]; values below 1e-1"));
+        // Within two decades: linear in f, labelled with f itself.
+        let s = ColourScale::new(1.0, 50.0);
+        assert_eq!((s.log_floor, s.lo, s.hi), (None, 1.0, 50.0));
+        assert_eq!((s.position(25.5), s.label("f [-]")), (0.5, "f [-]".into()));
+        // Positive, above the floor: log10 f, nothing clipped.
+        let s = ColourScale::new(20.0, 1e4);
+        assert_eq!((s.lo, s.clipped), (20f64.log10(), false));
+        assert_eq!(s.label("f [-]"), "log10 of f [-]");
+        // Negative values: linear.
+        assert_eq!(ColourScale::new(-1.0, 1e6).log_floor, None);
+    }
+
+    #[test]
+    fn floor_and_infeasible_cells_are_named() {
+        let dir = std::env::temp_dir().join(format!("plyscape-floor-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let axes = Axes {
+            title: "gap",
+            x: "calls [-]",
+            y: "gap [-]",
+            scale: Scale::LogLog,
+        };
+        let curve = |ys: &[f64]| Curve {
+            label: "c".into(),
+            points: ys
+                .iter()
+                .enumerate()
+                .map(|(k, &y)| (k as f64 + 1.0, y))
+                .collect(),
+        };
+        let path = dir.join("floor.svg");
+        line_plot_floored(&path, &axes, &[curve(&[1.0, 1e-3, 1e-12, 1e-12])], 1e-12).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(svg.contains("≤ 1e-12 (floor)"), "{svg}");
+        line_plot_floored(&path, &axes, &[curve(&[1.0, 1e-3])], 1e-12).unwrap();
+        assert!(!std::fs::read_to_string(&path).unwrap().contains("(floor)"));
+        let (xs, ys) = ([0.0, 1.0], [0.0, 1.0]);
+        let map = |infeasible: &'static [bool]| HeatMap {
+            title: "t",
+            subtitle: "held at x3 = 0.5",
+            names: ("x1 [-]", "x2 [-]"),
+            value_label: "f [-]",
+            xs: &xs,
+            ys: &ys,
+            values: &[1.0, 2.0, 3.0, 4.0],
+            infeasible,
+            marks: Vec::new(),
+        };
+        let path = dir.join("map.svg");
+        heat_map(&path, &map(&[false, true, false, false])).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(svg.contains("grey: infeasible") && svg.contains("held at x3 = 0.5"));
+        heat_map(&path, &map(&[false; 4])).unwrap();
+        assert!(!std::fs::read_to_string(&path)
+            .unwrap()
+            .contains("infeasible"));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
