@@ -12,7 +12,7 @@
 use plyscape::sections::support_compare::{compare, reference_of, run_compare, CompareSpec};
 use plyscape::study::Study;
 
-const STUDY: &str = include_str!("../studies/sar_phase1_centre_clamp.toml");
+const STUDY: &str = include_str!("../../../studies/sar_phase1_centre_clamp.toml");
 
 #[test]
 fn centre_clamp_scene_runs_like_free_free() {

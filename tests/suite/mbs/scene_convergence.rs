@@ -9,7 +9,7 @@ fn grid_over_mesh_and_modes_writes_errors_against_the_finest() {
     let dir = std::env::temp_dir().join(format!("plyscape_scene_conv_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // The main study's scene, shortened to 0.3 s.
-    let main = include_str!("../studies/main.toml");
+    let main = include_str!("../../../studies/main.toml");
     assert_eq!(
         main.matches("t_end = 3.0").count(),
         1,

@@ -1,9 +1,7 @@
 //! Kill the real `plyscape multistart` process mid-run, then `--resume`:
 //! the final tables equal those of an uninterrupted run.
 
-mod explore_common;
-
-use explore_common::{table_without, temp_dir};
+use crate::common::explore::{table_without, temp_dir};
 use std::process::Command;
 use std::time::{Duration, Instant};
 

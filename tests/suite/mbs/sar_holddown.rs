@@ -9,16 +9,14 @@
 //! gradient of panel 2's part of Ψ₀ matches central differences of whole
 //! simulations.
 
-mod sar_common;
-
 use nalgebra::DMatrix;
 use plyscape::mbs::{Force, System, Workspace};
 use plyscape::scene::{load_scene, Scene};
 use plyscape::simulate::{simulate, Simulation};
 use plyscape::study::Study;
-use sar_common::{coarse_sar, replace};
+use crate::common::sar::{coarse_sar, replace};
 
-const STUDY: &str = include_str!("../studies/sar_phase1_holddown.toml");
+const STUDY: &str = include_str!("../../../studies/sar_phase1_holddown.toml");
 
 /// The coarse scene: 16 divisions, 6 modes, 0–0.5 s at rtol 1e-10; panel
 /// 2's outer plies (1 and 4) at `theta_deg`; `sens` = with the one

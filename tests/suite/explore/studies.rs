@@ -1,8 +1,6 @@
 //! The shipped analytic studies run end to end through `plyscape run`.
 
-mod explore_common;
-
-use explore_common::{column, table_without, temp_dir};
+use crate::common::explore::{column, table_without, temp_dir};
 use plyscape::cli::{run_study, RunConfig};
 use plyscape::study::Study;
 

@@ -136,7 +136,7 @@ fn no_text_points_outside_the_repository() {
         "docs/numerics.md",
         "studies/main.toml",
         "src/lib.rs",
-        "tests/repo_self_contained.rs",
+        "tests/suite/repo_self_contained.rs",
     ] {
         assert!(
             all.iter().any(|p| relative(root, p) == must),

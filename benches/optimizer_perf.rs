@@ -1,6 +1,6 @@
 //! Optimizer overhead and CMA-ES parallel speed-up.
 //!
-//! Run: `cargo run --release --example optimizer_perf [out.csv]`
+//! Run: `cargo bench --bench optimizer_perf [-- out.csv]`
 //! (default `optimizer_perf.csv` in the current directory).
 //!
 //! 1. MMFD overhead per iteration for 2 and 10 variables: wall time of a
@@ -98,8 +98,10 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() -> Result<()> {
+    // `cargo bench` adds `--bench` to the arguments.
     let out = std::env::args()
-        .nth(1)
+        .skip(1)
+        .find(|a| a != "--bench")
         .unwrap_or_else(|| "optimizer_perf.csv".into());
     let mut rows: Vec<(String, usize, f64, String)> = Vec::new();
     let reps = 7;

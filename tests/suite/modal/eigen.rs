@@ -3,9 +3,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
-mod modal_common;
-
-use modal_common::*;
+use crate::common::modal::*;
 use plyscape::modal::{mode_shape_rows, DofLabel, ModalOptions, ModalSolver};
 use plyscape::Error;
 use std::f64::consts::PI;

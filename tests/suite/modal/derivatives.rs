@@ -4,11 +4,9 @@
 //! near-crossing, and the error paths.
 #![allow(clippy::needless_range_loop)]
 
-mod modal_common;
-
 use faer::sparse::SparseColMat;
 use faer::Mat;
-use modal_common::*;
+use crate::common::modal::*;
 use plyscape::modal::{
     DerivativeOptions, DesignDerivative, ModalOptions, ModalSolver, ModeUpdate, Modes,
 };

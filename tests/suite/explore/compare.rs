@@ -1,8 +1,6 @@
 //! Comparison (multistart + CMA-ES), evolution table and design-space map.
 
-mod explore_common;
-
-use explore_common::{column, ctx, study, table_without, temp_dir};
+use crate::common::explore::{column, ctx, study, table_without, temp_dir};
 use plyscape::explore::{self, DriveFlags};
 
 fn text(name: &str, problem: &str, extra: &str) -> String {

@@ -5,15 +5,13 @@
 //! gradients against central finite differences of its own `evaluate`,
 //! its 180° periodicity, and input errors that name the key.
 
-mod sar_common;
-
 use plyscape::explore;
 use plyscape::optimize::Problem;
 use plyscape::study::Study;
-use sar_common::{coarse_sar, replace};
+use crate::common::sar::{coarse_sar, replace};
 use std::time::Instant;
 
-const STUDY: &str = include_str!("../studies/sar_optimize.toml");
+const STUDY: &str = include_str!("../../../studies/sar_optimize.toml");
 
 /// The coarse study text.
 fn coarse() -> String {

@@ -7,15 +7,13 @@
 //! closes, θ(t) stays close to the rigid scene, and a ply-angle
 //! sensitivity of panel 3's strain energy matches central differences.
 
-mod sar_common;
-
 use plyscape::mbs::{Force, PiecewiseLaw};
 use plyscape::scene::load_scene;
 use plyscape::simulate::{simulate, Simulation};
 use plyscape::study::Study;
-use sar_common::{coarse_sar, replace};
+use crate::common::sar::{coarse_sar, replace};
 
-const STUDY: &str = include_str!("../studies/sar_phase1_flexible.toml");
+const STUDY: &str = include_str!("../../../studies/sar_phase1_flexible.toml");
 
 /// The coarse scene: 8 divisions, 6 modes, 0–0.5 s at rtol 1e-10; panel
 /// 3's outer plies (1 and 4) at `theta_deg`; `sens` = with the

@@ -1,9 +1,7 @@
 //! Multistart driver: known optima, reproducibility over threads, resume,
 //! shards, bad input.
 
-mod explore_common;
-
-use explore_common::{column, ctx, study, table_without, temp_dir};
+use crate::common::explore::{column, ctx, study, table_without, temp_dir};
 use plyscape::explore::multistart::Shard;
 use plyscape::explore::{self, DriveFlags};
 

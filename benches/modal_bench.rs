@@ -16,7 +16,7 @@
 //! `BENCH_BLOCK`, `BENCH_TOL`, `BENCH_BASIS`. Writes
 //! `results/modal_bench/modal_bench.csv`.
 //!
-//! Run: `cargo run --release --example modal_bench`
+//! Run: `cargo bench --bench modal_bench`
 
 use std::time::Instant;
 

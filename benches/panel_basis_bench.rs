@@ -6,7 +6,7 @@
 //! `PanelAnalysis::run` (no basis conversion). Wall time, one thread,
 //! fastest and median of `REPEATS` runs.
 //!
-//! Run: `cargo run --release --example panel_basis_bench`
+//! Run: `cargo bench --bench panel_basis_bench`
 
 use plyscape::fe::PanelSpec;
 use plyscape::modal::ModeUpdate;

@@ -8,14 +8,10 @@
 //! coarse version of studies/sar_optimize.toml (8 mesh divisions, 4 modes,
 //! 0–0.5 s).
 
-mod explore_common;
-
-mod sar_common;
-
-use explore_common::{column, ctx, study, table_without, temp_dir};
+use crate::common::explore::{column, ctx, study, table_without, temp_dir};
 use plyscape::explore::DriveFlags;
 use plyscape::study::Study;
-use sar_common::replace;
+use crate::common::sar::replace;
 use std::path::Path;
 
 const HS22: &str = "[study]\nname = \"rep_hs22\"\nseed = 7\n\
@@ -233,7 +229,7 @@ const QUANTITIES: &str = "quantities = [\"R3.angle\", \"B2.strain_energy\", \"B3
 /// form (the states do not depend on the gradient lanes, to the bit), no
 /// [compare] or [map], and these changes.
 fn sar_text(changes: &[(&str, &str)]) -> String {
-    let mut t = include_str!("../studies/sar_optimize.toml").to_string();
+    let mut t = include_str!("../../../studies/sar_optimize.toml").to_string();
     for (from, to, n) in [
         ("divisions = 32", "divisions = 8", 2),
         ("modes = 14", "modes = 4", 2),

@@ -1,6 +1,6 @@
 //! Where a scene's right-hand side spends its time, and how stiff it is.
 //!
-//! `cargo run --release --example scene_profile -- studies/sar_phase1_flexible.toml`
+//! `cargo bench --bench scene_profile -- studies/sar_phase1_flexible.toml`
 //!
 //! Prints, at the consistent initial state of the study's scene:
 //! - the natural frequencies of each flexible body's modal basis (Hz);
@@ -21,8 +21,10 @@ use plyscape::study::Study;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // `cargo bench` adds `--bench` to the arguments.
     let path = std::env::args()
-        .nth(1)
+        .skip(1)
+        .find(|a| a != "--bench")
         .ok_or("usage: scene_profile <study.toml>")?;
     let study = Study::load(std::path::Path::new(&path))?;
     let scene = load_scene(&study)?;

@@ -1,0 +1,4 @@
+//! Helpers and fixtures shared by the test modules.
+pub mod explore;
+pub mod modal;
+pub mod sar;
