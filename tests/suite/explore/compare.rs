@@ -1,6 +1,7 @@
 //! Comparison (multistart + CMA-ES), evolution table and design-space map.
 
-use crate::common::explore::{column, ctx, study, table_without, temp_dir};
+use crate::common::explore::{column, ctx, study, table_without};
+use crate::common::temp_dir;
 use plyscape::explore::{self, DriveFlags};
 
 fn text(name: &str, problem: &str, extra: &str) -> String {
@@ -12,7 +13,8 @@ fn text(name: &str, problem: &str, extra: &str) -> String {
 
 #[test]
 fn compare_tables_are_identical_on_one_and_two_threads() {
-    let dir = temp_dir("cmp-threads");
+    let tmp = temp_dir("cmp-threads");
+    let dir = tmp.path().to_path_buf();
     let s = study("c", &text("c", "himmelblau", ""));
     let (d1, d2) = (dir.join("t1"), dir.join("t2"));
     explore::run_compare(&ctx(&s, &d1, 1, DriveFlags::default())).unwrap();
@@ -24,12 +26,12 @@ fn compare_tables_are_identical_on_one_and_two_threads() {
             "{f}"
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn comparison_names_the_global_minimum() {
-    let dir = temp_dir("cmp-global");
+    let tmp = temp_dir("cmp-global");
+    let dir = tmp.path().to_path_buf();
     // Himmelblau: four global minima, f* = 0 (Himmelblau 1972, p. 428).
     let s = study("h", &text("h", "himmelblau", ""));
     let rows = explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
@@ -81,12 +83,12 @@ fn comparison_names_the_global_minimum() {
             "{r:?}"
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn evolution_table_and_map_match_direct_evaluation() {
-    let dir = temp_dir("cmp-map");
+    let tmp = temp_dir("cmp-map");
+    let dir = tmp.path().to_path_buf();
     // HS 22: constrained, so the map has infeasible cells.
     let s = study("m", &text("m", "hs22", ""));
     explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
@@ -119,12 +121,12 @@ fn evolution_table_and_map_match_direct_evaluation() {
     assert!(calls.windows(2).all(|w| w[0] < w[1]));
     let mean = column(&ev, "mean_f");
     assert!(mean.iter().all(|m| !m.is_empty()));
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn more_than_two_variables_get_slices_through_the_base_design() {
-    let dir = temp_dir("cmp-slices");
+    let tmp = temp_dir("cmp-slices");
+    let dir = tmp.path().to_path_buf();
     let s = study(
         "r",
         "[study]\nname = \"r\"\n[problem]\nname = \"rosenbrock\"\ndimension = 4\n\
@@ -158,12 +160,12 @@ fn more_than_two_variables_get_slices_through_the_base_design() {
     );
     let e = explore::run_map(&ctx(&bad, &dir, 1, DriveFlags::default())).unwrap_err();
     assert!(e.to_string().contains("map.pairs[0]"), "{e}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn bipop_is_chosen_in_the_study_and_reported() {
-    let dir = temp_dir("cmp-bipop");
+    let tmp = temp_dir("cmp-bipop");
+    let dir = tmp.path().to_path_buf();
     // `[evolve] restarts = "bipop"`: the comparison names the method, the
     // manifest records the schedule and every run's regime, λ, σ0 and
     // evaluations, which add up to the evolution's function calls. (A
@@ -227,7 +229,6 @@ fn bipop_is_chosen_in_the_study_and_reported() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("evolve.restarts"), "{e}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `[evolve] restarts = ["ipop", "bipop"]`: one comparison row per
@@ -235,7 +236,8 @@ fn bipop_is_chosen_in_the_study_and_reported() {
 /// (same seed, same numbers), both on the multistart's function calls.
 #[test]
 fn listed_schedules_each_equal_their_run_alone_on_one_budget() {
-    let dir = temp_dir("cmp-both");
+    let tmp = temp_dir("cmp-both");
+    let dir = tmp.path().to_path_buf();
     let without_wall = |p: &std::path::Path| table_without(p, &["wall_seconds"]);
     for problem in ["hs22", "himmelblau"] {
         let run = |name: &str, evolve: &str| {
@@ -323,14 +325,14 @@ fn listed_schedules_each_equal_their_run_alone_on_one_budget() {
             "{problem}"
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// No `[evolve]`, `restarts = "ipop"` and `restarts = ["ipop"]` are one
 /// and the same search: identical tables, no `method` column.
 #[test]
 fn the_default_schedule_is_ipop_however_written() {
-    let dir = temp_dir("cmp-default");
+    let tmp = temp_dir("cmp-default");
+    let dir = tmp.path().to_path_buf();
     let mut tables = Vec::new();
     for (name, evolve) in [
         ("none", ""),
@@ -348,14 +350,14 @@ fn the_default_schedule_is_ipop_however_written() {
     assert!(tables.iter().all(|t| *t == tables[0]));
     let header = String::from_utf8(tables[0].0.clone()).unwrap();
     assert!(header.starts_with("generation,function_calls,"), "{header}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// A bad schedule list names the file, the key, the value and what is
 /// expected, and is refused before any work.
 #[test]
 fn bad_schedule_lists_are_refused_before_any_work() {
-    let dir = temp_dir("cmp-bad-list");
+    let tmp = temp_dir("cmp-bad-list");
+    let dir = tmp.path().to_path_buf();
     for (value, key, shown, expected) in [
         ("[]", "evolve.restarts", "[]", "a non-empty list"),
         ("3", "evolve.restarts", "3", "one of ipop, bipop"),
@@ -395,7 +397,6 @@ fn bad_schedule_lists_are_refused_before_any_work() {
         assert!(e.starts_with(&want), "{value}: {e}");
         assert!(!dir.join("bad/runs.csv").exists(), "{value}: work was done");
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -405,7 +406,8 @@ fn tol_fun_is_read_from_the_study_and_ends_runs_earlier() {
     // objective, 4 global minima at f = 0) with 3000 evaluations, a range
     // of 1e-3 ends each run long before 1e-12 does, so more runs fit the
     // same budget; the value is recorded, and a bad one is refused.
-    let dir = temp_dir("cmp-tolfun");
+    let tmp = temp_dir("cmp-tolfun");
+    let dir = tmp.path().to_path_buf();
     let runs = |name: &str, extra: &str| {
         let s = study(
             name,
@@ -438,5 +440,4 @@ fn tol_fun_is_read_from_the_study_and_ends_runs_earlier() {
         e.contains("x.toml") && e.contains("evolve.tol_fun") && e.contains(">= 0"),
         "{e}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }

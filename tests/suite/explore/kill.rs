@@ -1,7 +1,8 @@
 //! Kill the real `plyscape multistart` process mid-run, then `--resume`:
 //! the final tables equal those of an uninterrupted run.
 
-use crate::common::explore::{table_without, temp_dir};
+use crate::common::explore::table_without;
+use crate::common::temp_dir;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -17,7 +18,8 @@ fn plyscape(args: &[&str]) -> Command {
 
 #[test]
 fn killed_multistart_resumes_to_the_same_tables() {
-    let dir = temp_dir("kill");
+    let tmp = temp_dir("kill");
+    let dir = tmp.path().to_path_buf();
     let study = dir.join("k.toml");
     std::fs::write(&study, STUDY).unwrap();
     let study = study.to_str().unwrap();
@@ -91,7 +93,6 @@ fn killed_multistart_resumes_to_the_same_tables() {
         "{commit}"
     );
     assert!(ms["started"].as_str().unwrap() <= ms["ended"].as_str().unwrap());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// A second command on a results directory that a running one holds is
@@ -99,7 +100,8 @@ fn killed_multistart_resumes_to_the_same_tables() {
 /// touched; another results root is free.
 #[test]
 fn a_held_results_directory_is_refused_with_its_holder() {
-    let dir = temp_dir("lock");
+    let tmp = temp_dir("lock");
+    let dir = tmp.path().to_path_buf();
     let study = dir.join("k.toml");
     std::fs::write(&study, STUDY).unwrap();
     let out = dir.join("out");
@@ -122,7 +124,6 @@ fn a_held_results_directory_is_refused_with_its_holder() {
     );
     assert!(!out.join("k/runs.csv").exists());
     drop(held);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// The Slurm scripts in `scripts/` (shown verbatim in the README) run as a
@@ -132,7 +133,8 @@ fn a_held_results_directory_is_refused_with_its_holder() {
 fn the_documented_slurm_array_runs_and_merges() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
-    let dir = temp_dir("slurm");
+    let tmp = temp_dir("slurm");
+    let dir = tmp.path().to_path_buf();
     let study = dir.join("k.toml");
     std::fs::write(&study, STUDY).unwrap();
     let bin = env!("CARGO_BIN_EXE_plyscape");
@@ -176,5 +178,4 @@ fn the_documented_slurm_array_runs_and_merges() {
         );
     }
     assert!(dir.join("results/k/comparison.csv").exists());
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,7 +1,8 @@
 //! Multistart driver: known optima, reproducibility over threads, resume,
 //! shards, bad input.
 
-use crate::common::explore::{column, ctx, study, table_without, temp_dir};
+use crate::common::explore::{column, ctx, study, table_without};
+use crate::common::temp_dir;
 use plyscape::explore::multistart::Shard;
 use plyscape::explore::{self, DriveFlags};
 
@@ -28,7 +29,8 @@ const MINIMA: [[f64; 2]; 4] = [
 
 #[test]
 fn himmelblau_finds_all_four_minima_with_their_basin_counts() {
-    let dir = temp_dir("ms-himmelblau");
+    let tmp = temp_dir("ms-himmelblau");
+    let dir = tmp.path().to_path_buf();
     let s = study("h", &himmelblau(40, ""));
     let r = explore::run_multistart(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
     assert_eq!(r.runs.len(), 40);
@@ -78,12 +80,12 @@ fn himmelblau_finds_all_four_minima_with_their_basin_counts() {
             .count();
         assert_eq!(n, o.count);
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn periodic_optima_merge_across_the_seam() {
-    let dir = temp_dir("ms-periodic");
+    let tmp = temp_dir("ms-periodic");
+    let dir = tmp.path().to_path_buf();
     let text = format!(
         "[study]\nname = \"p\"\nseed = 5\n[problem]\nname = \"periodic2\"\n\
          [multistart]\nmethod = \"{METHOD}\"\nsampler = \"sobol\"\nstarts = 64\n\
@@ -106,12 +108,12 @@ fn periodic_optima_merge_across_the_seam() {
     let x1 = r.runs[1].result.as_ref().unwrap().x[0];
     assert!((89.0..=90.0).contains(&x0.abs()) && (89.0..=90.0).contains(&x1.abs()));
     assert!((best.x[1] + 30.0).abs() < 1e-3);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn one_and_two_threads_give_identical_tables() {
-    let dir = temp_dir("ms-threads");
+    let tmp = temp_dir("ms-threads");
+    let dir = tmp.path().to_path_buf();
     let s = study("h", &himmelblau(24, ""));
     let (d1, d2) = (dir.join("t1"), dir.join("t2"));
     explore::run_multistart(&ctx(&s, &d1, 1, DriveFlags::default())).unwrap();
@@ -123,12 +125,12 @@ fn one_and_two_threads_give_identical_tables() {
             "{f}"
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn resume_after_a_kill_gives_the_uninterrupted_tables() {
-    let dir = temp_dir("ms-resume");
+    let tmp = temp_dir("ms-resume");
+    let dir = tmp.path().to_path_buf();
     let s = study("h", &himmelblau(20, ""));
     let full = dir.join("full");
     explore::run_multistart(&ctx(&s, &full, 2, DriveFlags::default())).unwrap();
@@ -181,12 +183,12 @@ fn resume_after_a_kill_gives_the_uninterrupted_tables() {
     let other = study("h", &himmelblau(20, "").replace("seed = 11", "seed = 12"));
     let e = explore::run_multistart(&ctx(&other, &part, 1, flags)).unwrap_err();
     assert!(e.to_string().contains("not a start of this study"), "{e}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn merged_shards_equal_the_unsharded_run() {
-    let dir = temp_dir("ms-shards");
+    let tmp = temp_dir("ms-shards");
+    let dir = tmp.path().to_path_buf();
     let s = study("h", &himmelblau(17, ""));
     let full = dir.join("full");
     explore::run_multistart(&ctx(&s, &full, 2, DriveFlags::default())).unwrap();
@@ -231,12 +233,12 @@ fn merged_shards_equal_the_unsharded_run() {
             "{f}"
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn wall_time_budget_stops_cleanly_and_resume_completes() {
-    let dir = temp_dir("ms-wall");
+    let tmp = temp_dir("ms-wall");
+    let dir = tmp.path().to_path_buf();
     let costly = |extra: &str| {
         format!(
             "[study]\nname = \"w\"\nseed = 8\n[problem]\nname = \"himmelblau\"\ncost_ms = 1.0\n\
@@ -271,11 +273,11 @@ fn wall_time_budget_stops_cleanly_and_resume_completes() {
             "{f}"
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 fn error_of(text: &str) -> String {
-    let dir = temp_dir("ms-bad");
+    let tmp = temp_dir("ms-bad");
+    let dir = tmp.path().to_path_buf();
     let s = match plyscape::study::Study::parse("bad.toml", text) {
         Ok(s) => s,
         Err(e) => return e.to_string(),
@@ -387,7 +389,8 @@ fn bad_study_input_gets_a_clear_error() {
 /// `--force` discards it.
 #[test]
 fn rerun_without_resume_keeps_the_earlier_table_unless_forced() {
-    let dir = temp_dir("ms-keep");
+    let tmp = temp_dir("ms-keep");
+    let dir = tmp.path().to_path_buf();
     let s = study("h", &himmelblau(5, ""));
     explore::run_multistart(&ctx(&s, &dir, 1, DriveFlags::default())).unwrap();
     let first = std::fs::read_to_string(dir.join("h/runs.csv")).unwrap();
@@ -415,14 +418,14 @@ fn rerun_without_resume_keeps_the_earlier_table_unless_forced() {
         })
         .count();
     assert_eq!(runs, 2, "--force kept nothing more");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `merge` never modifies a shard, refuses a shard that lacks rows (naming
 /// the starts) and refuses a directory that is not a shard.
 #[test]
 fn merge_is_strict_and_read_only() {
-    let dir = temp_dir("ms-merge-strict");
+    let tmp = temp_dir("ms-merge-strict");
+    let dir = tmp.path().to_path_buf();
     let s = study("h", &himmelblau(7, ""));
     let mut dirs = Vec::new();
     for i in 0..2 {
@@ -463,7 +466,6 @@ fn merge_is_strict_and_read_only() {
         .to_string();
     assert!(e.contains("unsharded"), "{e}");
     explore::merge(&dirs, &dir, true).unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `plyscape run` checks every section before any runs: a bad late section
@@ -471,7 +473,8 @@ fn merge_is_strict_and_read_only() {
 /// with its key and nothing is written.
 #[test]
 fn a_bad_late_section_is_refused_before_any_work() {
-    let dir = temp_dir("ms-late");
+    let tmp = temp_dir("ms-late");
+    let dir = tmp.path().to_path_buf();
     for (late, key) in [
         ("[map]\nresolution = 1\n", "map.resolution"),
         ("[evolve]\nrestarts = \"bopop\"\n", "evolve.restarts"),
@@ -489,5 +492,4 @@ fn a_bad_late_section_is_refused_before_any_work() {
         assert!(e.starts_with("late.toml") && e.contains(key), "{e}");
         assert!(!dir.join("late/runs.csv").exists(), "{late}: work was done");
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -8,10 +8,11 @@
 //! coarse version of studies/sar_optimize.toml (8 mesh divisions, 4 modes,
 //! 0–0.5 s).
 
-use crate::common::explore::{column, ctx, study, table_without, temp_dir};
+use crate::common::explore::{column, ctx, study, table_without};
+use crate::common::sar::replace;
+use crate::common::temp_dir;
 use plyscape::explore::DriveFlags;
 use plyscape::study::Study;
-use crate::common::sar::replace;
 use std::path::Path;
 
 const HS22: &str = "[study]\nname = \"rep_hs22\"\nseed = 7\n\
@@ -129,7 +130,8 @@ fn summary_is_the_run(
 
 #[test]
 fn hs22_history_and_summary_are_the_runs() {
-    let out = temp_dir("optrep-hs22");
+    let tmp = temp_dir("optrep-hs22");
+    let out = tmp.path().to_path_buf();
     let st = study("rep_hs22", HS22);
     plyscape::explore::run_multistart(&ctx(&st, &out, 2, DriveFlags::default())).unwrap();
     let dir = out.join("rep_hs22");
@@ -161,12 +163,12 @@ fn hs22_history_and_summary_are_the_runs() {
     }
     let manifest = plyscape::report::read_manifest(&dir).unwrap();
     assert_eq!(manifest["commands"]["optimum_report"]["start"], 0);
-    std::fs::remove_dir_all(&out).unwrap();
 }
 
 #[test]
 fn steepest_descent_history_is_the_run_too() {
-    let out = temp_dir("optrep-steepest");
+    let tmp = temp_dir("optrep-steepest");
+    let out = tmp.path().to_path_buf();
     let text = "[study]\nname = \"rep_himmelblau\"\nseed = 3\n[problem]\nname = \"himmelblau\"\n\
                 [multistart]\nmethod = \"steepest\"\nstarts = 3\npoints = [[0.0, 0.0]]\n[optimum_report]\n";
     let st = study("rep_himmelblau", text);
@@ -180,7 +182,6 @@ fn steepest_descent_history_is_the_run_too() {
     assert_eq!(cell(&s, 1, "active"), "");
     // No constraints, no constraint plot.
     assert!(!dir.join("iterations_constraints.svg").exists());
-    std::fs::remove_dir_all(&out).unwrap();
 }
 
 #[test]
@@ -253,7 +254,8 @@ fn sar_text(changes: &[(&str, &str)]) -> String {
 
 #[test]
 fn sar_start_curve_is_a_plain_simulation_at_the_start() {
-    let out = temp_dir("optrep-sar");
+    let tmp = temp_dir("optrep-sar");
+    let out = tmp.path().to_path_buf();
     let text = sar_text(&[(
         QUANTITIES,
         "quantities = [\"R3.angle\", \"B3.strain_energy\"]",
@@ -317,12 +319,12 @@ fn sar_start_curve_is_a_plain_simulation_at_the_start() {
     ] {
         assert!(dir.join(f).exists(), "{f}");
     }
-    std::fs::remove_dir_all(&out).unwrap();
 }
 
 #[test]
 fn unknown_scene_output_is_refused_before_the_multistart() {
-    let out = temp_dir("optrep-sar-bad");
+    let tmp = temp_dir("optrep-sar-bad");
+    let out = tmp.path().to_path_buf();
     let text = sar_text(&[(QUANTITIES, "quantities = [\"R9.angle\"]")]);
     let st = study("sar_optimize", &text);
     let e = plyscape::explore::run_multistart(&ctx(&st, &out, 2, DriveFlags::default()))
@@ -333,5 +335,4 @@ fn unknown_scene_output_is_refused_before_the_multistart() {
         "{e}"
     );
     assert!(!out.join("sar_optimize/runs.csv").exists());
-    std::fs::remove_dir_all(&out).unwrap();
 }

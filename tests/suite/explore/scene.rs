@@ -5,10 +5,11 @@
 //! gradients against central finite differences of its own `evaluate`,
 //! its 180° periodicity, and input errors that name the key.
 
+use crate::common::sar::{coarse_sar, replace};
+use crate::common::temp_dir;
 use plyscape::explore;
 use plyscape::optimize::Problem;
 use plyscape::study::Study;
-use crate::common::sar::{coarse_sar, replace};
 use std::time::Instant;
 
 const STUDY: &str = include_str!("../../../studies/sar_optimize.toml");
@@ -282,8 +283,8 @@ fn evaluations_compute_only_what_they_are_asked() {
     // lanes and no Jacobian-vector products (tsit45 is explicit); f+g: one
     // tied lane per shared ply angle (two) and both bases with
     // derivatives. The section's CSV carries the same counts.
-    let dir = std::env::temp_dir().join(format!("plyscape-eval-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = temp_dir("eval-bench");
+    let dir = tmp.path().to_path_buf();
     std::fs::write(dir.join("coarse.toml"), coarse()).unwrap();
     let bench = "[eval_bench]\nproblems = [\"coarse.toml\"]\nrepeats = 1\n";
     let path = dir.join("bench.toml");
@@ -345,7 +346,6 @@ fn evaluations_compute_only_what_they_are_asked() {
     assert!(col(f, "jvp_calls").parse::<u64>().unwrap() > 0);
     assert_eq!(col(fg, "lanes"), "2");
     assert_eq!(col(f, "steps"), col(fg, "steps"));
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -430,8 +430,8 @@ fn fused_sensitivities_give_the_staggered_gradient() {
 /// the updated one's), and both tables are written with every row.
 #[test]
 fn gradient_check_section_compares_fixed_and_updated_modes() {
-    let dir = std::env::temp_dir().join(format!("plyscape-gradcheck-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = temp_dir("gradcheck");
+    let dir = tmp.path().to_path_buf();
     std::fs::write(dir.join("coarse.toml"), coarse()).unwrap();
     let text = "[study]\nname = \"gc\"\n[gradient_check]\nproblems = [\"coarse.toml\"]\n\
                 step_deg = 1e-3\nrepeats = 1\n";
@@ -458,5 +458,4 @@ fn gradient_check_section_compares_fixed_and_updated_modes() {
         "updated-mode gradient vs central: {updated}"
     );
     assert!(fixed > 10.0 * updated, "fixed {fixed} vs updated {updated}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,6 +1,7 @@
 //! The shipped analytic studies run end to end through `plyscape run`.
 
-use crate::common::explore::{column, table_without, temp_dir};
+use crate::common::explore::{column, table_without};
+use crate::common::temp_dir;
 use plyscape::cli::{run_study, RunConfig};
 use plyscape::study::Study;
 
@@ -19,7 +20,8 @@ fn run(file: &str, out: &std::path::Path) -> Study {
 
 #[test]
 fn analytic_studies_run_and_find_their_known_optima() {
-    let dir = temp_dir("studies");
+    let tmp = temp_dir("studies");
+    let dir = tmp.path().to_path_buf();
     // Known optima: Himmelblau f* = 0 (Himmelblau 1972); HS 22 f* = 1 at
     // (1, 1) (Hock & Schittkowski 1981); Periodic2 f* = -5 (closed form in
     // explore::problems::Periodic2).
@@ -78,7 +80,6 @@ fn analytic_studies_run_and_find_their_known_optima() {
         let plan = plyscape::explore::multistart_plan(&s, p.as_ref()).unwrap();
         assert_eq!(plan.starts.points.len(), 64);
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Every study in `studies/` passes the whole-study check `plyscape run`

@@ -5,14 +5,12 @@
 //! Reference: the same scene at rtol 1e-13 (self-convergence; the
 //! Andrews test checks an independent published reference).
 
+use crate::common::scenes::shipped_scene;
 use plyscape::integrate::Method;
-use plyscape::scene::load_scene;
 use plyscape::simulate::simulate;
-use plyscape::study::Study;
 
 fn run(file: &str, method: Method, rtol: f64) -> (Vec<f64>, usize) {
-    let path = format!("{}/studies/{file}", env!("CARGO_MANIFEST_DIR"));
-    let mut scene = load_scene(&Study::load(path).unwrap()).unwrap();
+    let mut scene = shipped_scene(file);
     scene.options.method = method;
     scene.options.rtol = rtol;
     scene.options.atol = rtol * 1e-2;

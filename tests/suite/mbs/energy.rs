@@ -5,26 +5,11 @@
 //! start, T + U constant), with the sensitivities of the responses against
 //! closed forms and central differences, and the exact state derivative
 //! of a flexible body's kinetic energy.
+use crate::common::scenes::{column, run, scene_spec};
 use num_dual::Dual64;
 use plyscape::mbs::responses::{ResponseKind, ResponseValue};
 use plyscape::mbs::{Energy, Workspace};
-use plyscape::scene::SceneSpec;
 use plyscape::simulate::{simulate, Simulation};
-
-fn run(text: &str) -> Simulation {
-    let table: toml::Table = toml::from_str(text).unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
-    simulate(&spec.build().unwrap()).unwrap().1
-}
-
-fn column(sim: &Simulation, name: &str) -> Vec<f64> {
-    let c = sim
-        .headers
-        .iter()
-        .position(|h| h.starts_with(name))
-        .unwrap_or_else(|| panic!("no column {name} in {:?}", sim.headers));
-    sim.rows.iter().map(|r| r[c]).collect()
-}
 
 fn response<'a>(sim: &'a Simulation, name: &str) -> &'a ResponseValue {
     sim.responses.iter().find(|r| r.name == name).unwrap()
@@ -233,8 +218,7 @@ fn flexible_kinetic_energy_has_exact_state_derivatives() {
     // ∂T/∂y · v from one dual evaluation against central differences at a
     // deformed, tumbling state of the beam (T depends on the modal
     // coordinates through the mass matrix).
-    let table: toml::Table = toml::from_str(&free_beam(1.5)).unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
+    let spec = scene_spec(&free_beam(1.5));
     let (sys, sim) = simulate(&spec.build().unwrap()).unwrap();
     let y = sim.y_end.clone();
     let v: Vec<f64> = (0..y.len())

@@ -1,6 +1,7 @@
 //! Segment changes of a piecewise actuator law (paper Eq. 32) as
 //! integration events: a 1-DOF rotor with a closed-form motion, and the
 //! sensitivity jump at the event against central finite differences.
+use crate::common::scenes::scene_spec;
 use plyscape::integrate::{integrate, integrate_sens, Method, Options, SensitivityForm, Stats};
 use plyscape::mbs::{Model, Param, System, Workspace};
 use plyscape::scene::SceneSpec;
@@ -52,8 +53,7 @@ dt_out = 0.1
 {extra}
 "#
     );
-    let table: toml::Table = toml::from_str(&scene).unwrap();
-    table["scene"].clone().try_into().unwrap()
+    scene_spec(&scene)
 }
 
 #[test]

@@ -4,6 +4,7 @@
 //! sensitivities through a panel's modal basis against central finite
 //! differences, the effects switches, and input errors.
 
+use crate::common::scenes::{shipped_study, shipped_text};
 use num_dual::Dual64;
 use plyscape::mbs::beam::{Beam, Plane};
 use plyscape::mbs::{System, Workspace};
@@ -171,11 +172,7 @@ fn rigid_tip_mass_on_a_spherical_joint_at_a_flexible_node_stays_attached() {
 }
 
 fn spinup() -> Study {
-    Study::load(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/studies/beam_spinup.toml"
-    ))
-    .unwrap()
+    shipped_study("beam_spinup.toml")
 }
 
 #[test]
@@ -380,12 +377,7 @@ fn effects_switch_flexibility_quadratic_terms_and_modal_damping() {
     // The same spin-up with effects removed: nothing of what is not listed
     // is built or evaluated (counters), and without `flexibility` the beam
     // is the rigid stand-in given by mass/com/inertia.
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/studies/beam_spinup.toml"
-    ))
-    .unwrap()
-    .replace("t_end = 4.0", "t_end = 0.5");
+    let text = shipped_text("beam_spinup.toml").replace("t_end = 4.0", "t_end = 0.5");
     let run = |effects: &str| {
         let t = text.replace(
             r#"effects = ["flexibility", "quadratic_velocity", "loads", "damping"]"#,

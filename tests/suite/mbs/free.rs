@@ -1,18 +1,16 @@
 //! Free rigid body spinning about its intermediate axis (Dzhanibekov
 //! effect): energy and angular momentum are invariants of the exact flow
 //! (Euler's equations), so their drift measures the integrator error.
+use crate::common::scenes::{run as simulate_text, shipped_scene};
 use plyscape::integrate::{integrate, Method, Options, SensitivityForm};
 use plyscape::mbs::{System, Workspace};
-use plyscape::scene::load_scene;
-use plyscape::study::Study;
 
 /// The body of studies/dzhanibekov.toml: 1.5 kg, principal inertia
 /// diag(1, 2, 3) kg m², spin 5 rad/s about the intermediate axis y with a
 /// 0.01 rad/s perturbation about x, centre of mass drifting at
 /// (0.1, 0, −0.2) m/s.
 fn tumbling_body() -> System {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/studies/dzhanibekov.toml");
-    let scene = load_scene(&Study::load(path).unwrap()).unwrap();
+    let scene = shipped_scene("dzhanibekov.toml");
     System::new(scene.model)
 }
 
@@ -154,14 +152,6 @@ quantities = ["box.position"]
             r[1]
         );
     }
-}
-
-/// Build the `[scene]` of a study text and simulate it.
-fn simulate_text(text: &str) -> plyscape::simulate::Simulation {
-    let table: toml::Table = toml::from_str(text).unwrap();
-    let spec: plyscape::scene::SceneSpec = table["scene"].clone().try_into().unwrap();
-    let scene = spec.build().unwrap();
-    plyscape::simulate::simulate(&scene).unwrap().1
 }
 
 #[test]

@@ -252,8 +252,8 @@ fn effects_not_listed_are_not_built_or_evaluated() {
 
 #[test]
 fn simulate_command_writes_history_stats_and_svg() {
-    let dir = std::env::temp_dir().join(format!("plyscape_mbs_cli_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::common::temp_dir("mbs-cli");
+    let dir = tmp.path().to_path_buf();
     let study = dir.join("pendulum.toml");
     std::fs::write(
         &study,
@@ -339,5 +339,4 @@ fn simulate_command_writes_history_stats_and_svg() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("scene.bodies[0].mass"));
-    std::fs::remove_dir_all(&dir).ok();
 }

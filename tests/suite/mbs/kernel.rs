@@ -1,20 +1,13 @@
 //! Kernel identities: exact Jacobian-vector products (dual numbers) against
 //! central finite differences, projection of perturbed initial positions,
 //! driven joints and their reactions against closed forms.
+use crate::common::scenes::{scene, shipped_scene};
 use num_dual::Dual64;
 use plyscape::mbs::{System, Workspace};
-use plyscape::scene::load_scene;
-use plyscape::scene::SceneSpec;
 use plyscape::simulate::simulate;
-use plyscape::study::Study;
 
 fn sar_system() -> System {
-    let study = Study::load(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/studies/sar_phase1_rigid.toml"
-    ))
-    .unwrap();
-    System::new(load_scene(&study).unwrap().model)
+    System::new(shipped_scene("sar_phase1_rigid.toml").model)
 }
 
 /// A consistent state of `sys` with non-zero velocities (every velocity
@@ -160,9 +153,7 @@ dt_out = 0.25
 [scene.outputs]
 quantities = ["motor.angle", "motor.rate", "motor.reaction"]
 "#;
-    let table: toml::Table = toml::from_str(text).unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
-    let (_, sim) = simulate(&spec.build().unwrap()).unwrap();
+    let (_, sim) = simulate(&scene(text)).unwrap();
     assert_eq!(sim.redundant, 0);
     for r in &sim.rows {
         let t = r[0];

@@ -5,28 +5,8 @@
 //! closed forms; tip force and tip moment on a flexible cantilever against
 //! the static deflections `PL³/3EI` and `ML²/2EI`; sensitivities through a
 //! marker load against central differences.
+use crate::common::scenes::{column, run, scene};
 use plyscape::mbs::{Force, Load, LoadFrame, System, Workspace};
-use plyscape::scene::{Scene, SceneSpec};
-use plyscape::simulate::{simulate, Simulation};
-
-fn scene(text: &str) -> Scene {
-    let table: toml::Table = toml::from_str(text).unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
-    spec.build().unwrap()
-}
-
-fn run(text: &str) -> Simulation {
-    simulate(&scene(text)).unwrap().1
-}
-
-fn column(sim: &Simulation, name: &str) -> Vec<f64> {
-    let c = sim
-        .headers
-        .iter()
-        .position(|h| h.starts_with(name))
-        .unwrap_or_else(|| panic!("no column {name} in {:?}", sim.headers));
-    sim.rows.iter().map(|r| r[c]).collect()
-}
 
 /// A free 1.2 kg body spinning about an oblique axis (no gravity), loaded
 /// by `load` (a `[[scene.forces]]` body without its header).

@@ -6,23 +6,8 @@
 //! cosine along the axis). Each checks the constraint drift and, where
 //! the scene is conservative, the energy. Every closed form is derived in
 //! the test's comment from Newton's law along the joint axis.
-use plyscape::scene::SceneSpec;
-use plyscape::simulate::{simulate, Simulation};
-
-fn run(text: &str) -> Simulation {
-    let table: toml::Table = toml::from_str(text).unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
-    simulate(&spec.build().unwrap()).unwrap().1
-}
-
-/// Column `name` (header prefix) of `rows`.
-fn column(headers: &[String], rows: &[Vec<f64>], name: &str) -> Vec<f64> {
-    let c = headers
-        .iter()
-        .position(|h| h.starts_with(name))
-        .unwrap_or_else(|| panic!("no column {name} in {headers:?}"));
-    rows.iter().map(|r| r[c]).collect()
-}
+use crate::common::scenes::{run, scene_spec};
+use crate::common::tables::column;
 
 /// A 2 kg block on a prismatic joint to the ground along the unit axis
 /// (1, 2, 2)/3 through (0.3, −0.2, 0.1), with a joint spring k = 50 N/m
@@ -118,12 +103,10 @@ fn prismatic_without_its_spring_keeps_the_block_still_and_refuses_an_angle() {
     let s = column(&sim.headers, &sim.rows, "slide.displacement");
     assert!(s.iter().all(|v| v.abs() < 1e-14), "{s:?}");
     // A prismatic joint's frames stay parallel: no initial angle.
-    let table: toml::Table = toml::from_str(&spring_block("").replace(
+    let spec = scene_spec(&spring_block("").replace(
         "axis = [1.0, 2.0, 2.0]",
         "axis = [1.0, 2.0, 2.0]\nangle = 0.3",
-    ))
-    .unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
+    ));
     let e = spec.build().unwrap_err().to_string();
     assert!(e.contains("joints[0].angle") && e.contains("0.3"), "{e}");
 }

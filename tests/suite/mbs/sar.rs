@@ -1,18 +1,12 @@
 //! Rigid SAR antenna, phase 1 (studies/sar_phase1_rigid.toml; the geometry
 //! is a reconstruction, see docs/sar_reconstruction.md).
+use crate::common::scenes::shipped_scene;
 use plyscape::integrate::Method;
 use plyscape::mbs::Workspace;
-use plyscape::scene::load_scene;
 use plyscape::simulate::simulate;
-use plyscape::study::Study;
 
 fn sar() -> plyscape::scene::Scene {
-    let study = Study::load(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/studies/sar_phase1_rigid.toml"
-    ))
-    .unwrap();
-    load_scene(&study).unwrap()
+    shipped_scene("sar_phase1_rigid.toml")
 }
 
 #[test]

@@ -7,11 +7,12 @@
 //! closes, θ(t) stays close to the rigid scene, and a ply-angle
 //! sensitivity of panel 3's strain energy matches central differences.
 
+use crate::common::sar::{coarse_sar, replace};
+use crate::common::tables::column_index;
 use plyscape::mbs::{Force, PiecewiseLaw};
 use plyscape::scene::load_scene;
 use plyscape::simulate::{simulate, Simulation};
 use plyscape::study::Study;
-use crate::common::sar::{coarse_sar, replace};
 
 const STUDY: &str = include_str!("../../../studies/sar_phase1_flexible.toml");
 
@@ -51,11 +52,9 @@ fn coarse(theta_deg: f64, sens: bool, flexible: bool) -> Simulation {
     simulate(&scene).unwrap().1
 }
 
+/// The index of history column `name` (by header prefix).
 fn col(sim: &Simulation, name: &str) -> usize {
-    sim.headers
-        .iter()
-        .position(|h| h.starts_with(name))
-        .unwrap_or_else(|| panic!("no column {name}"))
+    column_index(&sim.headers, name)
 }
 
 /// ∫_{a}^{b} m(θ) dθ of the Eq. (32) law `m = value + slope·(anchor − θ)`

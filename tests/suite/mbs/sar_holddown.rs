@@ -9,12 +9,13 @@
 //! gradient of panel 2's part of Ψ₀ matches central differences of whole
 //! simulations.
 
+use crate::common::sar::{coarse_sar, replace};
+use crate::common::tables::column_index;
 use nalgebra::DMatrix;
 use plyscape::mbs::{Force, System, Workspace};
 use plyscape::scene::{load_scene, Scene};
 use plyscape::simulate::{simulate, Simulation};
 use plyscape::study::Study;
-use crate::common::sar::{coarse_sar, replace};
 
 const STUDY: &str = include_str!("../../../studies/sar_phase1_holddown.toml");
 
@@ -48,11 +49,9 @@ fn run(scene: &Scene) -> Simulation {
     simulate(scene).unwrap().1
 }
 
+/// The index of history column `name` (by header prefix).
 fn col(sim: &Simulation, name: &str) -> usize {
-    sim.headers
-        .iter()
-        .position(|h| h.starts_with(name))
-        .unwrap_or_else(|| panic!("no column {name}"))
+    column_index(&sim.headers, name)
 }
 
 fn response(sim: &Simulation, name: &str) -> (f64, Vec<f64>) {
@@ -232,7 +231,7 @@ fn work_energy_balance(scene: &Scene, sim: &Simulation) {
     }
     println!("worst |ΔE − W| {worst:e} J of {scale:e} J");
     // Measured 1.4e-10 relative at rtol 1e-10 (the reference scene:
-    // 1.5e-9, tests/mbs_sar_flex.rs); the same bound as there.
+    // 1.5e-9, tests/suite/mbs/sar_flex.rs); the same bound as there.
     assert!(
         scale > 0.0 && worst < 1e-8 * scale,
         "{worst:e} of {scale:e}"

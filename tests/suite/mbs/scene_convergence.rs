@@ -6,8 +6,8 @@ use plyscape::study::Study;
 
 #[test]
 fn grid_over_mesh_and_modes_writes_errors_against_the_finest() {
-    let dir = std::env::temp_dir().join(format!("plyscape_scene_conv_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::common::temp_dir("scene-conv");
+    let dir = tmp.path().to_path_buf();
     // The main study's scene, shortened to 0.3 s.
     let main = include_str!("../../../studies/main.toml");
     assert_eq!(

@@ -1,8 +1,8 @@
 //! Forward sensitivities (direct differentiation with exact dual-number
 //! products) against central finite differences of the simulation.
+use crate::common::scenes::{scene, scene_spec, shipped_scene};
 use plyscape::integrate::{integrate, integrate_sens, Method, Options, SensitivityForm};
 use plyscape::mbs::{Force, Model, Param, System};
-use plyscape::scene::SceneSpec;
 
 /// A rod pendulum (pin about y at the origin) with gravity, a spring-damper
 /// from its tip to a ground point, and a rotational spring-damper-actuator
@@ -48,9 +48,7 @@ dt_out = 1.0
 "#;
 
 fn model() -> Model {
-    let table: toml::Table = toml::from_str(SCENE).unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
-    spec.build().unwrap().model
+    scene(SCENE).model
 }
 
 fn options(method: Method) -> Options {
@@ -153,12 +151,7 @@ fn sar_sensitivities_of_deployment_angle() {
     // Rigid SAR phase 1: ∂θ(3 s)/∂p for the actuator damping c, the Eq. 32
     // breakpoint 3.12 of the first segment, and the panel-3 mass, against
     // central finite differences (BDF, rtol 1e-10).
-    let study = plyscape::study::Study::load(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/studies/sar_phase1_rigid.toml"
-    ))
-    .unwrap();
-    let m = plyscape::scene::load_scene(&study).unwrap().model;
+    let m = shipped_scene("sar_phase1_rigid.toml").model;
     let law = match &m.forces[0] {
         Force::Rotational { law: Some(l), .. } => l.clone(),
         other => panic!("{other:?}"),
@@ -233,8 +226,7 @@ fn scene_sensitivities_of_outputs_match_differences() {
             "\nsensitivities = [\"forces[0].stiffness\", \"rod.mass\", \"forces[1].segments[0].anchor\", \"forces[1].damping\"]\n[[scene.bodies]]",
             1,
         );
-    let table: toml::Table = toml::from_str(&text).unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
+    let spec = scene_spec(&text);
     let scene = spec.build().unwrap();
     assert_eq!(scene.params.len(), 4);
     let (_, sim) = plyscape::simulate::simulate(&scene).unwrap();
@@ -260,9 +252,7 @@ fn scene_sensitivities_of_outputs_match_differences() {
     }
     // Bad names are input errors naming the key.
     let bad = text.replace("\"rod.mass\"", "\"rod.masss\"");
-    let table: toml::Table = toml::from_str(&bad).unwrap();
-    let spec: SceneSpec = table["scene"].clone().try_into().unwrap();
-    match spec.build() {
+    match scene_spec(&bad).build() {
         Err(plyscape::Error::Input { key, .. }) => assert_eq!(key, "sensitivities[1]"),
         other => panic!("{other:?}"),
     }

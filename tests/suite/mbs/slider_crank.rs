@@ -14,11 +14,11 @@
 //!
 //! and the convergence of G with the tolerance, which explains the
 //! difference to IDAS (2.7e-6, the size of an rtol-1e-6 integration).
+use crate::common::scenes::{shipped_scene, shipped_study};
 use plyscape::integrate::{Method, SensitivityForm};
 use plyscape::mbs::responses::ResponseValue;
-use plyscape::scene::{load_scene, Scene};
+use plyscape::scene::Scene;
 use plyscape::simulate::simulate;
-use plyscape::study::Study;
 
 /// IDAS's printed values (idasSlCrank_FSA_dns.out, see the module doc).
 /// G as printed: 3.3366157997761721 (17 digits; the nearest f64 below).
@@ -26,8 +26,7 @@ const IDAS_G: f64 = 3.336_615_799_776_172;
 const IDAS_DG: [f64; 2] = [3.3346e-01, -3.6375e-01];
 
 fn shipped() -> Scene {
-    let path = format!("{}/studies/slider_crank.toml", env!("CARGO_MANIFEST_DIR"));
-    load_scene(&Study::load(path).unwrap()).unwrap()
+    shipped_scene("slider_crank.toml")
 }
 
 /// The scene with `method`, `rtol` (atol = rtol/100) and `form`.
@@ -194,8 +193,7 @@ fn sens_bench_times_the_plain_run_and_both_forms() {
     // The study's [sens_bench] section, cut to one run at one tolerance:
     // a plain row (ratio 1) and one row per form with the same G and
     // gradients (fused = staggered).
-    let path = format!("{}/studies/slider_crank.toml", env!("CARGO_MANIFEST_DIR"));
-    let study = Study::load(path).unwrap();
+    let study = shipped_study("slider_crank.toml");
     let spec = plyscape::sections::sens_bench::SensBenchSpec {
         repeats: 1,
         rtols: vec![1e-6],

@@ -1,27 +1,16 @@
 //! The shipped multibody studies (studies/*.toml) run end to end through
 //! `plyscape run` and write their files; the `[kernel_bench]` driver produces a consistent table. What each scene
-//! shows is tested where the scene is derived: tests/mbs_free.rs
-//! (Dzhanibekov), tests/mbs_mechanisms.rs (four-bar, Bricard),
-//! tests/mbs_andrews.rs (Andrews), tests/mbs_sar.rs (SAR); those tests run
+//! shows is tested where the scene is derived: tests/suite/mbs/free.rs
+//! (Dzhanibekov), tests/suite/mbs/mechanisms.rs (four-bar, Bricard),
+//! tests/suite/mbs/andrews.rs (Andrews), tests/suite/mbs/sar.rs (SAR); those tests run
 //! the same study files.
+use crate::common::scenes::study_path;
+use crate::common::temp_dir;
 use plyscape::cli::{run_study, RunConfig};
 use plyscape::integrate::Method;
 use plyscape::sections::kernel_bench::{run_bench, write_csv, BenchSpec, HEADERS};
 use plyscape::study::Study;
-use std::path::{Path, PathBuf};
-
-fn study_path(file: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("studies")
-        .join(file)
-}
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("plyscape-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use std::path::Path;
 
 /// Read a CSV written by the crate: header and numeric rows.
 fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
@@ -41,7 +30,8 @@ fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 
 #[test]
 fn shipped_scene_studies_run_and_write_history() {
-    let out = temp_dir("mbs-studies");
+    let tmp = temp_dir("mbs-studies");
+    let out = tmp.path().to_path_buf();
     // (file, end time, output interval, extra files expected)
     let cases: [(&str, f64, f64, &[&str]); 5] = [
         ("dzhanibekov.toml", 10.0, 0.025, &["energy.svg"]),
@@ -126,7 +116,8 @@ fn kernel_bench_table_is_consistent() {
         b.jvp_calls,
         a.jvp_calls
     );
-    let dir = temp_dir("kernel-bench");
+    let tmp = temp_dir("kernel-bench");
+    let dir = tmp.path().to_path_buf();
     let path = write_csv(&rows, &dir).unwrap();
     let mut rd = csv::Reader::from_path(&path).unwrap();
     assert_eq!(rd.headers().unwrap().iter().collect::<Vec<_>>(), HEADERS);

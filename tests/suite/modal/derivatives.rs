@@ -4,9 +4,9 @@
 //! near-crossing, and the error paths.
 #![allow(clippy::needless_range_loop)]
 
+use crate::common::modal::*;
 use faer::sparse::SparseColMat;
 use faer::Mat;
-use crate::common::modal::*;
 use plyscape::modal::{
     DerivativeOptions, DesignDerivative, ModalOptions, ModalSolver, ModeUpdate, Modes,
 };

@@ -216,13 +216,6 @@ fn bin() -> PathBuf {
     PathBuf::from(env!("CARGO_BIN_EXE_plyscape"))
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("plyscape-panel-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
 const STUDY: &str = r#"
 [study]
 name = "pm"
@@ -253,7 +246,8 @@ plies = [{ angle = 55.0, thickness = 0.5e-3 }, { angle = -55.0, thickness = 0.5e
 /// the CSV has the documented columns.
 #[test]
 fn modes_command_writes_reproducible_tables() {
-    let dir = scratch("repro");
+    let tmp = crate::common::temp_dir("panel-repro");
+    let dir = tmp.path().to_path_buf();
     let study = dir.join("pm.toml");
     std::fs::write(&study, STUDY).unwrap();
     let mut outputs = Vec::new();
