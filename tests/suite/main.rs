@@ -4,6 +4,7 @@
 mod common;
 mod explore;
 mod fe;
+mod golden;
 mod laminate;
 mod mbs;
 mod modal;
