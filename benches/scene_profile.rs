@@ -1,6 +1,7 @@
 //! Where a scene's right-hand side spends its time, and how stiff it is.
 //!
 //! `cargo bench --bench scene_profile -- studies/sar_phase1_flexible.toml`
+//! (that study when none is named, so a plain `cargo bench` runs it too).
 //!
 //! Prints, at the consistent initial state of the study's scene:
 //! - the natural frequencies of each flexible body's modal basis (Hz);
@@ -25,7 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args()
         .skip(1)
         .find(|a| a != "--bench")
-        .ok_or("usage: scene_profile <study.toml>")?;
+        .unwrap_or_else(|| "studies/sar_phase1_flexible.toml".into());
     let study = Study::load(std::path::Path::new(&path))?;
     let scene = load_scene(&study)?;
     for b in &scene.model.bodies {

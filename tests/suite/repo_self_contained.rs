@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 /// What the walk scans, relative to the crate root: directories
 /// (recursively) and single files.
-const ROOTS: [&str; 5] = ["studies", "tests", "src", "docs", "README.md"];
+const ROOTS: [&str; 6] = ["studies", "tests", "benches", "src", "docs", "README.md"];
 
 /// Text that marks a reference to something outside the repository: the
 /// folder of the external design notes, a machine path, a path that climbs
