@@ -27,7 +27,7 @@ use serde::Deserialize;
 
 /// Default mesh density: cells along the panel length. Measured on SAR
 /// panel 3 ([0/90/90/0], ignored measurement test `sar_panel_mode_convergence`
-/// in `tests/fe_modes.rs`):
+/// in `tests/suite/fe/modes.rs`):
 /// at 64 divisions (≈16 000 DOF) the 14 lowest flexural modes are within
 /// about 0.5 % of the 160-division values (≈1 % at 40, ≈0.2 % at 80;
 /// second-order convergence). The two near-rigid rocking modes and the

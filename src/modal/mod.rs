@@ -42,7 +42,7 @@
 //! the cluster threshold and what the caller gets for a cluster. The
 //! fixed-mode approach (Eq. 19) returns only `λ'`.
 //!
-//! # Cost (measured, `examples/modal_bench.rs`, `results/modal_bench/`)
+//! # Cost (measured, `benches/modal_bench.rs`, `results/modal_bench/`)
 //! One symbolic analysis (AMD + elimination tree) per stiffness pattern,
 //! reused by every numeric factorization ([`ModalSolver::set_stiffness`]
 //! keeps it across designs). Then

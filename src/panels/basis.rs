@@ -37,7 +37,7 @@
 //! per call from the element geometry (O(elements)) and checked against
 //! the assembled diagonal of M, entry by entry.
 //!
-//! Measured (`examples/panel_basis_bench.rs`; SAR panel 3, 32 divisions,
+//! Measured (`benches/panel_basis_bench.rs`; SAR panel 3, 32 divisions,
 //! 4152 DOF, 14 modes; 2-core x86_64 VM shared with other jobs, fastest of
 //! 7): `panel_basis` 52 ms without derivatives, 58 ms fixed-mode, 135 ms
 //! updated-mode for 2 variables, of which ≈ 32–38 ms is the one-off set-up
@@ -115,7 +115,7 @@
 //! depends on density and thickness only; the set is fixed while no
 //! content crosses the limit, guaranteed by the gap), so the basis's
 //! derivatives are the columns of the kept modes
-//! (`tests/panel_basis.rs` checks them against central differences).
+//! (`tests/suite/panels/basis.rs` checks them against central differences).
 //! Free–free bases have `c ≈ 1e-23` (elastic modes are M-orthogonal to
 //! `R`): nothing is dropped.
 //!

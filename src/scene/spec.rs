@@ -378,7 +378,7 @@ pub struct IntegratorSpec {
     /// ride in the state, one directional derivative per lane and stage or
     /// Newton iterate) or `staggered` (diffsol's sensitivity equations, two
     /// per lane and stage). Both control the error of the states alone;
-    /// with tsit45 they agree to about 1e-11 (tests/explore_scene.rs), with
+    /// with tsit45 they agree to about 1e-11 (tests/suite/explore/scene.rs), with
     /// the implicit methods to the lanes' integration error.
     pub sensitivity_form: Option<SensitivityForm>,
 }

@@ -407,6 +407,10 @@ fn kinetic_terms(sys: &System, body: Option<usize>) -> Vec<Energy> {
 /// Write `history.csv`, `stats.csv`, `sensitivities.csv` and
 /// `responses.csv` (when the scene has them) and (if asked)
 /// `<plot_file or output>.svg` into `dir`, through [`crate::report`].
+/// Every file holds only what the same build reproduces bit for bit: the
+/// wall-clock times (`Stats::wall`, `Stats::observer_wall`) go to the
+/// command's entry in `manifest.json` (see `cli::run_scene`), so a rerun
+/// of a committed study leaves its tables unchanged.
 pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<PathBuf>> {
     let sci_rows = |rows: &[Vec<f64>]| -> Vec<Vec<String>> {
         rows.iter()
@@ -432,8 +436,6 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
         ("events", scene.options.events.to_string()),
         ("segment_events", s.events.to_string()),
         ("restarts", s.restarts.to_string()),
-        ("wall_time_s", format!("{:.6e}", s.wall)),
-        ("output_wall_time_s", format!("{:.6e}", s.observer_wall)),
         ("equations", sim.equations.to_string()),
         ("redundant_equations", sim.redundant.to_string()),
         ("redundant_rows", redundant_rows(sim)),
@@ -510,7 +512,6 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
 /// The unit of a `stats.csv` quantity (`-`: a count, a name or a ratio).
 fn stat_unit(quantity: &str) -> &'static str {
     match quantity {
-        "wall_time_s" | "output_wall_time_s" => "s",
         // Constraint rows mix lengths and rotations: the largest residual.
         "initial_violation" | "position_correction" | "max_violation" => "m or rad",
         "velocity_correction" => "m/s or rad/s",

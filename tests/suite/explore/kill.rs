@@ -1,0 +1,181 @@
+//! Kill the real `plyscape multistart` process mid-run, then `--resume`:
+//! the final tables equal those of an uninterrupted run.
+
+use crate::common::explore::table_without;
+use crate::common::temp_dir;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+const STUDY: &str = "[study]\nname = \"k\"\nseed = 3\n\
+    [problem]\nname = \"himmelblau\"\ncost_ms = 2.0\n\
+    [multistart]\nsampler = \"sobol\"\nstarts = 24\n";
+
+fn plyscape(args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_plyscape"));
+    c.args(args);
+    c
+}
+
+#[test]
+fn killed_multistart_resumes_to_the_same_tables() {
+    let tmp = temp_dir("kill");
+    let dir = tmp.path().to_path_buf();
+    let study = dir.join("k.toml");
+    std::fs::write(&study, STUDY).unwrap();
+    let study = study.to_str().unwrap();
+    let (full, part) = (dir.join("full"), dir.join("part"));
+    let (full_s, part_s) = (full.to_str().unwrap(), part.to_str().unwrap());
+    let st = plyscape(&["multistart", study, "--out", full_s, "--threads", "2", "-q"])
+        .status()
+        .unwrap();
+    assert!(st.success());
+
+    let mut child = plyscape(&["multistart", study, "--out", part_s, "--threads", "2", "-q"])
+        .spawn()
+        .unwrap();
+    let runs = part.join("k/runs.csv");
+    let t0 = Instant::now();
+    // Kill once a few rows (header + 3) are on disk.
+    loop {
+        let lines = std::fs::read_to_string(&runs).map_or(0, |t| t.lines().count());
+        if lines >= 4 || t0.elapsed() > Duration::from_secs(60) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let rows_at_kill = std::fs::read_to_string(&runs).unwrap().lines().count() - 1;
+    assert!(
+        (3..24).contains(&rows_at_kill),
+        "{rows_at_kill} rows at kill"
+    );
+
+    let out = plyscape(&[
+        "multistart",
+        study,
+        "--out",
+        part_s,
+        "--threads",
+        "1",
+        "--resume",
+        "-q",
+    ])
+    .output()
+    .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in ["runs.csv", "optima.csv"] {
+        assert_eq!(
+            table_without(&full.join("k").join(f), &["wall_seconds"]),
+            table_without(&part.join("k").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    // The manifest records what was run.
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(part.join("k/manifest.json")).unwrap())
+            .unwrap();
+    assert_eq!(m["seed"], 3);
+    let ms = &m["commands"]["multistart"];
+    assert_eq!(ms["resume"], true);
+    assert_eq!(ms["threads"], 1);
+    assert_eq!(ms["complete"], true);
+    assert!(ms["runs_this_invocation"].as_u64().unwrap() <= 24 - 3);
+    assert_eq!(m["study_text"], STUDY);
+    // Built from a git checkout: a 40-hex commit (maybe `-dirty`).
+    let commit = m["git_commit"].as_str().unwrap();
+    assert!(
+        commit == "unknown" || commit[..40].chars().all(|c| c.is_ascii_hexdigit()),
+        "{commit}"
+    );
+    assert!(ms["started"].as_str().unwrap() <= ms["ended"].as_str().unwrap());
+}
+
+/// A second command on a results directory that a running one holds is
+/// refused with who holds it (exit code 4), and nothing of the holder's is
+/// touched; another results root is free.
+#[test]
+fn a_held_results_directory_is_refused_with_its_holder() {
+    let tmp = temp_dir("lock");
+    let dir = tmp.path().to_path_buf();
+    let study = dir.join("k.toml");
+    std::fs::write(&study, STUDY).unwrap();
+    let out = dir.join("out");
+    let held = plyscape::report::lock::DirLock::acquire(&out.join("k"), "compare").unwrap();
+    let r = plyscape(&[
+        "multistart",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "-q",
+    ])
+    .output()
+    .unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(4), "{err}");
+    assert!(err.contains("in use by plyscape compare"), "{err}");
+    assert!(
+        err.contains(&format!("process {}", std::process::id())),
+        "{err}"
+    );
+    assert!(!out.join("k/runs.csv").exists());
+    drop(held);
+}
+
+/// The Slurm scripts in `scripts/` (shown verbatim in the README) run as a
+/// job array would: one shard per task id, then the merge script; the
+/// merged tables equal an unsharded run's.
+#[test]
+fn the_documented_slurm_array_runs_and_merges() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let tmp = temp_dir("slurm");
+    let dir = tmp.path().to_path_buf();
+    let study = dir.join("k.toml");
+    std::fs::write(&study, STUDY).unwrap();
+    let bin = env!("CARGO_BIN_EXE_plyscape");
+    let script = |name: &str| {
+        let path = root.join("scripts").join(name);
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            readme.contains(&text),
+            "README does not show {name} verbatim"
+        );
+        let mut c = Command::new("bash");
+        c.arg(path)
+            .current_dir(&dir)
+            .env("STUDY", &study)
+            .env("NAME", "k")
+            .env("SHARDS", "3")
+            .env("PLYSCAPE", bin);
+        c
+    };
+    for task in 0..3 {
+        let r = script("slurm_multistart.sh")
+            .env("SLURM_ARRAY_TASK_ID", task.to_string())
+            .env("SLURM_CPUS_PER_TASK", "1")
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    }
+    let r = script("slurm_merge.sh").output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let st = plyscape(&["multistart", study.to_str().unwrap(), "--out"])
+        .arg(dir.join("full"))
+        .arg("-q")
+        .status()
+        .unwrap();
+    assert!(st.success());
+    for f in ["runs.csv", "optima.csv"] {
+        assert_eq!(
+            table_without(&dir.join("full/k").join(f), &["wall_seconds"]),
+            table_without(&dir.join("results/k").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    assert!(dir.join("results/k/comparison.csv").exists());
+}

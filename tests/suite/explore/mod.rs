@@ -1,0 +1,7 @@
+//! Tests of `plyscape::explore`: optimization drivers, multistart, shards, reports.
+mod compare;
+mod kill;
+mod multistart;
+mod optimum_report;
+mod scene;
+mod studies;

@@ -1,0 +1,2 @@
+//! Tests of `plyscape::laminate`: ABD stiffness and its derivatives.
+mod abd;

@@ -1,0 +1,13 @@
+//! plyscape's integration tests, in one binary: one module per module of
+//! `src/` (`mbs` tests `plyscape::mbs`, and so on) and `common` for the
+//! helpers and fixtures they share.
+mod common;
+mod explore;
+mod fe;
+mod golden;
+mod laminate;
+mod mbs;
+mod modal;
+mod optimize;
+mod panels;
+mod repo_self_contained;

@@ -1,0 +1,20 @@
+//! Tests of `plyscape::mbs` and the scenes built on it: kernel, joints, loads, flexible bodies, sensitivities, the SAR scenes and the shipped studies.
+mod andrews;
+mod convergence;
+mod energy;
+mod events;
+mod flex;
+mod free;
+mod input;
+mod kernel;
+mod loads;
+mod mechanisms;
+mod prismatic;
+mod sar;
+mod sar_clamp;
+mod sar_flex;
+mod sar_holddown;
+mod scene_convergence;
+mod sens;
+mod slider_crank;
+mod studies;

@@ -1,0 +1,3 @@
+//! Tests of `plyscape::modal`: sparse eigen-solutions and their derivatives.
+mod derivatives;
+mod eigen;

@@ -1,0 +1,3 @@
+//! Tests of `plyscape::optimize`: CMA-ES and MMFD.
+mod cmaes;
+mod mmfd;

@@ -1,0 +1,3 @@
+//! Tests of `plyscape::panels`: modal bases and panel modes.
+mod basis;
+mod modes;
