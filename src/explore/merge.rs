@@ -217,7 +217,7 @@ mod tests {
                 ..DriveFlags::default()
             },
         };
-        crate::explore::run_multistart(&ctx).unwrap();
+        crate::explore::commands::multistart::run_multistart(&ctx).unwrap();
         ctx.dir().unwrap()
     }
 
