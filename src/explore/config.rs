@@ -336,10 +336,10 @@ mod tests {
         // The same study gives the same starts; another seed other ones.
         let again = multistart_plan(&s, p.as_ref()).unwrap();
         assert_eq!(again.starts, plan.starts);
-        let other = study(&format!(
+        let other = study(
             "[study]\nseed = 8\n[problem]\nname = \"himmelblau\"\n[multistart]\nstarts = 5\n\
-             points = [[1.0, 2.0]]\n"
-        ));
+             points = [[1.0, 2.0]]\n",
+        );
         let q = multistart_plan(&other, p.as_ref()).unwrap();
         assert_ne!(q.starts.points[1..], plan.starts.points[1..]);
     }

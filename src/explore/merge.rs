@@ -237,7 +237,7 @@ mod tests {
         assert!(e.contains("each of the shards 0..3 exactly once"), "{e}");
         let twice = [dirs[0].clone(), dirs[0].clone(), dirs[1].clone()];
         assert!(merge(&twice, &sharded, true).is_err());
-        let e = merge(&[whole.clone()], &sharded, true)
+        let e = merge(std::slice::from_ref(&whole), &sharded, true)
             .unwrap_err()
             .to_string();
         assert!(e.contains("unsharded run"), "{e}");
@@ -246,13 +246,11 @@ mod tests {
         let report = merge(&dirs, &sharded, true).unwrap();
         assert_eq!(report.runs.len(), 7);
         let merged = sharded.join("m");
-        for table in ["optima.csv"] {
-            assert_eq!(
-                read(&merged.join(table)),
-                read(&whole.join(table)),
-                "{table}"
-            );
-        }
+        // (runs.csv differs in its wall times only.)
+        assert_eq!(
+            read(&merged.join("optima.csv")),
+            read(&whole.join("optima.csv"))
+        );
         // The manifest says where the rows came from; shards are untouched.
         let m = Manifest::read(&merged).unwrap();
         let entry: DriverEntry<MergeEntry> = m.entry("merge").unwrap();
