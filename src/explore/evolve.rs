@@ -191,16 +191,33 @@ pub fn run(
     })
 }
 
+/// The evolutionary method's name in `comparison.csv`: `cmaes` (IPOP, the
+/// name it had before BIPOP existed) or `cmaes-bipop`.
+pub fn global_method(restarts: Restarts) -> &'static str {
+    match restarts {
+        Restarts::Ipop => "cmaes",
+        Restarts::Bipop => "cmaes-bipop",
+    }
+}
+
+/// The restart schedule of an evolutionary method name of
+/// [`global_method`] (`None`: not such a name).
+pub fn global_schedule(method: &str) -> Option<Restarts> {
+    [Restarts::Ipop, Restarts::Bipop]
+        .into_iter()
+        .find(|&r| global_method(r) == method)
+}
+
 /// `evolution.csv`: header and one row per generation of each report, the
 /// reports one after another. With more than one report a first column
-/// `method` names each row's schedule ([`super::solvers::global_method`],
+/// `method` names each row's schedule ([`global_method`],
 /// as in `comparison.csv`); one report's table has no such column, as
 /// before schedules could be listed. Non-finite entries are left empty.
 pub fn table(problem: &dyn Problem, reports: &[Report]) -> Vec<Vec<String>> {
     let tagged = reports.len() > 1;
     let mut out = vec![header(problem, tagged)];
     for r in reports {
-        let method = super::solvers::global_method(r.restarts);
+        let method = global_method(r.restarts);
         for g in &r.generations {
             let mut row = if tagged {
                 vec![method.to_string()]

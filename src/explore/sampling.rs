@@ -34,8 +34,8 @@ pub const SAMPLER_STREAM: u64 = 1;
 #[serde(deny_unknown_fields)]
 pub struct StartsSpec {
     /// `lhs` (default), `sobol` or `uniform`.
-    #[serde(default = "default_sampler")]
-    pub sampler: String,
+    #[serde(default)]
+    pub sampler: Sampler,
     /// Number of sampled starts (after the listed points).
     #[serde(default)]
     pub count: usize,
@@ -47,35 +47,17 @@ pub struct StartsSpec {
     pub feasible_only: bool,
 }
 
-fn default_sampler() -> String {
-    "lhs".into()
-}
-
-/// Samplers by name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Samplers, by the names study files use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Sampler {
     /// Latin hypercube.
+    #[default]
     Lhs,
     /// Scrambled Sobol.
     Sobol,
     /// Uniform random.
     Uniform,
-}
-
-impl Sampler {
-    /// Parse a sampler name; the error names the key `sampler`.
-    pub fn parse(name: &str) -> Result<Sampler> {
-        match name {
-            "lhs" => Ok(Sampler::Lhs),
-            "sobol" => Ok(Sampler::Sobol),
-            "uniform" => Ok(Sampler::Uniform),
-            other => Err(Error::input(
-                "sampler",
-                format!("\"{other}\""),
-                "one of lhs, sobol, uniform",
-            )),
-        }
-    }
 }
 
 /// Start points and the evaluations the feasibility filter used.
@@ -92,7 +74,7 @@ impl StartsSpec {
     /// Errors name keys inside `[starts]`.
     pub fn generate(&self, problem: &dyn Problem, seed: u64) -> Result<Starts> {
         let vars = problem.variables();
-        let sampler = Sampler::parse(&self.sampler)?;
+        let sampler = self.sampler;
         if self.count + self.points.len() == 0 {
             return Err(Error::input(
                 "count",
@@ -412,7 +394,7 @@ mod tests {
         use crate::explore::problems::Hs22;
         let p = Hs22::new();
         let spec = StartsSpec {
-            sampler: "sobol".into(),
+            sampler: Sampler::Sobol,
             count: 20,
             points: vec![vec![0.0, 1.0], vec![4.0, 4.0]],
             feasible_only: true,

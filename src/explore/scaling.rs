@@ -17,7 +17,8 @@
 //! Wall times depend on the machine and its load (recorded as
 //! `load_average_1min`); the tables of the runs do not (the `runs.csv` of each thread count are identical up to wall times).
 
-use super::{Context, DriveFlags};
+use super::commands::multistart::run_multistart;
+use super::context::{Context, DriveFlags};
 use crate::error::{Error, Result};
 use serde::Deserialize;
 
@@ -50,7 +51,7 @@ pub struct ScalingRow {
 /// Run `[scaling]`: the study's multistart once per thread count, each in
 /// `out/<study>/threads-<t>/`, and `scaling.csv` in `out/<study>/`.
 pub fn run_scaling(ctx: &Context) -> Result<Vec<ScalingRow>> {
-    let sec: ScalingSection = ctx.study.require_section("scaling", "threads = [1, 2]")?;
+    let sec = check(ctx.study)?;
     if sec.threads.is_empty() || sec.threads.contains(&0) {
         return Err(ctx.study.error(
             "scaling.threads",
@@ -72,7 +73,7 @@ pub fn run_scaling(ctx: &Context) -> Result<Vec<ScalingRow>> {
             quiet: ctx.quiet,
             flags: DriveFlags::default(),
         };
-        let r = super::run_multistart(&sub)?;
+        let r = run_multistart(&sub)?;
         rows.push(ScalingRow {
             threads: t,
             runs: r.runs.len(),
@@ -128,4 +129,9 @@ pub fn run_scaling(ctx: &Context) -> Result<Vec<ScalingRow>> {
         }
     }
     Ok(rows)
+}
+
+/// Read `[scaling]` (no work; `plyscape run` checks every section first).
+pub fn check(study: &crate::study::Study) -> Result<ScalingSection> {
+    study.require_section("scaling", "threads = [1, 2]")
 }

@@ -17,23 +17,30 @@
 use super::evolve::{GlobalSolver, Request};
 use super::multistart::LocalSolver;
 use crate::error::{Error, Result};
-use crate::optimize::cmaes::Restarts;
 use crate::optimize::{
     Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination,
 };
 
-/// Local methods by name.
-pub const LOCAL_METHODS: &str = "mmfd, steepest";
+/// The local optimizers, by the names study files use
+/// (`[multistart] method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LocalMethod {
+    /// The modified method of feasible directions (`optimize::mmfd`).
+    #[default]
+    Mmfd,
+    /// Projected steepest descent ([`steepest`]).
+    Steepest,
+}
 
-/// Check a local method name (error key `method`).
-pub fn check_local(method: &str) -> Result<()> {
-    match method {
-        "mmfd" | "steepest" => Ok(()),
-        other => Err(Error::input(
-            "method",
-            format!("\"{other}\""),
-            format!("one of {LOCAL_METHODS}"),
-        )),
+impl LocalMethod {
+    /// The name in study files and in `comparison.csv`
+    /// (`multistart-<name>`).
+    pub fn name(self) -> &'static str {
+        match self {
+            LocalMethod::Mmfd => "mmfd",
+            LocalMethod::Steepest => "steepest",
+        }
     }
 }
 
@@ -91,17 +98,18 @@ impl MmfdSettings {
     }
 }
 
-/// The local solver called `method` (MMFD with `mmfd`'s settings).
-pub fn local(method: &str, mmfd: &MmfdSettings) -> Result<Box<LocalSolver<'static>>> {
-    check_local(method)?;
+/// The local solver `method` (MMFD with `mmfd`'s settings).
+pub fn local(method: LocalMethod, mmfd: &MmfdSettings) -> Result<Box<LocalSolver<'static>>> {
     let options = mmfd.options();
     Ok(match method {
-        "steepest" => {
+        LocalMethod::Steepest => {
             Box::new(|p: &dyn Problem, x0: &[f64], obs: &mut dyn Observer| steepest(p, x0, obs))
         }
-        _ => Box::new(move |p: &dyn Problem, x0: &[f64], obs: &mut dyn Observer| {
-            crate::optimize::mmfd::minimize(p, x0, &options, obs)
-        }),
+        LocalMethod::Mmfd => {
+            Box::new(move |p: &dyn Problem, x0: &[f64], obs: &mut dyn Observer| {
+                crate::optimize::mmfd::minimize(p, x0, &options, obs)
+            })
+        }
     })
 }
 
@@ -120,23 +128,6 @@ pub fn global() -> Box<GlobalSolver<'static>> {
             crate::optimize::cmaes::minimize(p, &options, obs)
         },
     )
-}
-
-/// The evolutionary method's name in `comparison.csv`: `cmaes` (IPOP, the
-/// name it had before BIPOP existed) or `cmaes-bipop`.
-pub fn global_method(restarts: Restarts) -> &'static str {
-    match restarts {
-        Restarts::Ipop => "cmaes",
-        Restarts::Bipop => "cmaes-bipop",
-    }
-}
-
-/// The restart schedule of an evolutionary method name of
-/// [`global_method`] (`None`: not such a name).
-pub fn global_schedule(method: &str) -> Option<Restarts> {
-    [Restarts::Ipop, Restarts::Bipop]
-        .into_iter()
-        .find(|&r| global_method(r) == method)
 }
 
 /// The record of a steepest-descent design (no constraints, no active

@@ -8,6 +8,7 @@
 pub mod clock;
 pub mod csv;
 pub mod lock;
+pub mod manifest;
 pub mod plot;
 
 pub use plot::{heat_map, line_plot, line_plot_floored, Axes, Curve, HeatMap, Scale};
@@ -118,19 +119,19 @@ pub fn mark_start() {
 }
 
 /// Update `manifest.json` in `dir`: everything needed to reproduce the
-/// tables next to it. Common fields at the top (version, git commit, study,
-/// seed, threads, crate versions, the study text, `top`), and one entry per
-/// command under `commands`: the entries of earlier commands on the same
-/// study text are kept, so `plyscape run` records every step. Each entry
-/// gets `started` (when this process began) and `ended` (now) as UTC
-/// timestamps.
+/// tables next to it ([`manifest::Manifest`]). Common fields at the top
+/// (version, git commit, study, seed, threads, crate versions, the study
+/// text, the `shard` of a driver), and one entry per command under
+/// `commands`: the entries of earlier commands on the same study text are
+/// kept, so `plyscape run` records every step. Each entry gets `started`
+/// (when this process began) and `ended` (now) as UTC timestamps.
 pub fn record_command(
     dir: &Path,
     study: &crate::study::Study,
     threads: usize,
     command: &str,
     mut entry: serde_json::Map<String, serde_json::Value>,
-    top: serde_json::Map<String, serde_json::Value>,
+    shard: Option<manifest::ShardRecord>,
 ) -> Result<()> {
     use serde_json::json;
     mark_start();
@@ -140,29 +141,27 @@ pub fn record_command(
         "ended".into(),
         json!(clock::iso_utc(std::time::SystemTime::now())),
     );
-    let mut commands = read_manifest(dir)
+    let mut commands = manifest::Manifest::read(dir)
         .ok()
-        .filter(|m| m["study_text"].as_str() == Some(study.text.as_str()))
-        .and_then(|m| m["commands"].as_object().cloned())
+        .filter(|m| m.study_text == study.text)
+        .map(|m| m.commands)
         .unwrap_or_default();
     commands.insert(command.into(), serde_json::Value::Object(entry));
-    let crates: serde_json::Map<String, serde_json::Value> = crate_versions()
-        .into_iter()
-        .map(|(n, v)| (n, json!(v)))
-        .collect();
-    let mut m = serde_json::Map::new();
-    m.insert("plyscape_version".into(), json!(env!("CARGO_PKG_VERSION")));
-    m.insert("git_commit".into(), json!(GIT_COMMIT));
-    m.insert("study_file".into(), json!(study.path.display().to_string()));
-    m.insert("study_name".into(), json!(study.name()));
-    m.insert("seed".into(), json!(study.meta.seed));
-    m.insert("threads".into(), json!(threads));
-    m.insert("crates".into(), serde_json::Value::Object(crates));
-    m.extend(top);
-    m.insert("last_command".into(), json!(command));
-    m.insert("commands".into(), serde_json::Value::Object(commands));
-    m.insert("study_text".into(), json!(study.text));
-    let text = serde_json::to_string_pretty(&serde_json::Value::Object(m))
+    let m = manifest::Manifest {
+        plyscape_version: env!("CARGO_PKG_VERSION").into(),
+        git_commit: GIT_COMMIT.into(),
+        study_file: study.path.display().to_string(),
+        study_name: study.name(),
+        seed: study.meta.seed,
+        threads,
+        crates: crate_versions().into_iter().collect(),
+        shard,
+        last_command: command.into(),
+        commands,
+        study_text: study.text.clone(),
+    };
+    let text = m
+        .to_text()
         .map_err(|e| Error::csv(dir.join("manifest.json"), e))?;
     csv::write_bytes_atomic(&dir.join("manifest.json"), text.as_bytes())
 }

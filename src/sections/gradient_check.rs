@@ -217,7 +217,10 @@ pub const OPTIMIZE_HEADERS: [&str; 10] = [
 
 /// One MMFD run from the start per approach.
 fn optimize_rows(name: &str, p: &mut SceneProblem) -> Result<Vec<Vec<String>>> {
-    let solver = crate::explore::solvers::local("mmfd", &Default::default())?;
+    let solver = crate::explore::solvers::local(
+        crate::explore::solvers::LocalMethod::Mmfd,
+        &Default::default(),
+    )?;
     let start = p.start().to_vec();
     let mut rows = Vec::new();
     for update in [ModeUpdate::Updated, ModeUpdate::Fixed] {

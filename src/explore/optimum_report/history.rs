@@ -16,7 +16,7 @@
 //! the run started), `x_<variable>` (in the variables' unit, degrees for
 //! a scene problem).
 
-use super::Labels;
+use super::labels::Labels;
 use crate::error::Result;
 use crate::optimize::{IterRecord, Problem};
 use crate::report::csv::{num, write_table};

@@ -28,17 +28,21 @@
 
 pub mod curves;
 pub mod history;
+pub mod labels;
 pub mod summary;
 
+pub use labels::Labels;
+
+use super::config::MultistartPlan;
+use super::context::Context;
+use super::manifest::OptimumReportEntry;
 use super::problems::ProblemSpec;
 use super::scene_problem::SceneProblem;
-use super::{Context, MultistartPlan};
 use crate::error::{Error, Result};
 use crate::optimize::{Problem, TimedHistory};
 use crate::simulate::Simulation;
 use crate::study::Study;
 use serde::Deserialize;
-use serde_json::json;
 use std::path::{Path, PathBuf};
 
 /// The section's name in study files.
@@ -55,47 +59,6 @@ pub struct OptimumReportSection {
     /// at the start and at the optimum; scene problems only.
     #[serde(default)]
     pub quantities: Vec<String>,
-}
-
-/// How the report names and scales the problem's values.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Labels {
-    /// The objective in its unit is `f × divisor` (1 unless the scene
-    /// problem normalizes its response).
-    pub divisor: f64,
-    /// Unit of `f × divisor` (`-` for a dimensionless problem).
-    pub unit: String,
-    /// Unit of the design variables (`deg` for a scene's ply angles).
-    pub x_unit: String,
-    /// Constraint labels in the order of `g`: `g1 (u3_peak)`, or `g1`.
-    pub constraints: Vec<String>,
-}
-
-impl Labels {
-    /// Labels of a dimensionless problem with `m` constraints.
-    pub fn plain(m: usize) -> Labels {
-        Labels {
-            divisor: 1.0,
-            unit: "-".into(),
-            x_unit: "-".into(),
-            constraints: (1..=m).map(|j| format!("g{j}")).collect(),
-        }
-    }
-
-    /// Labels of a scene problem: its objective response's unit and
-    /// divisor, angles in degrees, constraints named by their responses.
-    pub fn scene(p: &SceneProblem) -> Labels {
-        let names = p.constraint_responses();
-        Labels {
-            divisor: p.objective_scale(),
-            unit: p.objective_response().1.into(),
-            x_unit: "deg".into(),
-            constraints: (1..=names.len())
-                .zip(names)
-                .map(|(j, n)| format!("g{j} ({n})"))
-                .collect(),
-        }
-    }
 }
 
 /// Is the study's `[problem]` the scene problem?
@@ -239,7 +202,7 @@ impl Prepared {
         };
         let mut files = history::write(dir, problem, &self.labels, &history.records)?;
         let facts = summary::Facts {
-            method: &plan.section.method,
+            method: plan.section.method.name(),
             f_start: history.records.first().map(|(r, _)| r.f),
             tolerance: plan.tolerances.feasibility,
             threads: ctx.threads,
@@ -268,12 +231,12 @@ impl Prepared {
             .iter()
             .filter_map(|f| f.file_name()?.to_str().map(String::from))
             .collect();
-        ctx.manifest(
-            dir,
-            KEY,
-            json!({"start": REPORTED_START, "files": names,
-                   "wall_seconds": t0.elapsed().as_secs_f64()}),
-        )?;
+        let entry = OptimumReportEntry {
+            start: REPORTED_START,
+            files: names.clone(),
+            wall_seconds: t0.elapsed().as_secs_f64(),
+        };
+        ctx.manifest(dir, KEY, entry)?;
         if !ctx.quiet {
             print_summary(&history_rows_note(history), &names);
         }

@@ -18,7 +18,7 @@
 //! average when the row was written; empty where unknown). Fields of a
 //! failed run's optimum are empty.
 
-use super::Labels;
+use super::labels::Labels;
 use crate::error::Result;
 use crate::explore::tables::RunRecord;
 use crate::optimize::Problem;

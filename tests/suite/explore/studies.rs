@@ -114,7 +114,13 @@ fn sar_explore_is_sar_optimize_with_64_starts_and_both_schedules() {
     }
     assert_eq!((s.meta.seed, s.meta.threads), (o.meta.seed, Some(2)));
     let ms = plyscape::explore::multistart_section(&s).unwrap();
-    assert_eq!((ms.method.as_str(), ms.sampler.as_str()), ("mmfd", "lhs"));
+    assert_eq!(
+        (ms.method, ms.sampler),
+        (
+            plyscape::explore::solvers::LocalMethod::Mmfd,
+            plyscape::explore::sampling::Sampler::Lhs
+        )
+    );
     assert_eq!(ms.points, [[55.0, -55.0]]);
     assert_eq!(ms.points.len() + ms.starts, 64);
     let ev = plyscape::explore::evolve_plan(&s).unwrap();

@@ -1,0 +1,136 @@
+//! `plyscape map`: the design-space map of `[map]` ([`crate::explore::map`]
+//! draws it), marked with the optima and evolutions found before.
+
+use crate::error::{Error, Result};
+use crate::explore::config::{map_section, problem};
+use crate::explore::context::Context;
+use crate::explore::evolve::global_schedule;
+use crate::explore::manifest::MapEntry;
+use crate::explore::map;
+use std::path::Path;
+
+/// `plyscape map`: the grid(s), marked with the optima in `optima.csv` and
+/// each evolution's best in `evolution.csv` when those exist in the study's
+/// output directory.
+pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
+    let problem = problem(ctx.study)?;
+    let sec = map_section(ctx.study)?;
+    let loc = ctx.study.locate("map");
+    let vars = problem.variables();
+    let n = vars.len();
+    let pairs: Vec<(usize, usize)> = match &sec.pairs {
+        Some(p) => {
+            for (k, &[a, b]) in p.iter().enumerate() {
+                if a >= n || b >= n || a == b {
+                    return Err(loc(Error::input(
+                        format!("pairs[{k}]"),
+                        format!("[{a}, {b}]"),
+                        format!("two different variable indices < {n}"),
+                    )));
+                }
+            }
+            p.iter().map(|&[a, b]| (a, b)).collect()
+        }
+        None => (0..n / 2).map(|k| (2 * k, 2 * k + 1)).collect(),
+    };
+    let dir = ctx.dir()?;
+    let optima: Vec<Vec<f64>> = read_points(&dir.join("optima.csv"), "x_", vars)?
+        .into_iter()
+        .map(|(_, x)| x)
+        .collect();
+    let evo = read_points(&dir.join("evolution.csv"), "best_x_", vars)?;
+    let base = optima
+        .first()
+        .cloned()
+        .unwrap_or_else(|| vars.iter().map(|v| 0.5 * (v.lower + v.upper)).collect());
+    let mut marks = Vec::new();
+    if !optima.is_empty() {
+        marks.push(("local optima".to_string(), optima));
+    }
+    marks.extend(evolution_marks(evo));
+    let req = map::MapRequest {
+        resolution: sec.resolution,
+        pairs,
+        base,
+        marks,
+    };
+    let slices = map::run(problem.as_ref(), &req, ctx.threads, &dir)?;
+    // With more than two variables, the design the slices pass through.
+    let slices_through = (n > 2).then(|| {
+        vars.iter()
+            .zip(&req.base)
+            .map(|(v, &x)| (v.name.clone(), x))
+            .collect()
+    });
+    let entry = MapEntry {
+        resolution: sec.resolution,
+        slices_through,
+    };
+    ctx.manifest(&dir, "map", entry)?;
+    if !ctx.quiet {
+        println!(
+            "map of {}: {} slice(s) of {}^2 points in {}",
+            problem.name(),
+            slices.len(),
+            sec.resolution,
+            dir.display()
+        );
+    }
+    Ok(slices)
+}
+
+/// `CMA-ES best` for a table of one schedule and `<solver> best`
+/// (`IPOP-CMA-ES best`, `BIPOP-CMA-ES best`) for each schedule of a table
+/// with a `method` column.
+fn evolution_marks(rows: Vec<(String, Vec<f64>)>) -> Vec<(String, Vec<Vec<f64>>)> {
+    let mut out: Vec<(String, Vec<Vec<f64>>)> = Vec::new();
+    for (method, x) in rows {
+        let label = if method.is_empty() {
+            "CMA-ES best".to_string()
+        } else {
+            match global_schedule(&method) {
+                Some(r) => format!("{} best", r.solver_name()),
+                None => format!("{method} best"),
+            }
+        };
+        match out.iter_mut().find(|(l, _)| *l == label) {
+            Some(mark) => mark.1 = vec![x],
+            None => out.push((label, vec![x])),
+        }
+    }
+    out
+}
+
+/// Designs from the `<prefix><name>` columns of a CSV, if the file exists,
+/// each with its `method` field (empty when there is no such column).
+fn read_points(
+    path: &Path,
+    prefix: &str,
+    vars: &[crate::optimize::Variable],
+) -> Result<Vec<(String, Vec<f64>)>> {
+    if !path.exists() {
+        return Ok(vec![]);
+    }
+    let mut rd = csv::Reader::from_path(path).map_err(|e| Error::csv(path, e))?;
+    let headers = rd.headers().map_err(|e| Error::csv(path, e))?.clone();
+    let cols: Option<Vec<usize>> = vars
+        .iter()
+        .map(|v| {
+            headers
+                .iter()
+                .position(|h| h == format!("{prefix}{}", v.name))
+        })
+        .collect();
+    let Some(cols) = cols else { return Ok(vec![]) };
+    let method = headers.iter().position(|h| h == "method");
+    let mut out = Vec::new();
+    for r in rd.records() {
+        let r = r.map_err(|e| Error::csv(path, e))?;
+        let x: Option<Vec<f64>> = cols.iter().map(|&c| r.get(c)?.parse().ok()).collect();
+        let tag = method.and_then(|c| r.get(c)).unwrap_or_default();
+        if let Some(x) = x {
+            out.push((tag.to_string(), x));
+        }
+    }
+    Ok(out)
+}

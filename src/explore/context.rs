@@ -1,0 +1,83 @@
+//! What a driver command gets from the command line ([`Context`],
+//! [`DriveFlags`]), the directory it writes into and its manifest entry.
+
+use super::multistart::Shard;
+use crate::error::{Error, Result};
+use crate::report::manifest::ShardRecord;
+use crate::study::Study;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Flags of the driver commands beyond the common ones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DriveFlags {
+    /// Continue from an existing `runs.csv`.
+    pub resume: bool,
+    /// Which starts to run.
+    pub shard: Shard,
+    /// Without `resume`: discard an earlier `runs.csv` instead of keeping
+    /// it under a timestamped name.
+    pub force: bool,
+}
+
+impl Default for DriveFlags {
+    fn default() -> Self {
+        DriveFlags {
+            resume: false,
+            shard: Shard { index: 0, count: 1 },
+            force: false,
+        }
+    }
+}
+
+/// What a driver command needs from the command line.
+#[derive(Debug, Clone)]
+pub struct Context<'a> {
+    /// The study.
+    pub study: &'a Study,
+    /// Results root (`results/`).
+    pub out: &'a Path,
+    /// Worker threads.
+    pub threads: usize,
+    /// No progress bars or summaries.
+    pub quiet: bool,
+    /// Resume and shard.
+    pub flags: DriveFlags,
+}
+
+impl Context<'_> {
+    /// `out/<study>/`, or `out/<study>/shard-<i>-of-<n>/` for a shard.
+    pub fn dir(&self) -> Result<PathBuf> {
+        let base = self.study.output_dir(self.out)?;
+        let s = self.flags.shard;
+        if s.count == 1 {
+            return Ok(base);
+        }
+        let dir = base.join(format!("shard-{}-of-{}", s.index, s.count));
+        std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+        Ok(dir)
+    }
+
+    /// Update `manifest.json` ([`crate::report::record_command`]) with the
+    /// shard, the threads, the resume flag and the command's own `detail`
+    /// ([`super::manifest`]).
+    pub fn manifest<D: Serialize>(&self, dir: &Path, command: &str, detail: D) -> Result<()> {
+        let entry = super::manifest::DriverEntry {
+            threads: self.threads,
+            resume: self.flags.resume,
+            detail,
+        };
+        let shard = ShardRecord {
+            index: self.flags.shard.index,
+            count: self.flags.shard.count,
+        };
+        crate::report::record_command(
+            dir,
+            self.study,
+            self.threads,
+            command,
+            crate::report::manifest::entry_map(&entry)?,
+            Some(shard),
+        )
+    }
+}
