@@ -10,7 +10,6 @@
 //! Every error names the file, the key, the value and what was expected.
 
 pub mod memory;
-mod reference;
 
 use crate::error::{Error, Result};
 use serde::de::DeserializeOwned;

@@ -2,6 +2,7 @@
 //! `src/` (`mbs` tests `plyscape::mbs`, and so on) and `common` for the
 //! helpers and fixtures they share.
 mod common;
+mod docs_reference;
 mod explore;
 mod fe;
 mod golden;

@@ -23,8 +23,6 @@
 //! backticks and brackets (`` ### `[[scene.bodies]]` ``) sets the current
 //! table; a table row whose first cell is a key in backticks
 //! (`` | `name` | ... ``) names the key `<table>.<key>`.
-#![cfg(test)]
-
 use serde::de::{self, DeserializeOwned, DeserializeSeed, IntoDeserializer, Visitor};
 use std::cell::RefCell;
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
@@ -33,13 +31,13 @@ use std::fmt;
 /// The sections a study file may hold, each with the type its key is read
 /// into: the one list to update when a section is added or renamed.
 fn probe_sections(p: &RefCell<Probe>) {
-    use crate::explore as ex;
-    use crate::sections as sec;
-    section::<crate::study::StudyMeta>(p, "study");
-    section::<Vec<crate::fe::spec::PanelSpec>>(p, "panels");
+    use plyscape::explore as ex;
+    use plyscape::sections as sec;
+    section::<plyscape::study::StudyMeta>(p, "study");
+    section::<Vec<plyscape::fe::spec::PanelSpec>>(p, "panels");
     section::<sec::modes::ModesSpec>(p, "modes");
     section::<sec::modes::ConvergenceSpec>(p, "convergence");
-    section::<crate::scene::spec::SceneSpec>(p, "scene");
+    section::<plyscape::scene::spec::SceneSpec>(p, "scene");
     section::<ex::problems::ProblemSpec>(p, "problem");
     section::<ex::scene_problem::SceneProblemSpec>(p, "scene_problem");
     section::<ex::MultistartSection>(p, "multistart");
@@ -677,6 +675,19 @@ fn reference_lists_exactly_the_accepted_keys() {
         "docs/reference.md lacks {missing:?} and lists keys no section accepts: {unknown:?}"
     );
     assert_eq!(tables, sections, "sections in docs/reference.md");
+}
+
+#[test]
+fn probed_sections_are_the_registered_ones() {
+    // `[study]` is read by `Study` itself; every other section a study may
+    // hold is one entry of the registry `plyscape run` works from.
+    let (_, probed) = accepted_keys();
+    let mut registered: BTreeSet<String> = plyscape::sections::registry::SECTIONS
+        .iter()
+        .map(|s| s.key.to_string())
+        .collect();
+    registered.insert("study".to_string());
+    assert_eq!(probed, registered);
 }
 
 #[test]
