@@ -26,8 +26,10 @@ use super::energy::Energy;
 use super::model::Param;
 use num_dual::Dual64;
 
-/// The kind of a response functional (paper Eqs. 33–34).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The kind of a response functional (paper Eqs. 33–34), as written in
+/// `[[scene.responses]] kind`: `integral`, `peak` or `final`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ResponseKind {
     /// `∫ scale·Σ E dt` over the run, an integrated state (Eq. 33).
     Integral,
