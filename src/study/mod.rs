@@ -115,7 +115,8 @@ impl Study {
             .map_err(|e| {
                 let path = e.path().clone();
                 let (dotted, value) = locate_value(key, v, &path);
-                let msg = e.into_inner().to_string();
+                // toml's message without its own (section-relative) key.
+                let msg = e.into_inner().message().to_string();
                 Error::Input {
                     file: self.path.display().to_string(),
                     key: dotted,
@@ -313,12 +314,12 @@ mod tests {
             "{e}"
         );
 
-        // A wrong length names the array.
+        // A wrong length names the array (shown by its length).
         let s = Study::parse("n.toml", &joint("[0.0, 1.0]")).unwrap();
         let (_, key, value, _) = input_error(s.section::<Nested>("scene").unwrap_err());
         assert_eq!(
             (key.as_str(), value.as_str()),
-            ("scene.joints[0].axis", "[0.0, 1.0]")
+            ("scene.joints[0].axis", "(array of 2)")
         );
 
         // An unknown kind lists the accepted names.
@@ -330,7 +331,7 @@ mod tests {
             (key.as_str(), value.as_str()),
             ("scene.kinds[1]", "\"plate\"")
         );
-        assert!(expected.contains("`beam`, `panel`"), "{expected}");
+        assert!(expected.contains("`beam` or `panel`"), "{expected}");
 
         // An unknown key is named with its place; a missing one names the
         // table it is missing from.
