@@ -46,7 +46,12 @@ pub enum Support {
     /// All nodes of the central rectangle |x| ≤ length/2, |y| ≤ width/2
     /// clamped (its corners must be mesh nodes: see
     /// [`Support::forced_points`]). Sizes in m.
-    CentralPatch { length: f64, width: f64 },
+    CentralPatch {
+        /// Side of the patch along x (m).
+        length: f64,
+        /// Side of the patch along y (m).
+        width: f64,
+    },
     /// Hard simple support on all four edges (Reddy's SS-1): w = 0,
     /// tangential displacement = 0 and rotation about the edge normal = 0
     /// (x = ±L/2: v = θx = 0; y = ±W/2: u = θy = 0).

@@ -64,9 +64,12 @@ impl ResponseKind {
 /// One evaluated response.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResponseValue {
+    /// The `[[scene.responses]] name`.
     pub name: String,
     /// Integral over the run, peak or final value.
     pub kind: ResponseKind,
+    /// The response's value (J·s for an integral, J otherwise, times the
+    /// scale).
     pub value: f64,
     /// Time of the peak or the end time (s); `None` for integrals.
     pub time: Option<f64>,
