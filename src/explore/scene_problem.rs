@@ -330,10 +330,7 @@ impl SceneProblem {
     /// SI unit of the `[[scene.responses]]` entry `name` (from its kind).
     fn response_unit(&self, name: &str) -> &'static str {
         let kind = self.plan.spec().responses.iter().find(|r| r.name == name);
-        match kind.map(|r| r.kind.as_str()) {
-            Some("integral") => ResponseKind::Integral.unit(),
-            _ => ResponseKind::Peak.unit(),
-        }
+        kind.map_or(ResponseKind::Peak.unit(), |r| r.kind.unit())
     }
 
     /// Simulate design `x` \[deg\] without sensitivities, with exactly the

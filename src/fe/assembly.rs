@@ -19,6 +19,25 @@ const NONE: usize = usize::MAX;
 /// Positions in the scatter map are u32 (half the memory traffic of usize).
 const MAX_STORED: usize = u32::MAX as usize;
 
+/// The kind of support as written in study files (`[[panels]] support`):
+/// `centre_clamp` (also `center_clamp`, the default), `central_patch`
+/// (with `patch_size`), `simply_supported` or `free_free`;
+/// [`Support::new`] gives the [`Support`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SupportKind {
+    /// [`Support::CentreClamp`].
+    #[default]
+    #[serde(alias = "center_clamp")]
+    CentreClamp,
+    /// [`Support::CentralPatch`] of `patch_size`.
+    CentralPatch,
+    /// [`Support::SimplySupported`].
+    SimplySupported,
+    /// [`Support::FreeFree`].
+    FreeFree,
+}
+
 /// Reference (boundary) condition of a panel for its modes (paper §6.2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Support {
@@ -27,7 +46,12 @@ pub enum Support {
     /// All nodes of the central rectangle |x| ≤ length/2, |y| ≤ width/2
     /// clamped (its corners must be mesh nodes: see
     /// [`Support::forced_points`]). Sizes in m.
-    CentralPatch { length: f64, width: f64 },
+    CentralPatch {
+        /// Side of the patch along x (m).
+        length: f64,
+        /// Side of the patch along y (m).
+        width: f64,
+    },
     /// Hard simple support on all four edges (Reddy's SS-1): w = 0,
     /// tangential displacement = 0 and rotation about the edge normal = 0
     /// (x = ±L/2: v = θx = 0; y = ±W/2: u = θy = 0).
@@ -38,19 +62,15 @@ pub enum Support {
 }
 
 impl Support {
-    /// Names accepted by [`Support::parse`].
-    pub const NAMES: &'static str =
-        "\"centre_clamp\", \"central_patch\", \"simply_supported\" or \"free_free\"";
-
-    /// Parse a study-file name; `patch` = [length, width] \[m\] is required
-    /// for (and only used by) "central_patch". Error keys: `support`,
+    /// The support of `kind`; `patch` = [length, width] \[m\] is required
+    /// for (and only used by) [`SupportKind::CentralPatch`]. Error keys:
     /// `patch_size`.
-    pub fn parse(name: &str, patch: Option<[f64; 2]>) -> Result<Support> {
-        match name {
-            "centre_clamp" | "center_clamp" => Ok(Support::CentreClamp),
-            "simply_supported" => Ok(Support::SimplySupported),
-            "free_free" => Ok(Support::FreeFree),
-            "central_patch" => {
+    pub fn new(kind: SupportKind, patch: Option<[f64; 2]>) -> Result<Support> {
+        match kind {
+            SupportKind::CentreClamp => Ok(Support::CentreClamp),
+            SupportKind::SimplySupported => Ok(Support::SimplySupported),
+            SupportKind::FreeFree => Ok(Support::FreeFree),
+            SupportKind::CentralPatch => {
                 let p = patch.ok_or_else(|| {
                     Error::input("patch_size", "(missing)", "[length, width] in m")
                 })?;
@@ -61,7 +81,6 @@ impl Support {
                     width: p[1],
                 })
             }
-            other => Err(Error::input("support", format!("\"{other}\""), Self::NAMES)),
         }
     }
 

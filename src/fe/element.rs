@@ -81,8 +81,11 @@ pub const SHEAR_DOF: [usize; 9] = [2, 3, 4, 8, 9, 10, 14, 15, 16];
 /// (2×9 on [`SHEAR_DOF`]). Every other entry of G is zero.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CompactOps {
+    /// Membrane strains (εxx, εyy, γxy) from the in-plane DOFs (1/m).
     pub gm: SMatrix<f64, 3, 6>,
+    /// Curvatures (κxx, κyy, κxy) from the rotation DOFs (1/m).
     pub gb: SMatrix<f64, 3, 6>,
+    /// Transverse shear strains (γxz, γyz) from w and the rotations.
     pub gs: SMatrix<f64, 2, 9>,
 }
 

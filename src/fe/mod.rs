@@ -67,7 +67,9 @@ pub mod element;
 pub mod mesh;
 pub mod spec;
 
-pub use assembly::{assemble, Derivatives, PanelModel, PanelSystem, Support, NODE_DOF};
+pub use assembly::{
+    assemble, Derivatives, PanelModel, PanelSystem, Support, SupportKind, NODE_DOF,
+};
 pub use element::{section_matrix, Triangle};
 pub use mesh::{Mesh, MeshParams};
 pub use spec::{panels_from_study, Panel, PanelSpec};

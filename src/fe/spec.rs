@@ -18,7 +18,7 @@
 //!
 //! Ply angles are in degrees in the file and radians after `resolve`.
 
-use super::assembly::{PanelModel, Support};
+use super::assembly::{PanelModel, Support, SupportKind};
 use super::mesh::{Mesh, MeshParams};
 use crate::error::{Error, Result};
 use crate::laminate::spec::{resolve_laminate, MaterialSpec, PlySpec};
@@ -36,10 +36,6 @@ pub const DEFAULT_DIVISIONS: usize = 64;
 
 fn default_divisions() -> usize {
     DEFAULT_DIVISIONS
-}
-
-fn default_support() -> String {
-    "centre_clamp".into()
 }
 
 /// One `[[panels]]` entry as written in a study file.
@@ -63,9 +59,10 @@ pub struct PanelSpec {
     /// centre) \[m\].
     #[serde(default)]
     pub attachment_points: Vec<[f64; 2]>,
-    /// Reference condition (default "centre_clamp", the paper's).
-    #[serde(default = "default_support")]
-    pub support: String,
+    /// Reference condition: `centre_clamp` (default, the paper's),
+    /// `central_patch`, `simply_supported` or `free_free`.
+    #[serde(default)]
+    pub support: SupportKind,
     /// [length, width] of the clamped patch for "central_patch" \[m\].
     pub patch_size: Option<[f64; 2]>,
     /// Design variables as lists of 1-based ply numbers (default: one per
@@ -77,10 +74,16 @@ pub struct PanelSpec {
 /// support.
 #[derive(Debug, Clone)]
 pub struct Panel {
+    /// The `[[panels]] name`.
     pub name: String,
+    /// The lay-up, angles in radians.
     pub laminate: Laminate,
+    /// Design variables → plies (0-based).
     pub design: DesignMap,
+    /// The structured mesh, with nodes at the attachment points, the
+    /// centre and the patch corners.
     pub mesh: Mesh,
+    /// The reference condition of the modes.
     pub support: Support,
 }
 
@@ -118,7 +121,7 @@ impl PanelSpec {
                 DesignMap::new(g0, n)?
             }
         };
-        let support = Support::parse(&self.support, self.patch_size)?;
+        let support = Support::new(self.support, self.patch_size)?;
         let mut points = self.attachment_points.clone();
         let n_attach = points.len();
         points.extend(support.forced_points());

@@ -146,6 +146,7 @@ impl Orthotropic {
 /// One ply: material, thickness \[m\] and angle \[rad\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ply {
+    /// Material of the ply.
     pub material: Orthotropic,
     /// Thickness \[m\].
     pub thickness: f64,
@@ -158,7 +159,9 @@ pub struct Ply {
 /// transverse shear C̄ (2×2, order γxz, γyz), unscaled by κ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlyStiffness {
+    /// In-plane Q̄ (or its derivative) \[Pa per rad^order\].
     pub q: Matrix3<f64>,
+    /// Transverse shear C̄ (or its derivative) \[Pa per rad^order\].
     pub g: Matrix2<f64>,
 }
 

@@ -10,12 +10,19 @@ use serde::Deserialize;
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
+    /// Young's modulus along the fibre (Pa).
     pub e1: f64,
+    /// Young's modulus across the fibre (Pa).
     pub e2: f64,
+    /// In-plane shear modulus (Pa).
     pub g12: f64,
+    /// Transverse shear modulus in the 1-3 plane (Pa).
     pub g13: f64,
+    /// Transverse shear modulus in the 2-3 plane (Pa).
     pub g23: f64,
+    /// Major Poisson's ratio ν12 (-).
     pub nu12: f64,
+    /// Density (kg/m³).
     pub rho: f64,
 }
 

@@ -78,8 +78,10 @@ pub struct DesignDerivative<'a> {
     pub d2k: Option<&'a SparseColMat<usize, f64>>,
 }
 
-/// Which approach of §3.1 (Haftka and Gürdal) is used.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which approach of §3.1 (Haftka and Gürdal) is used; written `fixed` or
+/// `updated` in study files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ModeUpdate {
     /// Fixed-mode approach (Eq. 19): eigenvectors kept, only `λ'`.
     Fixed,
@@ -88,15 +90,6 @@ pub enum ModeUpdate {
 }
 
 impl ModeUpdate {
-    /// The approach named as in study files: `"fixed"` or `"updated"`.
-    pub fn parse(name: &str) -> Option<ModeUpdate> {
-        match name {
-            "fixed" => Some(ModeUpdate::Fixed),
-            "updated" => Some(ModeUpdate::Updated),
-            _ => None,
-        }
-    }
-
     /// The name written in study files and reports.
     pub fn name(&self) -> &'static str {
         match self {

@@ -90,6 +90,8 @@ mod lanczos;
 mod modes;
 mod solver;
 mod sparse;
+#[cfg(test)]
+mod tests;
 
 pub use derivatives::{
     Cluster, DerivativeOptions, DesignDerivative, ModeUpdate, VariableDerivatives,

@@ -103,8 +103,10 @@ pub struct CmaesOptions {
     pub feasibility_tolerance: f64,
 }
 
-/// Restart schedule of [`Cmaes`] (module doc for the formulas).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// Restart schedule of [`Cmaes`] (module doc for the formulas); written
+/// `ipop` or `bipop` in study files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Restarts {
     /// Every restart multiplies the population by `popsize_factor`.
     #[default]
@@ -114,20 +116,26 @@ pub enum Restarts {
 }
 
 impl Restarts {
-    /// Names as written in study files.
+    /// Every schedule.
+    pub const ALL: [Restarts; 2] = [Restarts::Ipop, Restarts::Bipop];
+
+    /// Names as written in study files, for messages (the serde names;
+    /// a test checks them against [`Restarts::ALL`]).
     pub const NAMES: &'static str = "ipop, bipop";
 
-    /// Parse a study-file name; the error names the key `restarts`.
+    /// The schedule written `name`, by its serde name (for values that
+    /// are not deserialized as a whole, e.g. one of a list); the error
+    /// names the key `restarts` and lists [`Restarts::NAMES`].
     pub fn parse(name: &str) -> Result<Restarts> {
-        match name {
-            "ipop" => Ok(Restarts::Ipop),
-            "bipop" => Ok(Restarts::Bipop),
-            other => Err(Error::input(
+        use serde::de::{value, Deserialize, IntoDeserializer};
+        let de: value::StrDeserializer<'_, value::Error> = name.into_deserializer();
+        Restarts::deserialize(de).map_err(|_| {
+            Error::input(
                 "restarts",
-                format!("\"{other}\""),
+                format!("\"{name}\""),
                 format!("one of {}", Restarts::NAMES),
-            )),
-        }
+            )
+        })
     }
 
     /// Name as written in study files.
@@ -789,6 +797,22 @@ pub fn minimize(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The message list is the serde names of every schedule, and each
+    /// parses back; an unknown name lists them.
+    #[test]
+    fn restart_names_are_the_serde_names() {
+        let names: Vec<&str> = Restarts::ALL.iter().map(|r| r.name()).collect();
+        assert_eq!(names.join(", "), Restarts::NAMES);
+        for r in Restarts::ALL {
+            assert_eq!(Restarts::parse(r.name()).unwrap(), r);
+        }
+        let e = Restarts::parse("ipopp").unwrap_err().to_string();
+        assert!(
+            e.contains("`restarts` = \"ipopp\"") && e.contains("ipop, bipop"),
+            "{e}"
+        );
+    }
 
     /// Hansen (2016) Table 1 identities: positive decreasing weights that
     /// sum to 1, `1 <= μ_eff <= μ`, learning rates with `c_1 + c_μ <= 1`;

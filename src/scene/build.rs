@@ -5,21 +5,27 @@
 
 use super::parts::{
     finite3, flexible_body, make_marker, parse_energy, parse_param, parse_quantity, PanelBases,
+    ParamKind,
 };
-use super::quantity::{Quantity, Response};
+use super::quantity::{Columns, Quantity, Response};
 use super::spec::{Effect, JointSpec, SceneSpec};
 use crate::error::{Error, Result};
 use crate::integrate::{Options, SensitivityForm};
 use crate::mbs::math::{axis_angle, frame_from_axis};
 use crate::mbs::model::{Body, Drive, Integral, Joint, JointKind, Model, Param};
+use crate::mbs::responses::ResponseKind;
 use nalgebra::{Matrix3, Vector3};
 
 /// A built scene: the system model, integrator options and outputs.
 #[derive(Debug)]
 pub struct Scene {
+    /// The multibody model.
     pub model: Model,
+    /// Integrator options (method, tolerances, output times, events).
     pub options: Options,
+    /// Output columns: the name as written and what it is.
     pub outputs: Vec<(String, Quantity)>,
+    /// The plotted output's name, if any.
     pub plot: Option<String>,
     /// File stem of the plot (`<plot_file>.svg`).
     pub plot_file: Option<String>,
@@ -74,7 +80,7 @@ impl SceneSpec {
             outputs,
             plot: self.outputs.plot.clone(),
             plot_file: self.outputs.plot_file.clone(),
-            effects: self.effect_list()?,
+            effects: self.effects.clone(),
             params,
             responses,
         })
@@ -82,12 +88,11 @@ impl SceneSpec {
 
     /// Whether the scene lists effect `e`.
     pub(super) fn has(&self, e: Effect) -> bool {
-        self.effects.iter().any(|x| x == e.name())
+        self.effects.contains(&e)
     }
 
-    /// Known effects and a valid Baumgarte rate.
+    /// A valid Baumgarte rate (the effects are checked by serde).
     fn check_settings(&self) -> Result<()> {
-        self.effect_list()?;
         if !(self.baumgarte >= 0.0 && self.baumgarte.is_finite()) {
             return Err(Error::input(
                 "baumgarte",
@@ -262,23 +267,14 @@ impl SceneSpec {
             ));
         }
         if let Some(p) = &self.outputs.plot {
-            match parse_quantity(model, flex_names, "outputs.plot", p)? {
-                Quantity::Angle(_)
-                | Quantity::Rate(_)
-                | Quantity::Displacement(_)
-                | Quantity::Velocity(_)
-                | Quantity::Strain(_)
-                | Quantity::Kinetic(_)
-                | Quantity::Energy
-                | Quantity::Violation => {}
-                _ => {
-                    return Err(Error::input(
-                        "outputs.plot",
-                        p,
-                        "a scalar output (angle, rate, displacement, velocity, strain or \
-                         kinetic energy, energy, violation)",
-                    ))
-                }
+            let plotted = parse_quantity(model, flex_names, "outputs.plot", p)?;
+            if plotted.kind.info().columns != Columns::One {
+                return Err(Error::input(
+                    "outputs.plot",
+                    p,
+                    "a scalar output (angle, rate, displacement, velocity, strain or \
+                     kinetic energy, energy, violation)",
+                ));
             }
         }
         if let Some(f) = &self.outputs.plot_file {
@@ -316,10 +312,10 @@ impl SceneSpec {
                 Error::input(
                     &key,
                     name,
-                    "<body>.mass (rigid body), <body>.design.<variable> (flexible body), \
-                 <force name>.stiffness, <force name>.damping, forces[i].stiffness, \
-                 forces[i].damping or forces[i].segments[k].anchor of a force the effects \
-                 list builds",
+                    format!(
+                        "{} of a force the effects list builds",
+                        ParamKind::accepted()
+                    ),
                 )
             })?;
             if params.iter().any(|(_, q)| *q == p) {
@@ -367,22 +363,19 @@ impl SceneSpec {
                     "at least one energy",
                 ));
             }
-            let (name, scale) = (r.name.clone(), r.scale);
-            out.push(match r.kind.as_str() {
-                "integral" => {
-                    model.integrals.push(Integral { terms, scale });
-                    let index = model.integrals.len() - 1;
-                    Response::Integral { name, index }
-                }
-                "peak" => Response::Peak { name, terms, scale },
-                "final" => Response::Final { name, terms, scale },
-                other => {
-                    return Err(Error::input(
-                        format!("{key}.kind"),
-                        other,
-                        "integral, peak or final",
-                    ));
-                }
+            let integral = (r.kind == ResponseKind::Integral).then(|| {
+                model.integrals.push(Integral {
+                    terms: terms.clone(),
+                    scale: r.scale,
+                });
+                model.integrals.len() - 1
+            });
+            out.push(Response {
+                name: r.name.clone(),
+                kind: r.kind,
+                terms,
+                scale: r.scale,
+                integral,
             });
         }
         Ok(out)

@@ -104,8 +104,8 @@ impl ScenePlan {
     /// `update` from now on (overrides each body's `derivatives`).
     pub fn set_mode_update(&mut self, update: ModeUpdate) {
         for b in &mut self.spec.bodies {
-            if let Some(f) = b.flexible.as_mut().filter(|f| f.derivatives_name.is_some()) {
-                f.derivatives_name = Some(update.name().to_string());
+            if let Some(f) = b.flexible.as_mut().filter(|f| f.derivatives.is_some()) {
+                f.derivatives = Some(update);
             }
         }
     }
@@ -121,9 +121,9 @@ impl ScenePlan {
             .bodies
             .iter()
             .filter(|b| {
-                b.flexible.as_ref().is_some_and(|f| {
-                    f.kind("").ok() == Some(FlexKind::Panel) && f.panel.as_deref() == Some(panel)
-                })
+                b.flexible
+                    .as_ref()
+                    .is_some_and(|f| f.kind == FlexKind::Panel && f.panel.as_deref() == Some(panel))
             })
             .map(|b| b.name.as_str())
             .collect()

@@ -10,8 +10,11 @@
 //!
 //! Where things go: a new joint type is a [`crate::mbs::JointKind`]
 //! variant with its row blocks (`JointKind::blocks`, see [`crate::mbs`]),
-//! given a `type` name in [`build`] (`joint_kind`); a new output or response is a [`Quantity`] /
-//! [`Response`] variant parsed in [`parts`] and evaluated in
+//! given a `type` name in [`build`] (`joint_kind`); a new output is a
+//! [`QuantityKind`] variant with its row of [`QuantityKind::info`] (name,
+//! subject, unit, columns, sensitivities) and its evaluation in
+//! [`crate::simulate`]; a new response kind is a
+//! [`crate::mbs::responses::ResponseKind`] variant and its evaluation in
 //! [`crate::simulate`].
 //!
 //!
@@ -69,7 +72,7 @@
 //! a horizontal hinge about y, released horizontally):
 //!
 //! ```
-//! use plyscape::scene::{Quantity, SceneSpec};
+//! use plyscape::scene::{Quantity, QuantityKind, SceneSpec};
 //! use plyscape::study::Study;
 //!
 //! let text = r#"
@@ -97,7 +100,7 @@
 //! let spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
 //! let scene = spec.build()?;
 //! assert_eq!(scene.model.bodies.len(), 1);
-//! assert_eq!(scene.outputs[0].1, Quantity::Angle(0));
+//! assert_eq!(scene.outputs[0].1, Quantity::new(QuantityKind::Angle, 0));
 //! assert_eq!(scene.outputs[0].1.headers("hinge.angle"), ["hinge.angle [rad]"]);
 //! # Ok::<(), plyscape::Error>(())
 //! ```
@@ -112,5 +115,5 @@ pub mod spec;
 pub use build::Scene;
 pub use load::{load_scene, BuildProfile, ScenePlan};
 pub use parts::PanelBases;
-pub use quantity::{Quantity, Response};
+pub use quantity::{Quantity, QuantityKind, Response};
 pub use spec::{Effect, SceneSpec};

@@ -2,7 +2,7 @@
 //! and outputs, markers (snapped to flexible nodes), load tables and
 //! flexible bodies.
 
-use super::quantity::Quantity;
+use super::quantity::{Columns, Quantity, QuantityKind, Subject};
 use super::spec::{FlexKind, FlexSpec, ForceSpec};
 use crate::beams::Beam;
 use crate::error::{Error, Result};
@@ -29,6 +29,58 @@ pub(crate) fn finite3(key: String, a: [f64; 3]) -> Result<Vector3<f64>> {
     }
 }
 
+/// The kinds of sensitivity parameter, by the last part of their dotted
+/// name: `<body>.mass`, `<force>.stiffness`, `<force>.damping`,
+/// `<body>.design.<variable>`, `forces[i].segments[k].anchor`. The one
+/// table of these names: [`parse_param`] and its message follow from it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum ParamKind {
+    /// Mass of a rigid body (kg).
+    Mass,
+    /// Stiffness of a spring (N/m or N·m/rad).
+    Stiffness,
+    /// Damping of a spring or an actuator (N·s/m or N·m·s/rad).
+    Damping,
+    /// A ply-angle design variable of a flexible panel body (rad).
+    Design,
+    /// Anchor of a segment of an actuator's law.
+    Anchor,
+}
+
+impl ParamKind {
+    /// Every kind.
+    const ALL: [ParamKind; 5] = [
+        ParamKind::Mass,
+        ParamKind::Stiffness,
+        ParamKind::Damping,
+        ParamKind::Design,
+        ParamKind::Anchor,
+    ];
+
+    /// The name part as written in study files, and the forms it is
+    /// written in (for messages).
+    fn info(self) -> (&'static str, &'static str) {
+        match self {
+            ParamKind::Mass => ("mass", "<body>.mass (rigid body)"),
+            ParamKind::Stiffness => ("stiffness", "<force name>.stiffness, forces[i].stiffness"),
+            ParamKind::Damping => ("damping", "<force name>.damping, forces[i].damping"),
+            ParamKind::Design => ("design", "<body>.design.<variable> (flexible body)"),
+            ParamKind::Anchor => ("anchor", "forces[i].segments[k].anchor"),
+        }
+    }
+
+    /// The kind written `name`.
+    fn find(name: &str) -> Option<ParamKind> {
+        ParamKind::ALL.into_iter().find(|k| k.info().0 == name)
+    }
+
+    /// The accepted parameter names, for messages.
+    pub(super) fn accepted() -> String {
+        let forms: Vec<&str> = ParamKind::ALL.iter().map(|k| k.info().1).collect();
+        forms.join(", ")
+    }
+}
+
 /// A sensitivity parameter name → [`Param`], if it names an existing,
 /// built model value.
 /// Segment indices are those of the scene file; the model's law is sorted
@@ -39,23 +91,27 @@ pub(super) fn parse_param(
     force_index: &[Option<usize>],
     name: &str,
 ) -> Option<Param> {
-    if let Some(body) = name.strip_suffix(".mass") {
-        let b = model.body(body)?;
-        return model.bodies[b].flex.is_none().then_some(Param::Mass(b));
-    }
-    for (suffix, which) in [
-        (".stiffness", Param::Stiffness as fn(usize) -> Param),
-        (".damping", Param::Damping),
-    ] {
-        let Some(force) = name.strip_suffix(suffix) else {
-            continue;
-        };
-        if let Some(k) = forces.iter().position(|f| f.name() == Some(force)) {
-            let p = which((*force_index.get(k)?)?);
-            return p.value(model).map(|_| p);
+    let (head, last) = name.rsplit_once('.')?;
+    let spring = |kind: ParamKind, fi: usize| match kind {
+        ParamKind::Stiffness => Some(Param::Stiffness(fi)),
+        ParamKind::Damping => Some(Param::Damping(fi)),
+        _ => None,
+    };
+    match ParamKind::find(last) {
+        Some(ParamKind::Mass) => {
+            let b = model.body(head)?;
+            return model.bodies[b].flex.is_none().then_some(Param::Mass(b));
         }
+        Some(kind @ (ParamKind::Stiffness | ParamKind::Damping)) => {
+            if let Some(k) = forces.iter().position(|f| f.name() == Some(head)) {
+                let p = spring(kind, (*force_index.get(k)?)?)?;
+                return p.value(model).map(|_| p);
+            }
+        }
+        _ => {}
     }
-    if let Some((body, var)) = name.split_once(".design.") {
+    let design = format!(".{}.", ParamKind::Design.info().0);
+    if let Some((body, var)) = name.split_once(design.as_str()) {
         let b = model.body(body)?;
         let flex = model.bodies[b].flex.as_ref()?;
         let k = flex.basis.derivatives.iter().position(|d| d.name == var)?;
@@ -65,15 +121,14 @@ pub(super) fn parse_param(
     let (idx, rest) = rest.split_once(']')?;
     let k_spec = idx.parse::<usize>().ok()?;
     let fi = (*force_index.get(k_spec)?)?;
-    let p = match rest {
-        ".stiffness" => Param::Stiffness(fi),
-        ".damping" => Param::Damping(fi),
+    let p = match rest.strip_prefix('.').and_then(ParamKind::find) {
+        Some(kind @ (ParamKind::Stiffness | ParamKind::Damping)) => spring(kind, fi)?,
         _ => {
-            let seg: usize = rest
-                .strip_prefix(".segments[")?
-                .strip_suffix("].anchor")?
-                .parse()
-                .ok()?;
+            let (seg, kind) = rest.strip_prefix(".segments[")?.rsplit_once("].")?;
+            if ParamKind::find(kind)? != ParamKind::Anchor {
+                return None;
+            }
+            let seg: usize = seg.parse().ok()?;
             let ForceSpec::Actuator { segments, .. } = forces.get(k_spec)? else {
                 return None;
             };
@@ -91,83 +146,58 @@ pub(super) fn parse_param(
     p.value(model).map(|_| p)
 }
 
-/// An output name → [`Quantity`]. Bodies named in `flex_names` have a
-/// `flexible` table: their modal outputs stay valid when the scene runs
-/// them rigid (no columns for `modal`, zero strain energy and deflection).
+/// An output name → [`Quantity`], by the table of [`QuantityKind`]. Bodies
+/// named in `flex_names` have a `flexible` table: their modal outputs stay
+/// valid when the scene runs them rigid (no columns for `modal`, zero
+/// strain energy and deflection).
 pub(super) fn parse_quantity(
     model: &Model,
     flex_names: &[&str],
     key: &str,
     q: &str,
 ) -> Result<Quantity> {
-    match q {
-        "energy" => return Ok(Quantity::Energy),
-        "violation" => return Ok(Quantity::Violation),
-        "kinetic_energy" => return Ok(Quantity::Kinetic(None)),
-        _ => {}
+    if let Some(kind) = QuantityKind::find(q, false) {
+        return Ok(Quantity::new(kind, 0));
     }
-    let bad = || {
-        Error::input(
-            key,
-            q,
-            "energy, violation, <joint>.angle|rate|reaction, \
-             <prismatic or cylindrical joint>.displacement|velocity, <body>.position, \
-             kinetic_energy, <body>.kinetic_energy, <flexible body>.modal|strain_energy or \
-             <marker on a flexible node>.deflection",
-        )
-    };
+    let bad = || Error::input(key, q, QuantityKind::accepted());
     let (name, what) = q.rsplit_once('.').ok_or_else(bad)?;
-    match what {
-        "displacement" | "velocity" => {
+    let kind = QuantityKind::find(what, true).ok_or_else(bad)?;
+    let mut out = Quantity::new(kind, 0);
+    out.of = match kind.info().subject {
+        Subject::Scene => return Err(bad()),
+        subject @ (Subject::AngleJoint | Subject::SlideJoint | Subject::Joint) => {
             let j = model.joint(name).ok_or_else(bad)?;
-            if !model.joints[j].kind.has_slide() {
+            let joint = &model.joints[j].kind;
+            if subject == Subject::SlideJoint && !joint.has_slide() {
                 return Err(Error::input(
                     key,
                     q,
                     "a displacement or velocity of a prismatic or cylindrical joint",
                 ));
             }
-            Ok(match what {
-                "displacement" => Quantity::Displacement(j),
-                _ => Quantity::Velocity(j),
-            })
-        }
-        "angle" | "rate" | "reaction" => {
-            let j = model.joint(name).ok_or_else(bad)?;
-            if what != "reaction" && !model.joints[j].kind.has_angle() {
+            if subject == Subject::AngleJoint && !joint.has_angle() {
                 return Err(Error::input(
                     key,
                     q,
                     "an angle or rate of a revolute, locked or driven joint",
                 ));
             }
-            Ok(match what {
-                "angle" => Quantity::Angle(j),
-                "rate" => Quantity::Rate(j),
-                _ => Quantity::Reaction(j),
-            })
+            j
         }
-        "position" => {
-            let b = model.body(name).ok_or_else(bad)?;
-            Ok(Quantity::Position(b))
-        }
-        "kinetic_energy" => {
-            let b = model.body(name).ok_or_else(bad)?;
-            Ok(Quantity::Kinetic(Some(b)))
-        }
-        "modal" | "strain_energy" => {
+        Subject::Body => model.body(name).ok_or_else(bad)?,
+        Subject::FlexBody => {
             let b = model.body(name).ok_or_else(bad)?;
             let n = match &model.bodies[b].flex {
                 Some(f) => f.n(),
                 None if flex_names.contains(&name) => 0,
                 None => return Err(bad()),
             };
-            Ok(match what {
-                "modal" => Quantity::Modal(b, n),
-                _ => Quantity::Strain(b),
-            })
+            if kind.info().columns == Columns::Modes {
+                out.modes = n;
+            }
+            b
         }
-        "deflection" => {
+        Subject::FlexMarker => {
             let m = model.marker(name).ok_or_else(bad)?;
             let on_flex = model.markers[m]
                 .body
@@ -175,26 +205,28 @@ pub(super) fn parse_quantity(
             if model.markers[m].node.is_none() && !on_flex {
                 return Err(bad());
             }
-            Ok(Quantity::Deflection(m))
+            m
         }
-        _ => Err(bad()),
-    }
+    };
+    Ok(out)
 }
 
-/// An energy name → its terms: `kinetic_energy` (every moving body),
-/// `<body>.kinetic_energy`, or `<body>.strain_energy` of a body named in
-/// `flex_names` (a `flexible` table; zero when the scene runs it rigid).
+/// An energy name → its terms, by the table of [`QuantityKind`]:
+/// `kinetic_energy` (every moving body), `<body>.kinetic_energy`, or
+/// `<body>.strain_energy` of a body named in `flex_names` (a `flexible`
+/// table; zero when the scene runs it rigid).
 pub(super) fn parse_energy(model: &Model, flex_names: &[&str], q: &str) -> Option<Vec<Energy>> {
-    if q == "kinetic_energy" {
+    if QuantityKind::find(q, false) == Some(QuantityKind::TotalKineticEnergy) {
         return Some(Energy::kinetic_total(model));
     }
-    if let Some(b) = q.strip_suffix(".kinetic_energy") {
-        return Some(vec![Energy::Kinetic(model.body(b)?)]);
+    let (b, what) = q.rsplit_once('.')?;
+    match QuantityKind::find(what, true)? {
+        QuantityKind::KineticEnergy => Some(vec![Energy::Kinetic(model.body(b)?)]),
+        QuantityKind::StrainEnergy if flex_names.contains(&b) => {
+            Some(vec![Energy::Strain(model.body(b)?)])
+        }
+        _ => None,
     }
-    let b = q
-        .strip_suffix(".strain_energy")
-        .filter(|b| flex_names.contains(b))?;
-    Some(vec![Energy::Strain(model.body(b)?)])
 }
 
 /// A marker `(name, body)` at the global point `p` with global frame
@@ -299,7 +331,7 @@ pub(super) fn flexible_body(
             "a modal damping ratio in [0, 1)",
         ));
     }
-    let basis = match f.kind(&fk)? {
+    let basis = match f.kind {
         FlexKind::Beam => beam_basis(&fk, f)?,
         FlexKind::Panel => {
             let panel = f.panel.as_deref().ok_or_else(|| {
@@ -319,7 +351,7 @@ pub(super) fn flexible_body(
                     "a rigid-body content share in (0, 1] (1 keeps every mode)",
                 ));
             }
-            panels(panel, f.modes, f.derivatives(&fk)?)
+            panels(panel, f.modes, f.derivatives)
                 .map_err(|e| match e {
                     // The mode count is this body's key, not the panel's.
                     Error::Input { key, expected, .. } if key.ends_with("n_modes") => {

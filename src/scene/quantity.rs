@@ -1,63 +1,262 @@
 //! The output plan of a scene: output columns ([`Quantity`]) and
 //! response functionals ([`Response`]) resolved to model indices.
+//!
+//! Every kind of output is registered once, in [`QuantityKind`]: its name
+//! as written in study files, what the head of a dotted name must be, its
+//! SI unit, its column layout and whether it has sensitivities
+//! ([`QuantityKind::info`]). Parsing (`super::parts`), the CSV headers
+//! ([`Quantity::headers`]) and the choice of sensitivity columns follow
+//! from that table; adding an output is one variant, its row of the table
+//! and its evaluation in `crate::simulate`. Response kinds are
+//! [`ResponseKind`] (integral, peak, final), deserialized directly from
+//! `[[scene.responses]] kind`.
 
+use crate::mbs::responses::ResponseKind;
 use crate::mbs::Energy;
 
-/// A built response: a functional of a sum of energies over the run.
+/// A built response: `scale · Σ terms` over the run, reduced by its kind
+/// (the time integral, the peak or the final value).
 #[derive(Debug, Clone, PartialEq)]
-pub enum Response {
-    /// `∫ scale·Σ terms dt`: index into [`crate::mbs::Model::integrals`].
-    Integral { name: String, index: usize },
-    /// `max_t scale·Σ terms(t)` at its critical time point.
-    Peak {
-        name: String,
-        terms: Vec<Energy>,
-        scale: f64,
-    },
-    /// `scale·Σ terms` at the end time.
-    Final {
-        name: String,
-        terms: Vec<Energy>,
-        scale: f64,
-    },
+pub struct Response {
+    /// The `[[scene.responses]] name`.
+    pub name: String,
+    /// Integral over the run, peak or final value.
+    pub kind: ResponseKind,
+    /// The energies summed.
+    pub terms: Vec<Energy>,
+    /// Dimensionless factor of the sum.
+    pub scale: f64,
+    /// For [`ResponseKind::Integral`]: index of its integrated state in
+    /// [`crate::mbs::Model::integrals`] (`None` for the other kinds).
+    pub integral: Option<usize>,
 }
 
 impl Response {
     /// The response's name.
     pub fn name(&self) -> &str {
+        &self.name
+    }
+}
+
+/// What the head of an output name `<head>.<kind>` must name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Subject {
+    /// The whole scene: the output is written as the kind's name alone
+    /// (`energy`).
+    Scene,
+    /// A revolute, locked or driven joint (one with a relative angle).
+    AngleJoint,
+    /// A prismatic or cylindrical joint (one with a displacement).
+    SlideJoint,
+    /// Any joint.
+    Joint,
+    /// Any body.
+    Body,
+    /// A body with a `flexible` table.
+    FlexBody,
+    /// A marker on a node of a flexible body.
+    FlexMarker,
+}
+
+impl Subject {
+    /// How the head is written in messages (`<joint>`), empty for
+    /// [`Subject::Scene`].
+    pub fn placeholder(self) -> &'static str {
         match self {
-            Response::Integral { name, .. }
-            | Response::Peak { name, .. }
-            | Response::Final { name, .. } => name,
+            Subject::Scene => "",
+            Subject::AngleJoint => "<revolute, locked or driven joint>",
+            Subject::SlideJoint => "<prismatic or cylindrical joint>",
+            Subject::Joint => "<joint>",
+            Subject::Body => "<body>",
+            Subject::FlexBody => "<flexible body>",
+            Subject::FlexMarker => "<marker on a flexible node>",
         }
     }
 }
 
-/// One output column.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Quantity {
-    Angle(usize),
-    Rate(usize),
-    /// Displacement of a prismatic or cylindrical joint along its axis (m).
-    Displacement(usize),
-    /// Its rate (m/s).
-    Velocity(usize),
-    /// Reaction force (3) and torque (3) of a joint.
-    Reaction(usize),
-    /// Global position of a body's centre of mass (of a flexible body:
-    /// of its frame origin).
-    Position(usize),
-    /// Modal coordinates `w` of a flexible body (body, n: n columns).
-    Modal(usize, usize),
-    /// Strain energy `½ wᵀΛw` of a flexible body (J).
-    Strain(usize),
-    /// Kinetic energy of a body, or of all bodies (`None`) (J).
-    Kinetic(Option<usize>),
-    /// Elastic displacement `Φ_k w` of a marker on a flexible node, in
-    /// the body's frame axes (m).
-    Deflection(usize),
+/// The columns an output writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Columns {
+    /// One column `<name> [unit]`.
+    One,
+    /// Three columns `<name>_x|y|z [unit]` (global or body-frame axes).
+    Xyz,
+    /// Force and torque: `<joint>.force_x|y|z [N]`, `<joint>.torque_x|y|z
+    /// [N*m]`.
+    ForceTorque,
+    /// One column per mode of the body, `<name>_1.. [unit]`.
+    Modes,
+}
+
+/// The table row of a [`QuantityKind`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KindInfo {
+    /// The name as written in study files: the whole output name for
+    /// [`Subject::Scene`], else the part after the last dot.
+    pub name: &'static str,
+    /// What the head of the name must be.
+    pub subject: Subject,
+    /// SI unit written in the CSV header.
+    pub unit: &'static str,
+    /// Column layout.
+    pub columns: Columns,
+    /// Whether `sensitivities.csv` has its derivatives.
+    pub sensitivity: bool,
+}
+
+/// Every kind of output column (`[scene.outputs] quantities`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum QuantityKind {
+    /// `<joint>.angle`: relative rotation of a revolute, locked or driven
+    /// joint (rad), unwrapped to be continuous over the run.
+    Angle,
+    /// `<joint>.rate`: its rate (rad/s).
+    Rate,
+    /// `<joint>.displacement`: displacement of a prismatic or cylindrical
+    /// joint along its axis (m).
+    Displacement,
+    /// `<joint>.velocity`: its rate (m/s).
+    Velocity,
+    /// `<joint>.reaction`: reaction force (N) and torque (N·m) of a joint.
+    Reaction,
+    /// `<body>.position`: global position of a body's centre of mass (of a
+    /// flexible body: of its frame origin) (m).
+    Position,
+    /// `<body>.modal`: modal coordinates `w` of a flexible body (kg^0.5·m).
+    Modal,
+    /// `<body>.strain_energy`: `½ wᵀΛw` of a flexible body (J).
+    StrainEnergy,
+    /// `<body>.kinetic_energy`: kinetic energy of one body (J).
+    KineticEnergy,
+    /// `kinetic_energy`: kinetic energy of all bodies (J).
+    TotalKineticEnergy,
+    /// `<marker>.deflection`: elastic displacement `Φ_k w` of a marker on a
+    /// flexible node, in the body's frame axes (m).
+    Deflection,
+    /// `energy`: total mechanical energy (J).
     Energy,
+    /// `violation`: largest `|Φ|` of the position constraints (m or rad).
     Violation,
+}
+
+impl QuantityKind {
+    /// Every kind, in the order of the documentation and of messages.
+    pub const ALL: [QuantityKind; 13] = [
+        QuantityKind::Energy,
+        QuantityKind::Violation,
+        QuantityKind::TotalKineticEnergy,
+        QuantityKind::Angle,
+        QuantityKind::Rate,
+        QuantityKind::Reaction,
+        QuantityKind::Displacement,
+        QuantityKind::Velocity,
+        QuantityKind::Position,
+        QuantityKind::KineticEnergy,
+        QuantityKind::Modal,
+        QuantityKind::StrainEnergy,
+        QuantityKind::Deflection,
+    ];
+
+    /// The table: name, subject, unit, columns and sensitivities of each
+    /// kind.
+    pub fn info(self) -> KindInfo {
+        use Columns::*;
+        use Subject::*;
+        let row = |name, subject, unit, columns, sensitivity| KindInfo {
+            name,
+            subject,
+            unit,
+            columns,
+            sensitivity,
+        };
+        match self {
+            QuantityKind::Angle => row("angle", AngleJoint, "rad", One, true),
+            QuantityKind::Rate => row("rate", AngleJoint, "rad/s", One, true),
+            QuantityKind::Displacement => row("displacement", SlideJoint, "m", One, true),
+            QuantityKind::Velocity => row("velocity", SlideJoint, "m/s", One, true),
+            QuantityKind::Reaction => row("reaction", Joint, "N, N*m", ForceTorque, false),
+            QuantityKind::Position => row("position", Body, "m", Xyz, true),
+            QuantityKind::Modal => row("modal", FlexBody, "kg^0.5*m", Modes, true),
+            QuantityKind::StrainEnergy => row("strain_energy", FlexBody, "J", One, true),
+            QuantityKind::KineticEnergy => row("kinetic_energy", Body, "J", One, true),
+            QuantityKind::TotalKineticEnergy => row("kinetic_energy", Scene, "J", One, true),
+            QuantityKind::Deflection => row("deflection", FlexMarker, "m", Xyz, true),
+            QuantityKind::Energy => row("energy", Scene, "J", One, false),
+            QuantityKind::Violation => row("violation", Scene, "m|rad", One, false),
+        }
+    }
+
+    /// The kind an output name is written with: `name` alone for the
+    /// whole scene (`dotted = false`), else the part after the last dot.
+    pub fn find(name: &str, dotted: bool) -> Option<QuantityKind> {
+        QuantityKind::ALL.into_iter().find(|k| {
+            let i = k.info();
+            i.name == name && (i.subject != Subject::Scene) == dotted
+        })
+    }
+
+    /// The accepted output names, for messages: `energy, ..,
+    /// <joint>.reaction, ..`.
+    pub fn accepted() -> String {
+        let names: Vec<String> = QuantityKind::ALL
+            .iter()
+            .map(|k| {
+                let i = k.info();
+                match i.subject {
+                    Subject::Scene => i.name.to_string(),
+                    s => format!("{}.{}", s.placeholder(), i.name),
+                }
+            })
+            .collect();
+        names.join(", ")
+    }
+}
+
+/// One output column group: a kind of output of one joint, body or marker
+/// (`of`, an index into the model's list; 0 for the whole scene).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Quantity {
+    /// What is written.
+    pub kind: QuantityKind,
+    /// Index of the joint, body or marker the output is of (0 for
+    /// [`Subject::Scene`] kinds).
+    pub of: usize,
+    /// Number of columns of a [`Columns::Modes`] output (the body's modes;
+    /// 0 when the scene runs the body rigid); 0 otherwise.
+    pub modes: usize,
+}
+
+impl Quantity {
+    /// An output of `kind` of joint, body or marker `of`.
+    pub fn new(kind: QuantityKind, of: usize) -> Quantity {
+        Quantity { kind, of, modes: 0 }
+    }
+
+    /// CSV column headers with SI units.
+    pub fn headers(&self, label: &str) -> Vec<String> {
+        const XYZ: [&str; 3] = ["x", "y", "z"];
+        let info = self.kind.info();
+        let unit = info.unit;
+        match info.columns {
+            Columns::One => vec![format!("{label} [{unit}]")],
+            Columns::Xyz => XYZ
+                .iter()
+                .map(|c| format!("{label}_{c} [{unit}]"))
+                .collect(),
+            Columns::ForceTorque => {
+                let base = label.trim_end_matches(".reaction");
+                let mut h: Vec<String> = XYZ
+                    .iter()
+                    .map(|c| format!("{base}.force_{c} [N]"))
+                    .collect();
+                h.extend(XYZ.iter().map(|c| format!("{base}.torque_{c} [N*m]")));
+                h
+            }
+            Columns::Modes => (1..=self.modes)
+                .map(|j| format!("{label}_{j} [{unit}]"))
+                .collect(),
+        }
+    }
 }
 
 /// Is the output name `name` one of the one-column forms (`energy`,
@@ -65,56 +264,9 @@ pub enum Quantity {
 /// `<body>.strain_energy|kinetic_energy`)? By its form only: whether the
 /// joint or body exists is known when the scene is built.
 pub fn scalar_output(name: &str) -> bool {
-    const WHOLE: [&str; 3] = ["energy", "violation", "kinetic_energy"];
-    const SUFFIXES: [&str; 6] = [
-        "angle",
-        "rate",
-        "displacement",
-        "velocity",
-        "strain_energy",
-        "kinetic_energy",
-    ];
-    WHOLE.contains(&name)
-        || name
-            .rsplit_once('.')
-            .is_some_and(|(head, what)| !head.is_empty() && SUFFIXES.contains(&what))
-}
-
-impl Quantity {
-    /// CSV column headers with SI units.
-    pub fn headers(&self, label: &str) -> Vec<String> {
-        match self {
-            Quantity::Angle(_) => vec![format!("{label} [rad]")],
-            Quantity::Rate(_) => vec![format!("{label} [rad/s]")],
-            Quantity::Displacement(_) => vec![format!("{label} [m]")],
-            Quantity::Velocity(_) => vec![format!("{label} [m/s]")],
-            Quantity::Reaction(_) => {
-                let base = label.trim_end_matches(".reaction");
-                let mut h: Vec<String> = ["x", "y", "z"]
-                    .iter()
-                    .map(|c| format!("{base}.force_{c} [N]"))
-                    .collect();
-                h.extend(
-                    ["x", "y", "z"]
-                        .iter()
-                        .map(|c| format!("{base}.torque_{c} [N*m]")),
-                );
-                h
-            }
-            Quantity::Position(_) => ["x", "y", "z"]
-                .iter()
-                .map(|c| format!("{label}_{c} [m]"))
-                .collect(),
-            Quantity::Modal(_, n) => (1..=*n)
-                .map(|j| format!("{label}_{j} [kg^0.5*m]"))
-                .collect(),
-            Quantity::Strain(_) | Quantity::Kinetic(_) => vec![format!("{label} [J]")],
-            Quantity::Deflection(_) => ["x", "y", "z"]
-                .iter()
-                .map(|c| format!("{label}_{c} [m]"))
-                .collect(),
-            Quantity::Energy => vec!["energy [J]".into()],
-            Quantity::Violation => vec!["violation [m|rad]".into()],
-        }
-    }
+    let kind = match name.rsplit_once('.') {
+        Some((head, what)) if !head.is_empty() => QuantityKind::find(what, true),
+        _ => QuantityKind::find(name, false),
+    };
+    kind.is_some_and(|k| k.info().columns == Columns::One)
 }

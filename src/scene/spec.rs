@@ -2,15 +2,17 @@
 //! by serde (unknown keys refused), validated and turned into a model by
 //! [`super::build`].
 
-use crate::error::{Error, Result};
 use crate::integrate::{Method, SensitivityForm};
+use crate::mbs::responses::ResponseKind;
 use crate::modal::ModeUpdate;
 use serde::Deserialize;
 
-/// Effects a scene may list.
-/// What a scene may switch on (`[scene] effects`): what is not listed is
-/// neither built nor evaluated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What a scene may switch on (`[scene] effects`, written in snake case:
+/// `gravity`, `actuators`, `damping`, `springs`, `loads`, `flexibility`,
+/// `quadratic_velocity`): what is not listed is neither built nor
+/// evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Effect {
     /// Uniform gravity on every moving body.
     Gravity,
@@ -52,11 +54,6 @@ impl Effect {
             Effect::QuadraticVelocity => "quadratic_velocity",
         }
     }
-
-    /// The effect named `name`, if any.
-    pub fn parse(name: &str) -> Option<Effect> {
-        Effect::ALL.into_iter().find(|e| e.name() == name)
-    }
 }
 
 impl SceneSpec {
@@ -75,49 +72,45 @@ impl SceneSpec {
                 .any(|l| l.trim().starts_with(&prefix))
             {
                 if let Some(f) = &mut b.flexible {
-                    f.derivatives_name = None;
+                    f.derivatives = None;
                 }
             }
         }
     }
-
-    /// The listed effects; an unknown name is an input error on
-    /// `effects[k]` listing the known ones.
-    pub fn effect_list(&self) -> Result<Vec<Effect>> {
-        self.effects
-            .iter()
-            .enumerate()
-            .map(|(k, e)| {
-                Effect::parse(e).ok_or_else(|| {
-                    let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
-                    Error::input(
-                        format!("effects[{k}]"),
-                        e,
-                        format!("one of {}", names.join(", ")),
-                    )
-                })
-            })
-            .collect()
-    }
 }
 
+/// The `[scene]` section: a multibody model with its integrator, outputs,
+/// sensitivity parameters and responses (module doc of [`crate::scene`]
+/// for an example of every key). Unknown keys are refused.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneSpec {
-    /// Effect names as written ([`SceneSpec::effect_list`] checks them).
-    pub effects: Vec<String>,
+    /// The effects switched on ([`Effect`]; an unknown name is refused
+    /// when the section is read, naming `scene.effects[k]`).
+    pub effects: Vec<Effect>,
+    /// Gravitational acceleration, global axes (m/s²; default
+    /// `[0, 0, -9.81]`), applied with the `gravity` effect.
     #[serde(default = "default_gravity")]
     pub gravity: [f64; 3],
+    /// Baumgarte rate α of the constraint stabilisation (1/s, ≥ 0;
+    /// default 10).
     #[serde(default = "default_baumgarte")]
     pub baumgarte: f64,
+    /// The bodies, `[[scene.bodies]]` (at least one).
     pub bodies: Vec<BodySpec>,
+    /// The joints, `[[scene.joints]]` (default none).
     #[serde(default)]
     pub joints: Vec<JointSpec>,
+    /// Extra named points, `[[scene.markers]]` (default none).
     #[serde(default)]
     pub markers: Vec<MarkerSpec>,
+    /// Actuators, springs and loads, `[[scene.forces]]` (default none).
     #[serde(default)]
     pub forces: Vec<ForceSpec>,
+    /// Time span, output interval and method, `[scene.integrator]`.
     pub integrator: IntegratorSpec,
+    /// Output columns and plot, `[scene.outputs]` (default: none, only
+    /// time).
     #[serde(default)]
     pub outputs: OutputSpec,
     /// Parameters for forward sensitivities of the outputs:
@@ -142,9 +135,16 @@ pub struct SceneSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ResponseSpec {
+    /// Unique, non-empty name (the `response` of an exploration, the
+    /// column of `responses.csv`).
     pub name: String,
-    pub kind: String,
+    /// `integral` (∫ dt, J·s), `peak` (max over the run, J) or `final`
+    /// (at the end time, J).
+    pub kind: ResponseKind,
+    /// The energies summed (at least one): `kinetic_energy` (all bodies),
+    /// `<body>.kinetic_energy`, `<body>.strain_energy` (a flexible body).
     pub of: Vec<String>,
+    /// Dimensionless factor of the sum (finite; default 1).
     #[serde(default = "one")]
     pub scale: f64,
 }
@@ -162,20 +162,32 @@ fn default_baumgarte() -> f64 {
     10.0
 }
 
+/// One `[[scene.bodies]]` entry: a rigid body, or a flexible one with a
+/// `flexible` table. Rigid bodies start with their axes along the global
+/// axes.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
+    /// Unique body name (`ground` is reserved for the fixed frame).
     pub name: String,
     /// Rigid mass properties: required for rigid bodies, and for flexible
     /// ones when the scene does not list `flexibility` (then they are
     /// simulated rigid).
+    /// Mass (kg, > 0).
     pub mass: Option<f64>,
+    /// Initial global position of the centre of mass (m).
     pub com: Option<[f64; 3]>,
+    /// Inertia tensor about the centre of mass, global (= body) axes at
+    /// `t = 0` (kg·m², symmetric positive definite).
     pub inertia: Option<[[f64; 3]; 3]>,
+    /// Fixed to ground (default `false`).
     #[serde(default)]
     pub fixed: bool,
+    /// Initial velocity of the centre of mass, global axes (m/s; default
+    /// 0).
     #[serde(default)]
     pub velocity: [f64; 3],
+    /// Initial angular velocity, global axes (rad/s; default 0).
     #[serde(default)]
     pub angular_velocity: [f64; 3],
     /// A floating-frame flexible body (used when `flexibility` is listed).
@@ -187,77 +199,55 @@ pub struct BodySpec {
 #[serde(deny_unknown_fields)]
 pub struct FlexSpec {
     /// `beam` (closed-form cantilever modes) or `panel` (finite element
-    /// modes of a `[[panels]]` entry), as written; [`FlexSpec::kind`]
-    /// gives the [`FlexKind`].
-    #[serde(rename = "kind")]
-    pub kind_name: String,
+    /// modes of a `[[panels]]` entry).
+    pub kind: FlexKind,
     /// Number of modes kept.
     pub modes: usize,
     /// Global position of the basis frame's origin at t = 0 (m): the
     /// beam's root, the panel's centre.
     pub origin: [f64; 3],
-    /// Global directions of the basis frame's x and y axes at t = 0.
+    /// Global direction of the basis frame's x axis at t = 0 (default
+    /// `[1, 0, 0]`).
     #[serde(default = "unit_x")]
     pub x_axis: [f64; 3],
+    /// Global direction of the basis frame's y axis at t = 0 (default
+    /// `[0, 1, 0]`; made orthogonal to `x_axis`).
     #[serde(default = "unit_y")]
     pub y_axis: [f64; 3],
     /// Modal damping ratio ζ of every mode (with the `damping` effect).
     #[serde(default)]
     pub damping: f64,
-    /// Beam: length (m), bending stiffnesses for deflection along y
-    /// (`ei_z`) and z (`ei_y`) (N·m²), mass per length (kg/m), polar mass
-    /// moment per length (kg·m, rotary inertia about the beam axis).
+    /// Beam: length along the frame's x axis (m).
     pub length: Option<f64>,
+    /// Beam: bending stiffness for deflection along z (N·m²).
     pub ei_y: Option<f64>,
+    /// Beam: bending stiffness for deflection along y (N·m²).
     pub ei_z: Option<f64>,
+    /// Beam: mass per length (kg/m).
     pub rho_a: Option<f64>,
+    /// Beam: polar mass moment per length (kg·m, rotary inertia about the
+    /// beam axis).
     pub rho_ip: Option<f64>,
     /// Panel: the `name` of a `[[panels]]` entry of the study.
     pub panel: Option<String>,
     /// Panel: design derivatives of the modes for ply-angle sensitivities,
-    /// `fixed` (Eq. 19) or `updated` (Eq. 18), as written;
-    /// [`FlexSpec::derivatives`] gives the [`ModeUpdate`].
-    #[serde(rename = "derivatives")]
-    pub derivatives_name: Option<String>,
+    /// `fixed` (Eq. 19) or `updated` (Eq. 18); none when absent.
+    pub derivatives: Option<ModeUpdate>,
     /// Panel: drop the modes whose rigid-body content exceeds this share
     /// (in (0, 1]; default [`crate::panels::basis::RIGID_CONTENT_LIMIT`]
     /// = 0.9; 1 keeps every mode), see [`crate::panels::basis`].
     pub rigid_limit: Option<f64>,
 }
 
-/// Where a flexible body's modes come from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Where a flexible body's modes come from (`flexible.kind`: `beam` or
+/// `panel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum FlexKind {
     /// Closed-form Euler–Bernoulli cantilever modes ([`crate::beams`]).
     Beam,
     /// Finite element modes of a `[[panels]]` entry ([`crate::panels`]).
     Panel,
-}
-
-impl FlexSpec {
-    /// The kind; an unknown name is an input error on `<key>.kind`.
-    pub fn kind(&self, key: &str) -> Result<FlexKind> {
-        match self.kind_name.as_str() {
-            "beam" => Ok(FlexKind::Beam),
-            "panel" => Ok(FlexKind::Panel),
-            other => Err(Error::input(format!("{key}.kind"), other, "beam or panel")),
-        }
-    }
-
-    /// The derivative approach of a panel body (None: no derivatives); an
-    /// unknown name is an input error on `<key>.derivatives`.
-    pub fn derivatives(&self, key: &str) -> Result<Option<ModeUpdate>> {
-        match self.derivatives_name.as_deref() {
-            None => Ok(None),
-            Some(d) => ModeUpdate::parse(d).map(Some).ok_or_else(|| {
-                Error::input(
-                    format!("{key}.derivatives"),
-                    d,
-                    "fixed (Eq. 19) or updated (Eq. 18)",
-                )
-            }),
-        }
-    }
 }
 
 fn unit_x() -> [f64; 3] {
@@ -267,51 +257,87 @@ fn unit_y() -> [f64; 3] {
     [0.0, 1.0, 0.0]
 }
 
+/// One `[[scene.joints]]` entry. Each joint also makes the markers
+/// `<joint>.i` and `<joint>.j` at its point on either body.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JointSpec {
+    /// Unique joint name.
     pub name: String,
+    /// `type`: `spherical`, `revolute`, `locked`, `driven`, `fixed`,
+    /// `prismatic` or `cylindrical`, as written (checked when the scene is
+    /// built).
     #[serde(rename = "type")]
     pub kind: String,
+    /// First body (`ground` allowed).
     pub body_i: String,
+    /// Second body (`ground` allowed).
     pub body_j: String,
+    /// Global initial position of the joint (m).
     pub point: [f64; 3],
+    /// Global axis (revolute, locked, driven, prismatic, cylindrical;
+    /// normalised).
     pub axis: Option<[f64; 3]>,
+    /// Initial relative angle θ0 (rad, default 0; 0 for prismatic); the
+    /// held angle of a `locked` joint.
     #[serde(default)]
     pub angle: f64,
+    /// `driven`: polynomial coefficients `[c0, c1, ..]` of `θ(t) = Σ c_k t^k`
+    /// (rad, rad/s, ..).
     pub drive: Option<Vec<f64>>,
 }
 
+/// One `[[scene.markers]]` entry: a named point fixed on a body (for
+/// springs, loads and outputs).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MarkerSpec {
+    /// Unique marker name.
     pub name: String,
+    /// The body it is fixed on (`ground` allowed).
     pub body: String,
+    /// Global initial position (m); on a flexible body a node of its
+    /// basis.
     pub point: [f64; 3],
 }
 
+/// One segment of an actuator's law (paper Eq. 32): on `lower < θ ≤
+/// upper` the torque is `value + slope·(anchor − θ)`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SegmentSpec {
+    /// Lower end of the segment's joint-angle range (rad).
     pub lower: f64,
+    /// Upper end of the range (rad, > `lower`).
     pub upper: f64,
+    /// Torque at `θ = anchor` (N·m).
     pub value: f64,
+    /// Torque decrease per angle (N·m/rad, default 0).
     #[serde(default)]
     pub slope: f64,
+    /// Angle where the torque is `value` (rad, default 0).
     #[serde(default)]
     pub anchor: f64,
 }
 
+/// One `[[scene.forces]]` entry, chosen by `type`: `actuator`, `spring`
+/// or `load`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields, tag = "type", rename_all = "lowercase")]
 #[allow(clippy::large_enum_variant)]
 pub enum ForceSpec {
+    /// A rotational actuator on a revolute joint: the torque law of its
+    /// `segments` (Eq. 32, with the `actuators` effect) and a viscous
+    /// damping (with the `damping` effect).
     Actuator {
         /// Name for sensitivity parameters (`<name>.damping`).
         name: Option<String>,
+        /// The revolute joint it acts on.
         joint: String,
+        /// Viscous damping (N·m·s/rad, default 0).
         #[serde(default)]
         damping: f64,
+        /// The torque law's segments (default none: no torque).
         #[serde(default)]
         segments: Vec<SegmentSpec>,
     },
@@ -323,24 +349,37 @@ pub enum ForceSpec {
         /// Name for sensitivity parameters (`<name>.stiffness`,
         /// `<name>.damping`).
         name: Option<String>,
+        /// First marker (with `marker_j`; not with `joint`).
         marker_i: Option<String>,
+        /// Second marker.
         marker_j: Option<String>,
+        /// A prismatic or cylindrical joint to act along (instead of the
+        /// markers).
         joint: Option<String>,
+        /// Stiffness (N/m).
         stiffness: f64,
+        /// Viscous damping (N·s/m, default 0).
         #[serde(default)]
         damping: f64,
+        /// Rest length (m; default: the initial distance of the markers, or
+        /// 0 along a joint).
         length: Option<f64>,
+        /// Constant force along a joint's axis (N, default 0).
         force: Option<f64>,
     },
     /// A force and torque at a body's centre of mass (`body`) or at a
     /// marker (`marker`), in global or body axes (`frame`).
     Load {
+        /// The body loaded at its centre of mass (or `marker`).
         body: Option<String>,
+        /// The marker loaded (or `body`).
         marker: Option<String>,
         /// `global` (default) or `body`, as written.
         frame: Option<String>,
+        /// Constant force (N, default 0).
         #[serde(default)]
         force: [f64; 3],
+        /// Constant torque (N·m, default 0).
         #[serde(default)]
         torque: [f64; 3],
         /// Time table `[[t, fx, fy, fz, tx, ty, tz], ..]` (s, N, N·m),
@@ -359,16 +398,22 @@ impl ForceSpec {
     }
 }
 
+/// `[scene.integrator]`: method, tolerances, time span and output times.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSpec {
+    /// Integration method ([`Method`]): `bdf` (default), `tsit45` or `esdirk34`.
     #[serde(default = "default_method")]
     pub method: Method,
+    /// Relative tolerance of the error control (default 1e-6).
     #[serde(default = "default_rtol")]
     pub rtol: f64,
+    /// Absolute tolerance (state units; default 1e-8).
     #[serde(default = "default_atol")]
     pub atol: f64,
+    /// End time (s, > 0; the run starts at 0).
     pub t_end: f64,
+    /// Output interval (s, > 0): rows of `history.csv` at 0, dt_out, ...
     pub dt_out: f64,
     /// Segment changes of actuator laws as integration events
     /// ([`crate::integrate::Options::events`], default `true`).
@@ -395,11 +440,18 @@ fn default_atol() -> f64 {
     1e-8
 }
 
+/// `[scene.outputs]`: the columns of `history.csv` and the plotted one.
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
+    /// Output names, one column group each in this order (default none):
+    /// `energy`, `violation`, `kinetic_energy`, `<joint>.angle|rate|reaction`,
+    /// `<joint>.displacement|velocity`, `<body>.position|kinetic_energy`,
+    /// `<flexible body>.modal|strain_energy`, `<marker>.deflection`
+    /// ([`crate::scene::QuantityKind`]).
     #[serde(default)]
     pub quantities: Vec<String>,
+    /// A one-column output to plot as an SVG (default: no plot).
     pub plot: Option<String>,
     /// File stem of the plot (default: the plotted output's name), e.g.
     /// `theta` for `theta.svg`.

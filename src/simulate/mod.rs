@@ -9,19 +9,23 @@ use crate::mbs::Projection;
 use crate::mbs::{Energy, Param, Reaction, System, Workspace};
 use crate::report::csv::{sci, write_table};
 use crate::report::{line_plot, Axes, Curve};
-use crate::scene::{Quantity, Response, Scene};
+use crate::scene::quantity::QuantityKind;
+use crate::scene::{Quantity, Scene};
 use num_dual::Dual64;
 use std::path::{Path, PathBuf};
 
 /// Everything a simulation produced.
 #[derive(Debug)]
 pub struct Simulation {
+    /// Headers of `history.csv` (`t [s]`, then every output with units).
     pub headers: Vec<String>,
     /// One row per output time: `[t, outputs..]`.
     pub rows: Vec<Vec<f64>>,
     /// Final state.
     pub y_end: Vec<f64>,
+    /// The consistent initial state's projection (rank, dependent rows).
     pub projection: Projection,
+    /// Integrator statistics.
     pub stats: Stats,
     /// Largest `|Φ|` over the output times.
     pub max_violation: f64,
@@ -36,6 +40,7 @@ pub struct Simulation {
     /// are named depends on the elimination order; their number and the
     /// motion do not.
     pub redundant_rows: Vec<String>,
+    /// Number of constraint equations at the start.
     pub equations: usize,
     /// Headers of the output sensitivities (`t` first); only `t` when the
     /// scene asks for none.
@@ -69,7 +74,7 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
     let wants_reactions = scene
         .outputs
         .iter()
-        .any(|(_, q)| matches!(q, Quantity::Reaction(_)));
+        .any(|(_, q)| q.kind == QuantityKind::Reaction);
     let angle_columns = angle_columns(scene);
     let sens_quantities = sens_quantities(scene);
     let sens_headers = sens_headers(scene, &sens_quantities);
@@ -91,8 +96,8 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
                 .collect()
         };
         for (r, series) in scene.responses.iter().zip(peaks.iter_mut()) {
-            if let Response::Peak { terms, scale, .. } = r {
-                let (v, g) = energy_lanes(&sys, (terms, *scale), y, &lanes);
+            if r.kind == ResponseKind::Peak {
+                let (v, g) = energy_lanes(&sys, (&r.terms, r.scale), y, &lanes);
                 series.push((t, v, g));
             }
         }
@@ -170,7 +175,7 @@ fn angle_columns(scene: &Scene) -> Vec<usize> {
     let mut out = Vec::new();
     let mut col = 1;
     for (label, q) in &scene.outputs {
-        if matches!(q, Quantity::Angle(_)) {
+        if q.kind == QuantityKind::Angle {
             out.push(col);
         }
         col += q.headers(label).len();
@@ -190,27 +195,14 @@ fn unwrap_angles(row: &mut [f64], prev: &[f64], columns: &[usize]) {
     }
 }
 
-/// The output columns that have sensitivities (angles, rates, joint
-/// displacements and velocities, positions, modal coordinates, strain
-/// energies, deflections).
+/// The output columns that have sensitivities (by the table of
+/// [`QuantityKind`]: angles, rates, joint displacements and velocities,
+/// positions, modal coordinates, strain and kinetic energies, deflections).
 fn sens_quantities(scene: &Scene) -> Vec<(String, Quantity)> {
     scene
         .outputs
         .iter()
-        .filter(|(_, q)| {
-            matches!(
-                q,
-                Quantity::Angle(_)
-                    | Quantity::Rate(_)
-                    | Quantity::Displacement(_)
-                    | Quantity::Velocity(_)
-                    | Quantity::Position(_)
-                    | Quantity::Modal(..)
-                    | Quantity::Strain(_)
-                    | Quantity::Kinetic(_)
-                    | Quantity::Deflection(_)
-            )
-        })
+        .filter(|(_, q)| q.kind.info().sensitivity)
         .cloned()
         .collect()
 }
@@ -244,37 +236,42 @@ fn output_row(
     let (t, y) = at;
     let mut row = vec![t];
     for (_, q) in &scene.outputs {
-        match q {
-            Quantity::Angle(j) => row.push(sys.angle(y, *j, ws).0),
-            Quantity::Rate(j) => row.push(sys.angle(y, *j, ws).1),
-            Quantity::Displacement(j) => row.push(sys.slide(y, *j, ws).0),
-            Quantity::Velocity(j) => row.push(sys.slide(y, *j, ws).1),
-            Quantity::Reaction(j) => {
-                let r = reactions.map(|r| r[*j]).unwrap_or(Reaction {
+        let (i, n) = (q.of, q.modes);
+        match q.kind {
+            QuantityKind::Angle => row.push(sys.angle(y, i, ws).0),
+            QuantityKind::Rate => row.push(sys.angle(y, i, ws).1),
+            QuantityKind::Displacement => row.push(sys.slide(y, i, ws).0),
+            QuantityKind::Velocity => row.push(sys.slide(y, i, ws).1),
+            QuantityKind::Reaction => {
+                let r = reactions.map(|r| r[i]).unwrap_or(Reaction {
                     force: Default::default(),
                     torque: Default::default(),
                 });
                 row.extend(r.force.iter().chain(r.torque.iter()));
             }
-            Quantity::Position(b) => match sys.slot[*b] {
+            QuantityKind::Position => match sys.slot[i] {
                 Some(s) => {
                     let p = sys.pos_off(s);
                     row.extend_from_slice(&y[p..p + 3])
                 }
-                None => row.extend(sys.model.bodies[*b].r0.iter()),
+                None => row.extend(sys.model.bodies[i].r0.iter()),
             },
-            Quantity::Modal(b, n) => match sys.slot[*b] {
+            QuantityKind::Modal => match sys.slot[i] {
                 Some(s) => {
                     let p = sys.pos_off(s) + 7;
                     row.extend_from_slice(&y[p..p + n])
                 }
-                None => row.extend(std::iter::repeat_n(0.0, *n)),
+                None => row.extend(std::iter::repeat_n(0.0, n)),
             },
-            Quantity::Strain(b) => row.push(sys.slot[*b].map_or(0.0, |s| sys.strain_energy(y, s))),
-            Quantity::Kinetic(b) => row.push(sys.energy_sum(&kinetic_terms(sys, *b), y, ws)),
-            Quantity::Deflection(m) => row.extend(sys.deflection(y, *m).iter()),
-            Quantity::Energy => row.push(sys.energy(y, ws)),
-            Quantity::Violation => row.push(viol),
+            QuantityKind::StrainEnergy => {
+                row.push(sys.slot[i].map_or(0.0, |s| sys.strain_energy(y, s)))
+            }
+            QuantityKind::KineticEnergy | QuantityKind::TotalKineticEnergy => {
+                row.push(sys.energy_sum(&kinetic_terms(sys, q), y, ws))
+            }
+            QuantityKind::Deflection => row.extend(sys.deflection(y, i).iter()),
+            QuantityKind::Energy => row.push(sys.energy(y, ws)),
+            QuantityKind::Violation => row.push(viol),
         }
     }
     row
@@ -294,39 +291,48 @@ fn collect_responses(
     let io = sys.integral_off();
     let mut responses = Vec::new();
     for (r, series) in scene.responses.iter().zip(peaks) {
-        responses.push(match r {
-            Response::Integral { name, index } => ResponseValue {
-                name: name.clone(),
-                kind: ResponseKind::Integral,
-                value: y_end[io + index],
-                time: None,
-                gradient: (0..scene.params.len())
-                    .map(|i| s_end[i * n + io + index])
-                    .collect(),
-            },
-            Response::Final { name, terms, scale } => {
+        let name = r.name.clone();
+        responses.push(match r.kind {
+            ResponseKind::Integral => {
+                let index = r.integral.ok_or_else(|| {
+                    Error::numerical(
+                        "simulate: responses",
+                        format!("{name} has no integrated state"),
+                    )
+                })?;
+                ResponseValue {
+                    name,
+                    kind: r.kind,
+                    value: y_end[io + index],
+                    time: None,
+                    gradient: (0..scene.params.len())
+                        .map(|i| s_end[i * n + io + index])
+                        .collect(),
+                }
+            }
+            ResponseKind::Final => {
                 let lanes: Vec<(&[f64], Param)> = scene
                     .params
                     .iter()
                     .enumerate()
                     .map(|(i, (_, p))| (&s_end[i * n..(i + 1) * n], *p))
                     .collect();
-                let (value, gradient) = energy_lanes(sys, (terms, *scale), y_end, &lanes);
+                let (value, gradient) = energy_lanes(sys, (&r.terms, r.scale), y_end, &lanes);
                 ResponseValue {
-                    name: name.clone(),
-                    kind: ResponseKind::Final,
+                    name,
+                    kind: r.kind,
                     value,
                     time: scene.options.times.last().copied(),
                     gradient,
                 }
             }
-            Response::Peak { name, .. } => {
+            ResponseKind::Peak => {
                 let (t, value, gradient) = peak(series).ok_or_else(|| {
                     Error::numerical("simulate: responses", format!("no samples for {name}"))
                 })?;
                 ResponseValue {
-                    name: name.clone(),
-                    kind: ResponseKind::Peak,
+                    name,
+                    kind: r.kind,
                     value,
                     time: Some(t),
                     gradient,
@@ -357,50 +363,52 @@ fn output_sensitivities(
     sys.body_kin(&yd, &seeds, &mut kin);
     let mut out = Vec::new();
     for (_, q) in quantities {
-        match q {
-            Quantity::Angle(j) => out.push(sys.joint_angle(&kin, *j).0.eps),
-            Quantity::Rate(j) => out.push(sys.joint_angle(&kin, *j).1.eps),
-            Quantity::Displacement(j) => out.push(sys.joint_slide(&kin, *j).0.eps),
-            Quantity::Velocity(j) => out.push(sys.joint_slide(&kin, *j).1.eps),
-            Quantity::Position(b) => match sys.slot[*b] {
+        let (i, n) = (q.of, q.modes);
+        match q.kind {
+            QuantityKind::Angle => out.push(sys.joint_angle(&kin, i).0.eps),
+            QuantityKind::Rate => out.push(sys.joint_angle(&kin, i).1.eps),
+            QuantityKind::Displacement => out.push(sys.joint_slide(&kin, i).0.eps),
+            QuantityKind::Velocity => out.push(sys.joint_slide(&kin, i).1.eps),
+            QuantityKind::Position => match sys.slot[i] {
                 Some(k) => {
                     let p = sys.pos_off(k);
                     out.extend_from_slice(&s[p..p + 3])
                 }
                 None => out.extend([0.0; 3]),
             },
-            Quantity::Modal(b, n) => match sys.slot[*b] {
+            QuantityKind::Modal => match sys.slot[i] {
                 Some(k) => {
                     let p = sys.pos_off(k) + 7;
                     out.extend_from_slice(&s[p..p + n])
                 }
-                None => out.extend(std::iter::repeat_n(0.0, *n)),
+                None => out.extend(std::iter::repeat_n(0.0, n)),
             },
-            Quantity::Strain(b) => out.push(match sys.slot[*b] {
+            QuantityKind::StrainEnergy => out.push(match sys.slot[i] {
                 Some(k) => sys.strain_energy_dual(&yd, k, &kin[k].design).eps,
                 None => 0.0,
             }),
-            Quantity::Kinetic(b) => {
+            QuantityKind::KineticEnergy | QuantityKind::TotalKineticEnergy => {
                 let mut ws = Workspace::empty();
                 ws.params = seeds.clone();
-                out.push(sys.energy_sum(&kinetic_terms(sys, *b), &yd, &mut ws).eps);
+                out.push(sys.energy_sum(&kinetic_terms(sys, q), &yd, &mut ws).eps);
             }
-            Quantity::Deflection(m) => {
-                let d = sys.deflection_kin(&kin, *m);
+            QuantityKind::Deflection => {
+                let d = sys.deflection_kin(&kin, i);
                 out.extend(d.iter().map(|v| v.eps));
             }
-            _ => {}
+            // No sensitivities (`QuantityKind::info`): not in `quantities`.
+            QuantityKind::Reaction | QuantityKind::Energy | QuantityKind::Violation => {}
         }
     }
     out
 }
 
-/// The kinetic energy terms of output `<body>.kinetic_energy` (`Some`) or
-/// `kinetic_energy` (`None`: every body).
-fn kinetic_terms(sys: &System, body: Option<usize>) -> Vec<Energy> {
-    match body {
-        Some(b) => vec![Energy::Kinetic(b)],
-        None => Energy::kinetic_total(&sys.model),
+/// The kinetic energy terms of output `<body>.kinetic_energy` (one body)
+/// or `kinetic_energy` (every body).
+fn kinetic_terms(sys: &System, q: &Quantity) -> Vec<Energy> {
+    match q.kind {
+        QuantityKind::TotalKineticEnergy => Energy::kinetic_total(&sys.model),
+        _ => vec![Energy::Kinetic(q.of)],
     }
 }
 

@@ -101,21 +101,29 @@ impl Study {
     }
 
     /// Deserialize the top-level section `key` into `T`, or `None` if absent.
-    /// Serde errors (missing field, unknown field, wrong type) become input
-    /// errors naming this file and the section.
+    /// Serde errors (missing field, unknown field, wrong type, unknown kind)
+    /// become input errors naming this file, the dotted key of the value
+    /// that failed (e.g. `scene.joints[2].axis`, found by
+    /// `serde_path_to_error`), that value, and serde's expectation (for a
+    /// kind: the accepted names).
     pub fn section<T: DeserializeOwned>(&self, key: &str) -> Result<Option<T>> {
-        match self.table.get(key) {
-            None => Ok(None),
-            Some(v) => v.clone().try_into::<T>().map(Some).map_err(|e| {
-                let msg = e.to_string();
+        let Some(v) = self.table.get(key) else {
+            return Ok(None);
+        };
+        serde_path_to_error::deserialize::<_, T>(v.clone())
+            .map(Some)
+            .map_err(|e| {
+                let path = e.path().clone();
+                let (dotted, value) = locate_value(key, v, &path);
+                // toml's message without its own (section-relative) key.
+                let msg = e.into_inner().message().to_string();
                 Error::Input {
                     file: self.path.display().to_string(),
-                    key: key.to_string(),
-                    value: summarize(v),
+                    key: dotted,
+                    value: summarize_opt(value),
                     expected: msg.trim().replace('\n', " "),
                 }
-            }),
-        }
+            })
     }
 
     /// Like [`Study::section`] but the section must be present.
@@ -146,6 +154,43 @@ impl Study {
         std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
         Ok(dir)
     }
+}
+
+/// The dotted key of `path` inside section `key` (`scene.joints[2].axis`)
+/// and the TOML value there, if the document has one (a missing field has
+/// none).
+fn locate_value<'v>(
+    key: &str,
+    section: &'v toml::Value,
+    path: &serde_path_to_error::Path,
+) -> (String, Option<&'v toml::Value>) {
+    use serde_path_to_error::Segment;
+    let mut dotted = key.to_string();
+    let mut at = Some(section);
+    for seg in path.iter() {
+        match seg {
+            Segment::Seq { index } => {
+                dotted.push_str(&format!("[{index}]"));
+                at = at.and_then(|v| v.get(*index));
+            }
+            Segment::Map { key } => {
+                dotted.push('.');
+                dotted.push_str(key);
+                at = at.and_then(|v| v.get(key.as_str()));
+            }
+            Segment::Enum { variant } => {
+                dotted.push('.');
+                dotted.push_str(variant);
+            }
+            Segment::Unknown => {}
+        }
+    }
+    (dotted, at)
+}
+
+/// [`summarize`], or `(missing)` when there is no value.
+fn summarize_opt(v: Option<&toml::Value>) -> String {
+    v.map_or_else(|| "(missing)".to_string(), summarize)
 }
 
 /// Short one-line rendering of a TOML value for messages.
@@ -203,8 +248,97 @@ mod tests {
         assert_eq!(s.name(), "demo");
         assert_eq!(s.meta.seed, 3);
         let e = s.section::<Demo>("demo").unwrap_err().to_string();
-        assert!(e.starts_with("studies/demo.toml: `demo`"), "{e}");
+        assert!(
+            e.starts_with("studies/demo.toml: `demo.starts` = -1"),
+            "{e}"
+        );
         assert!(s.section::<Demo>("absent").unwrap().is_none());
+    }
+
+    #[derive(Debug, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Joint {
+        name: String,
+        axis: [f64; 3],
+    }
+
+    #[derive(Debug, Deserialize)]
+    #[serde(rename_all = "snake_case")]
+    #[allow(dead_code)]
+    enum Kind {
+        Beam,
+        Panel,
+    }
+
+    #[derive(Debug, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Nested {
+        joints: Vec<Joint>,
+        #[serde(default)]
+        kinds: Vec<Kind>,
+    }
+
+    fn input_error(e: Error) -> (String, String, String, String) {
+        match e {
+            Error::Input {
+                file,
+                key,
+                value,
+                expected,
+            } => (file, key, value, expected),
+            other => panic!("expected an input error, got {other:?}"),
+        }
+    }
+
+    /// A bad value deep inside a section names the file, the dotted key
+    /// down to that value, the value itself and serde's expectation.
+    #[test]
+    fn nested_errors_name_the_dotted_key_and_the_value() {
+        let joint = |axis: &str| format!("[[scene.joints]]\nname = \"j\"\naxis = {axis}\n");
+        let text =
+            joint("[0.0, 0.0, 1.0]") + &joint("[0.0, 0.0, 1.0]") + &joint("[0.0, \"z\", 1.0]");
+        let s = Study::parse("studies/nested.toml", &text).unwrap();
+        let (file, key, value, expected) = input_error(s.section::<Nested>("scene").unwrap_err());
+        assert_eq!(file, "studies/nested.toml");
+        assert_eq!(key, "scene.joints[2].axis[1]");
+        assert_eq!(value, "\"z\"");
+        assert!(
+            expected.contains("f64") || expected.contains("float"),
+            "{expected}"
+        );
+        let e = s.section::<Nested>("scene").unwrap_err().to_string();
+        assert!(
+            e.starts_with("studies/nested.toml: `scene.joints[2].axis[1]` = \"z\""),
+            "{e}"
+        );
+
+        // A wrong length names the array (shown by its length).
+        let s = Study::parse("n.toml", &joint("[0.0, 1.0]")).unwrap();
+        let (_, key, value, _) = input_error(s.section::<Nested>("scene").unwrap_err());
+        assert_eq!(
+            (key.as_str(), value.as_str()),
+            ("scene.joints[0].axis", "(array of 2)")
+        );
+
+        // An unknown kind lists the accepted names.
+        let text =
+            "[scene]\nkinds = [\"beam\", \"plate\"]\n".to_string() + &joint("[0.0, 0.0, 1.0]");
+        let s = Study::parse("k.toml", &text).unwrap();
+        let (_, key, value, expected) = input_error(s.section::<Nested>("scene").unwrap_err());
+        assert_eq!(
+            (key.as_str(), value.as_str()),
+            ("scene.kinds[1]", "\"plate\"")
+        );
+        assert!(expected.contains("`beam` or `panel`"), "{expected}");
+
+        // An unknown key is named with its place; a missing one names the
+        // table it is missing from.
+        let s = Study::parse("u.toml", &joint("[0.0, 0.0, 1.0]").replace("name", "nmae")).unwrap();
+        let (_, key, _, expected) = input_error(s.section::<Nested>("scene").unwrap_err());
+        assert!(key.starts_with("scene.joints[0]"), "{key}");
+        assert!(expected.contains("nmae"), "{expected}");
     }
 
     #[test]

@@ -25,8 +25,10 @@ use crate::mbs::model::{Energy, Param};
 use crate::mbs::system::{System, Workspace};
 use num_dual::Dual64;
 
-/// The kind of a response functional (paper Eqs. 33–34).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The kind of a response functional (paper Eqs. 33–34), as written in
+/// `[[scene.responses]] kind`: `integral`, `peak` or `final`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ResponseKind {
     /// `∫ scale·Σ E dt` over the run, an integrated state (Eq. 33).
     Integral,
@@ -61,9 +63,12 @@ impl ResponseKind {
 /// One evaluated response.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResponseValue {
+    /// The `[[scene.responses]] name`.
     pub name: String,
     /// Integral over the run, peak or final value.
     pub kind: ResponseKind,
+    /// The response's value (J·s for an integral, J otherwise, times the
+    /// scale).
     pub value: f64,
     /// Time of the peak or the end time (s); `None` for integrals.
     pub time: Option<f64>,

@@ -33,8 +33,13 @@ fn specs(text: &str) -> (Study, Vec<PanelSpec>) {
     (study, p)
 }
 
+/// The error of reading (a bad kind) or else of resolving the first panel.
 fn resolve_err(text: &str) -> Error {
-    let (study, p) = specs(text);
+    let study = Study::parse("test.toml", text).unwrap();
+    let p = match study.section::<Vec<PanelSpec>>("panels") {
+        Ok(p) => p.expect("panels section"),
+        Err(e) => return e,
+    };
     p[0].resolve()
         .map_err(study.locate("panels[0]"))
         .unwrap_err()

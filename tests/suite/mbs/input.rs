@@ -183,7 +183,7 @@ fn force_and_response_errors_name_key_value_and_the_expected_values() {
             BASE.to_string() + "[[scene.responses]]\nname = \"G\"\nkind = \"last\"\nof = [\"kinetic_energy\"]\n",
             "scene.responses[0].kind",
             "last",
-            &["integral, peak or final"],
+            &["`integral`, `peak`, `final`"],
         ),
     ];
     for (text, key, value, expected) in cases {
