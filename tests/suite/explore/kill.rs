@@ -10,6 +10,18 @@ const STUDY: &str = "[study]\nname = \"k\"\nseed = 3\n\
     [problem]\nname = \"himmelblau\"\ncost_ms = 2.0\n\
     [multistart]\nsampler = \"sobol\"\nstarts = 24\n";
 
+/// The same study with every evaluation sleeping 25 ms (`cost_mode =
+/// "sleep"`: the child is slow whatever the load of the machine, and needs
+/// no core for it). Its 24 starts take about 8 s on 2 threads (about 27
+/// evaluations per start), so once 3 runs are on disk the test has seconds,
+/// not milliseconds, to kill the child before it finishes: a stalled test
+/// thread cannot make the kill come too late. The evaluation cost changes
+/// no result, only the wall times (the runs of the killed study resume
+/// with the fast one).
+const SLOW: &str = "[study]\nname = \"k\"\nseed = 3\n\
+    [problem]\nname = \"himmelblau\"\ncost_ms = 25.0\ncost_mode = \"sleep\"\n\
+    [multistart]\nsampler = \"sobol\"\nstarts = 24\n";
+
 fn plyscape(args: &[&str]) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_plyscape"));
     c.args(args);
@@ -23,6 +35,9 @@ fn killed_multistart_resumes_to_the_same_tables() {
     let study = dir.join("k.toml");
     std::fs::write(&study, STUDY).unwrap();
     let study = study.to_str().unwrap();
+    let slow = dir.join("slow.toml");
+    std::fs::write(&slow, SLOW).unwrap();
+    let slow = slow.to_str().unwrap();
     let (full, part) = (dir.join("full"), dir.join("part"));
     let (full_s, part_s) = (full.to_str().unwrap(), part.to_str().unwrap());
     let st = plyscape(&["multistart", study, "--out", full_s, "--threads", "2", "-q"])
@@ -30,7 +45,7 @@ fn killed_multistart_resumes_to_the_same_tables() {
         .unwrap();
     assert!(st.success());
 
-    let mut child = plyscape(&["multistart", study, "--out", part_s, "--threads", "2", "-q"])
+    let mut child = plyscape(&["multistart", slow, "--out", part_s, "--threads", "2", "-q"])
         .spawn()
         .unwrap();
     let runs = part.join("k/runs.csv");
@@ -38,14 +53,18 @@ fn killed_multistart_resumes_to_the_same_tables() {
     // Kill once a few rows (header + 3) are on disk.
     loop {
         let lines = std::fs::read_to_string(&runs).map_or(0, |t| t.lines().count());
-        if lines >= 4 || t0.elapsed() > Duration::from_secs(60) {
+        if lines >= 4 || t0.elapsed() > Duration::from_secs(120) {
             break;
         }
         std::thread::sleep(Duration::from_millis(5));
     }
+    let waited = t0.elapsed();
     child.kill().unwrap();
-    child.wait().unwrap();
+    let killed = child.wait().unwrap();
+    // Killed by the signal, not finished: the child was still running.
+    assert!(!killed.success(), "the child finished before the kill");
     let rows_at_kill = std::fs::read_to_string(&runs).unwrap().lines().count() - 1;
+    println!("killed after {waited:?} with {rows_at_kill} runs on disk");
     assert!(
         (3..24).contains(&rows_at_kill),
         "{rows_at_kill} rows at kill"

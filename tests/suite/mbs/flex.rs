@@ -55,8 +55,9 @@ fn free_flexible_body_conserves_energy_and_momenta() {
         "energy error {e:e}, |ΔH|/|H| {:e}",
         (h1 - h0).norm() / h0.norm()
     );
-    assert!(e < 1e-8, "energy drift {e:e}");
-    assert!((h1 - h0).norm() < 1e-8 * h0.norm());
+    // Measured 1.6e-10 (energy) and 6.0e-11 (momentum); bounds 3×.
+    assert!(e < 4.8e-10, "energy drift {e:e}");
+    assert!((h1 - h0).norm() < 1.8e-10 * h0.norm());
     // The modes are really excited (the test cannot pass on a rigid body).
     let strain = sim.rows.iter().map(|r| r[5]).fold(0.0, f64::max);
     assert!(strain > 1e-7, "max strain energy {strain:e}");
@@ -117,8 +118,9 @@ fn assert_attached_and_conservative(text: &str) -> System {
     let (sys, sim) = simulate(&scene).unwrap();
     let e = sim.energy_error.expect("conservative");
     println!("violation {:e}, energy error {e:e}", sim.max_violation);
+    // Measured violation 8.1e-12 (weld) and 1.7e-11 (spherical); bound 3×.
     assert!(
-        sim.max_violation < 1e-9,
+        sim.max_violation < 4.8e-11,
         "violation {:e}",
         sim.max_violation
     );
@@ -330,7 +332,7 @@ fn slow_spin_up_follows_the_quasi_static_deflection() {
     // (Euler–Bernoulli closed form, Roark Table 8.1; `Beam::
     // tip_deflection_linear_load`). α is read from the simulated hub rate.
     // The linear floating frame softens the beam by ≈ Ω²/ω₁² (6.5e-4 at
-    // t = 4 s): the tolerance is 0.2 %.
+    // t = 4 s): the tolerance is 0.18 %.
     let scene = load_scene(&spinup()).unwrap();
     let (_, sim) = simulate(&scene).unwrap();
     let col = |name: &str| {
@@ -347,6 +349,7 @@ fn slow_spin_up_follows_the_quasi_static_deflection() {
         rho_a: 1.0,
     };
     let mut checked = 0;
+    let mut worst = 0.0f64;
     for k in 1..sim.rows.len() - 1 {
         let t = sim.rows[k][0];
         if t < 2.5 {
@@ -356,13 +359,17 @@ fn slow_spin_up_follows_the_quasi_static_deflection() {
         let alpha = (b[rate] - a[rate]) / (b[0] - a[0]);
         let qs = beam.tip_deflection_linear_load(Plane::Y, -alpha * 1.0);
         let rel = sim.rows[k][tip] / qs - 1.0;
+        worst = worst.max(rel.abs());
         assert!(
-            rel.abs() < 2e-3,
+            rel.abs() < 1.8e-3,
             "t = {t}: tip {} vs quasi-static {qs} ({rel:e})",
             sim.rows[k][tip]
         );
         checked += 1;
     }
+    println!(
+        "tip against the quasi-static deflection: worst {worst:.2e} relative over {checked} times"
+    );
     assert!(checked >= 25);
     // α = τ / (J_hub + ρAL³/3) = 0.4 / (1 + 1/3) (rigid-body closed form).
     let last = &sim.rows[sim.rows.len() - 2];
@@ -495,7 +502,8 @@ fn ply_angle_sensitivities_match_central_differences() {
         worst = worst.max(rel);
     }
     println!("worst relative error {worst:e}");
-    assert!(worst < 1e-5, "sensitivity error {worst:e}");
+    // Measured 2.3e-6 (the strain energy's column); bound 3×.
+    assert!(worst < 6.9e-6, "sensitivity error {worst:e}");
 }
 
 #[test]
@@ -550,12 +558,17 @@ of = ["panel.strain_energy"]
         with_responses(30.0 + h.to_degrees(), false),
         with_responses(30.0 - h.to_degrees(), false),
     );
-    for k in 0..2 {
+    // Measured 2.4e-6 (Ψ₀) and 3.1e-8 (peak) relative; bounds 3×.
+    for (k, bound) in [(0, 7.2e-6), (1, 9e-8)] {
         let fd = (p.responses[k].value - m.responses[k].value) / (2.0 * h);
         let an = base.responses[k].gradient[0];
-        println!("{}: analytic {an:e}, FD {fd:e}", base.responses[k].name);
+        println!(
+            "{}: analytic {an:e}, FD {fd:e}, relative {:.2e}",
+            base.responses[k].name,
+            (fd - an).abs() / an.abs()
+        );
         assert!(
-            (fd - an).abs() < 1e-5 * an.abs(),
+            (fd - an).abs() < bound * an.abs(),
             "{}: {an:e} vs {fd:e}",
             base.responses[k].name
         );

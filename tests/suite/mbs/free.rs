@@ -48,8 +48,10 @@ fn dzhanibekov_flips_and_conserves_invariants() {
         // The intermediate-axis spin is unstable: ω_y changes sign (flip).
         assert!(min_wy < -4.0, "{method:?}: no flip, min ω_y = {min_wy}");
         // Invariants to the integrator tolerance (rtol 1e-8 over ~5 flips).
-        assert!(de < 3e-6, "{method:?}: energy drift {de:e}");
-        assert!(dh < 3e-6, "{method:?}: momentum drift {dh:e}");
+        // Measured at most 2.8e-7 (energy) and 6.9e-7 (momentum), both
+        // ESDIRK 3(4); bounds about 3×.
+        assert!(de < 9e-7, "{method:?}: energy drift {de:e}");
+        assert!(dh < 2e-6, "{method:?}: momentum drift {dh:e}");
         println!("{method:?}: energy {de:.2e}, momentum {dh:.2e}");
     }
 }

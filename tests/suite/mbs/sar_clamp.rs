@@ -142,5 +142,6 @@ fn centre_clamp_strain_energy_sensitivity_matches_central_differences() {
         base.rows[last][cs]
     );
     assert!(base.rows[last][cs] > 0.0);
-    assert!(rel < 1e-5, "relative error {rel:e}");
+    // Measured 1.5e-6; bound 4e-6.
+    assert!(rel < 4e-6, "relative error {rel:e}");
 }

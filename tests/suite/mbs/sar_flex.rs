@@ -6,6 +6,8 @@
 //! under a second: it runs, the constraints hold, the work–energy balance
 //! closes, θ(t) stays close to the rigid scene, and a ply-angle
 //! sensitivity of panel 3's strain energy matches central differences.
+//! The balance and the sensitivity are also checked on the study at full
+//! size (2 × 14 modes on 32 divisions, 0–3 s; a few seconds each).
 
 use crate::common::sar::{coarse_sar, replace};
 use crate::common::tables::column_index;
@@ -77,6 +79,52 @@ fn law_integral(law: &PiecewiseLaw, a: f64, b: f64) -> f64 {
     sign * total
 }
 
+/// The R3 actuator of a SAR scene: its Eq. (32) law and damper c.
+fn actuator(scene: &plyscape::scene::Scene) -> (PiecewiseLaw, f64) {
+    match scene.model.forces.first() {
+        Some(Force::Rotational {
+            law: Some(law),
+            damping,
+            ..
+        }) => (law.clone(), *damping),
+        other => panic!("expected the R3 actuator, got {other:?}"),
+    }
+}
+
+/// Work–energy balance of a SAR run. No gravity and no modal damping
+/// (ζ = 0), so the only non-conservative force is the R3 actuator, torque
+/// τ = −M(θ, θ̇) = −m(θ) − c θ̇ (docs/sar_reconstruction.md §5), and
+///   E(t) − E(0) = −∫_{θ0}^{θ(t)} m dθ − c ∫ θ̇² dt,
+/// E = kinetic + strain energy (the `energy` output). The first term is
+/// exact (`law_integral`); the second is composite Simpson on the output
+/// grid, checked at every second output time (the damper's work is
+/// 3.7e-7 J on the coarse scene, 1.3e-4 J at full size; Simpson's error
+/// ~h⁴ stays far below both tests' bounds, the trapezoid rule would leave
+/// ~1e-11 J on the coarse scene).
+/// Returns (largest |ΔE − W|, largest |ΔE|, the damper's work) [J].
+fn balance(sim: &Simulation, law: &PiecewiseLaw, c: f64) -> (f64, f64, f64) {
+    let (ca, cr, ce) = (
+        col(sim, "R3.angle"),
+        col(sim, "R3.rate"),
+        col(sim, "energy"),
+    );
+    let r0 = &sim.rows[0];
+    let mut damper = 0.0;
+    let mut worst = 0.0f64;
+    let mut scale = 0.0f64;
+    for k in (2..sim.rows.len()).step_by(2) {
+        let (a, m, b) = (&sim.rows[k - 2], &sim.rows[k - 1], &sim.rows[k]);
+        let dt = b[0] - a[0];
+        assert!((m[0] - a[0] - 0.5 * dt).abs() < 1e-12, "uneven output grid");
+        damper += c * dt / 6.0 * (a[cr].powi(2) + 4.0 * m[cr].powi(2) + b[cr].powi(2));
+        let work = -law_integral(law, r0[ca], b[ca]) - damper;
+        let de = b[ce] - r0[ce];
+        worst = worst.max((de - work).abs());
+        scale = scale.max(de.abs());
+    }
+    (worst, scale, damper)
+}
+
 #[test]
 fn flexible_sar_runs_balances_energy_and_stays_near_rigid() {
     let flex = coarse(55.0, false, true);
@@ -97,48 +145,17 @@ fn flexible_sar_runs_balances_energy_and_stays_near_rigid() {
         flex.max_violation
     );
 
-    // Work–energy balance. No gravity and no modal damping (ζ = 0), so
-    // the only non-conservative force is the R3 actuator, torque
-    // τ = −M(θ, θ̇) = −m(θ) − c θ̇ (docs/sar_reconstruction.md §5), and
-    //   E(t) − E(0) = −∫_{θ0}^{θ(t)} m dθ − c ∫ θ̇² dt,
-    // E = kinetic + strain energy (the `energy` output). The first term is
-    // exact (law_integral); the second is composite Simpson on the 5 ms
-    // output grid, checked at every second output time (θ̇ ~ 1e-3 rad/s,
-    // the damper term is ~4e-7 J and its quadrature error ~h⁴ far below
-    // the tolerance; the trapezoid rule would leave ~1e-11 J).
+    // Work–energy balance (`balance`), on the coarse scene's own law.
     let scene_text = replace(STUDY, "divisions = 32", "divisions = 8", 2);
     let scene = load_scene(&Study::parse("s.toml", &scene_text).unwrap()).unwrap();
-    let (law, c) = match scene.model.forces.first() {
-        Some(Force::Rotational {
-            law: Some(law),
-            damping,
-            ..
-        }) => (law.clone(), *damping),
-        other => panic!("expected the R3 actuator, got {other:?}"),
-    };
-    let (ca, cr, ce) = (
-        col(&flex, "R3.angle"),
-        col(&flex, "R3.rate"),
-        col(&flex, "energy"),
-    );
+    let (law, c) = actuator(&scene);
+    let (ca, ce) = (col(&flex, "R3.angle"), col(&flex, "energy"));
     let (cs2, cs3) = (
         col(&flex, "B2.strain_energy"),
         col(&flex, "B3.strain_energy"),
     );
     let r0 = &flex.rows[0];
-    let mut damper = 0.0;
-    let mut worst = 0.0f64;
-    let mut scale = 0.0f64;
-    for k in (2..flex.rows.len()).step_by(2) {
-        let (a, m, b) = (&flex.rows[k - 2], &flex.rows[k - 1], &flex.rows[k]);
-        let dt = b[0] - a[0];
-        assert!((m[0] - a[0] - 0.5 * dt).abs() < 1e-12, "uneven output grid");
-        damper += c * dt / 6.0 * (a[cr].powi(2) + 4.0 * m[cr].powi(2) + b[cr].powi(2));
-        let work = -law_integral(&law, r0[ca], b[ca]) - damper;
-        let de = b[ce] - r0[ce];
-        worst = worst.max((de - work).abs());
-        scale = scale.max(de.abs());
-    }
+    let (worst, scale, damper) = balance(&flex, &law, c);
     let last = flex.rows.last().unwrap();
     println!(
         "ΔE {:e} J, damper work {damper:e} J, worst |ΔE − W| {worst:e} J; \
@@ -210,4 +227,93 @@ fn strain_energy_ply_angle_sensitivity_matches_central_differences() {
     );
     assert!(base.rows[last][cs] > 0.0);
     assert!(rel < 1e-5, "relative error {rel:e}");
+}
+
+/// The shipped study at full size (2 × 14 modes on 32 divisions, 0–3 s,
+/// dt_out 0.01 s) with `rtol`, `atol` and `method`; `sens` keeps only the
+/// sensitivity to B3.design.theta_1_4 (else none); panel 3's outer plies
+/// at `theta_deg`.
+fn full(theta_deg: f64, sens: bool, method: &str, rtol: &str, atol: &str) -> Simulation {
+    let sens_line = "sensitivities = [\"B3.design.theta_1_4\", \"B3.design.theta_2_3\", \
+                     \"B2.design.theta_1_4\", \"B2.design.theta_2_3\"]";
+    let new_sens = if sens {
+        "sensitivities = [\"B3.design.theta_1_4\"]"
+    } else {
+        ""
+    };
+    let mut t = replace(STUDY, sens_line, new_sens, 1);
+    t = replace(&t, "method = \"bdf\"", &format!("method = \"{method}\""), 1);
+    t = replace(&t, "rtol = 1e-6", &format!("rtol = {rtol}"), 1);
+    t = replace(&t, "atol = 1e-8", &format!("atol = {atol}"), 1);
+    let (head, tail) = t.split_once("name = \"panel3\"").expect("panel3 entry");
+    let tail = replace(
+        tail,
+        "{ angle = 55.0, thickness",
+        &format!("{{ angle = {theta_deg:.15}, thickness"),
+        2,
+    );
+    let text = format!("{head}name = \"panel3\"{tail}");
+    let study = Study::parse("sar_phase1_flexible.toml", &text).unwrap();
+    simulate(&load_scene(&study).unwrap()).unwrap().1
+}
+
+/// The work–energy balance of the shipped flexible study at full size and
+/// its own settings (BDF, rtol 1e-6, atol 1e-8): the balance closes to
+/// the integration tolerance over the whole deployment window.
+#[test]
+fn full_size_flexible_sar_balances_energy() {
+    let t0 = std::time::Instant::now();
+    let sim = full(55.0, false, "bdf", "1e-6", "1e-8");
+    let study = Study::parse("sar_phase1_flexible.toml", STUDY).unwrap();
+    let (law, c) = actuator(&load_scene(&study).unwrap());
+    let (worst, scale, damper) = balance(&sim, &law, c);
+    let cs3 = col(&sim, "B3.strain_energy");
+    let u3 = sim.rows.iter().map(|r| r[cs3]).fold(0.0, f64::max);
+    println!(
+        "full size: worst |ΔE − W| {worst:e} J of {scale:e} J ({:.2e} relative), \
+         damper work {damper:e} J, peak U3 {u3:e} J, {:?}; {:.2} s",
+        worst / scale,
+        sim.stats,
+        t0.elapsed().as_secs_f64()
+    );
+    assert_eq!(sim.rows.len(), 301);
+    assert!(u3 > 1e-3 * scale, "peak U3 {u3:e}");
+    // Measured 1.4e-7 of the energy change (862 steps, about 2 s); bound 3×.
+    assert!(
+        worst < 4.3e-7 * scale,
+        "balance error {worst:e} of {scale:e} J"
+    );
+}
+
+/// d U_3(3 s) / d θ_{1,4} of panel 3 at full size (2 × 14 modes on 32
+/// divisions, 0–3 s) against central differences of whole simulations
+/// with panel 3 rebuilt at θ ± h; tsit45 at rtol 1e-10 so that the
+/// differences resolve the derivative (the shipped rtol 1e-6 would leave
+/// ~1e-6/h of noise in them).
+#[test]
+fn full_size_strain_energy_ply_angle_sensitivity() {
+    let t0 = std::time::Instant::now();
+    let (rtol, atol) = ("1e-10", "1e-12");
+    let base = full(55.0, true, "tsit45", rtol, atol);
+    let cs = col(&base, "B3.strain_energy");
+    let last = base.rows.len() - 1;
+    let sc = base
+        .sens_headers
+        .iter()
+        .position(|h| h.starts_with("d(B3.strain_energy)/d(B3.design.theta_1_4)"))
+        .expect("sensitivity column");
+    let analytic = base.sens_rows[last][sc];
+    let h: f64 = 2e-4; // rad
+    let plus = full(55.0 + h.to_degrees(), false, "tsit45", rtol, atol);
+    let minus = full(55.0 - h.to_degrees(), false, "tsit45", rtol, atol);
+    let fd = (plus.rows[last][cs] - minus.rows[last][cs]) / (2.0 * h);
+    let rel = (analytic - fd).abs() / fd.abs();
+    println!(
+        "full size: U3(3 s) = {:e} J, dU3/dθ14: analytic {analytic:e}, central FD {fd:e}, \
+         rel {rel:e}; {:.2} s",
+        base.rows[last][cs],
+        t0.elapsed().as_secs_f64()
+    );
+    // Measured 2.3e-6 (three runs, about 4 s); bound 3×.
+    assert!(rel < 6.8e-6, "relative error {rel:e}");
 }

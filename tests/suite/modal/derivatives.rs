@@ -13,6 +13,26 @@ use plyscape::modal::{
 use plyscape::Error;
 use std::f64::consts::PI;
 
+// Bounds of the checks below, about 3× the errors measured on the 2-core
+// VM (2026-11-26), printed by each test.
+/// Distinct modes, dλ against differences (relative): measured 1.7e-9.
+const FD_L_BOUND: f64 = 5e-9;
+/// Distinct modes, dX against differences (relative): measured 8.5e-11.
+const FD_X_BOUND: f64 = 1e-9;
+/// Repeated root, λ against the closed form: measured 6.7e-16.
+const REP_LAM: f64 = 2e-15;
+/// Repeated root, λ' against the closed form: measured 5.6e-17.
+const REP_DLAM: f64 = 1e-15;
+/// Repeated root, adjacent vectors: measured 7.8e-16.
+const REP_VEC: f64 = 2e-15;
+/// Repeated root, their derivatives (relative): measured 1.4e-15.
+const REP_DVEC: f64 = 4e-15;
+/// Generic repeated root, dλ against branch differences: measured 1.6e-12.
+const GEN_L_BOUND: f64 = 5e-12;
+/// Generic repeated root, dX against branch differences (relative):
+/// measured 7.1e-10.
+const GEN_X_BOUND: f64 = 2.1e-9;
+
 /// Parameterised irregular grid: K(p) = Σ_e k_e (1 + α_e sin p₀ + β_e cos 2p₁) K_e
 /// with varied α_e, β_e (so K' is not proportional to K) and varied masses.
 struct Param {
@@ -88,8 +108,8 @@ fn solve(k: &SparseColMat<usize, f64>, mass: &[f64], n_modes: usize, tol: f64) -
 
 /// Well-separated modes of an irregular grid, two design variables:
 /// λ' and X' against fourth-order central finite differences (h = 1e-3,
-/// eigen-solves at tol 1e-13: FD noise ~1e-10, truncation ~h⁴, both far
-/// below the 1e-6 tolerance),
+/// eigen-solves at tol 1e-13: FD noise ~1e-10, truncation ~h⁴; bounds
+/// FD_L_BOUND, FD_X_BOUND),
 /// and X' against the modal expansion over the full dense spectrum
 /// (Fox & Kapoor 1968: xᵢ' = Σ_{j≠i} xⱼ xⱼᵀK'xᵢ/(λᵢ − λⱼ) for M' = 0).
 #[test]
@@ -129,6 +149,7 @@ fn distinct_modes_match_finite_differences_and_modal_expansion() {
     let (lref, xref) = dense_eig(&kk, &pr.mass);
     // Fourth-order central differences (error O(h⁴)), h = 1e-3.
     let h = 1e-3;
+    let (mut worst_l, mut worst_x) = (0.0f64, 0.0f64);
     for v in 0..2 {
         assert!(der[v].clusters.is_empty());
         let at = |t: f64| {
@@ -144,16 +165,16 @@ fn distinct_modes_match_finite_differences_and_modal_expansion() {
         for i in 0..k_modes {
             let fd_l = fd(&|m: &Modes| m.lambda[i]);
             let dl = der[v].dlambda[i];
-            assert!(
-                (dl - fd_l).abs() < 1e-6 * dl.abs().max(1e-3 * modes.lambda[i]),
-                "var {v} mode {i}: dλ {dl} vs FD {fd_l}"
-            );
+            let rel_l = (dl - fd_l).abs() / dl.abs().max(1e-3 * modes.lambda[i]);
+            worst_l = worst_l.max(rel_l);
+            assert!(rel_l < FD_L_BOUND, "var {v} mode {i}: dλ {dl} vs FD {fd_l}");
             // Sign convention is fixed, so FD of the returned modes is valid.
             let fd_x: Vec<f64> = (0..n).map(|r| fd(&|m: &Modes| m.modes[(r, i)])).collect();
             let dx = col(dm, i);
             let scale = maxabs(&fd_x).max(1e-3 * maxabs(&col(&modes.modes, i)));
+            worst_x = worst_x.max(maxdiff(&dx, &fd_x) / scale);
             assert!(
-                maxdiff(&dx, &fd_x) < 1e-6 * scale,
+                maxdiff(&dx, &fd_x) < FD_X_BOUND * scale,
                 "var {v} mode {i}: |dX − FD| = {:e}, scale {scale:e}",
                 maxdiff(&dx, &fd_x)
             );
@@ -183,6 +204,7 @@ fn distinct_modes_match_finite_differences_and_modal_expansion() {
             );
         }
     }
+    println!("dλ against FD: {worst_l:.2e} relative; dX: {worst_x:.2e} relative");
     // Fixed-mode approach: same λ', no X'.
     let fixed = DerivativeOptions {
         update: ModeUpdate::Fixed,
@@ -243,15 +265,21 @@ fn repeated_eigenvalue_adjacent_eigenvectors_exact() {
         (2.0 / (nc as f64 + 1.0)).sqrt() * ((i + 1) as f64 * l as f64 * h).sin()
     };
     let r2 = 0.5f64.sqrt();
+    // Largest errors against the closed forms: λ and λ' (absolute, all
+    // O(0.1..1)), the adjacent vectors (max norm, unit-M-norm vectors),
+    // the derivatives (relative to the largest entry of the exact one).
+    let (mut e_lam, mut e_dlam, mut e_vec, mut e_dvec) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for l in 1..=3 {
         let (c0, c1) = (2 * (l - 1), 2 * (l - 1) + 1);
         assert_eq!(d.clusters[l - 1].first, c0);
-        assert!((modes.lambda[c0] - lam(l)).abs() < 1e-12);
-        assert!((modes.lambda[c1] - lam(l)).abs() < 1e-12);
+        e_lam = e_lam
+            .max((modes.lambda[c0] - lam(l)).abs())
+            .max((modes.lambda[c1] - lam(l)).abs());
         // λ' ascending: symmetric (0) then antisymmetric (2s x_l,0²).
-        assert!(d.dlambda[c0].abs() < 1e-12, "{}", d.dlambda[c0]);
         let dl_anti = 2.0 * s * xc(l, 0).powi(2);
-        assert!((d.dlambda[c1] - dl_anti).abs() < 1e-12 * dl_anti.max(1.0));
+        e_dlam = e_dlam
+            .max(d.dlambda[c0].abs())
+            .max((d.dlambda[c1] - dl_anti).abs());
         // Adjacent vectors, reference signs set by the crate's convention.
         let mut sym: Vec<f64> = (0..n).map(|i| r2 * xc(l, i % nc)).collect();
         let mut anti: Vec<f64> = (0..n)
@@ -265,14 +293,10 @@ fn repeated_eigenvalue_adjacent_eigenvectors_exact() {
             .collect();
         plyscape::modal::sign_normalize(&mut sym);
         plyscape::modal::sign_normalize(&mut anti);
-        assert!(maxdiff(&col(&adj, c0), &sym) < 1e-10);
-        assert!(maxdiff(&col(&adj, c1), &anti) < 1e-10);
-        // Derivatives.
-        assert!(
-            maxabs(&col(dm, c0)) < 1e-10,
-            "sym derivative {}",
-            maxabs(&col(dm, c0))
-        );
+        e_vec = e_vec
+            .max(maxdiff(&col(&adj, c0), &sym))
+            .max(maxdiff(&col(&adj, c1), &anti));
+        // Derivatives: ψ_sym' = 0 (measured against the scale of ψ_anti').
         let sgn = anti[0].signum() * xc(l, 0).signum();
         let mut xp = vec![0.0; nc];
         for q in 1..=nc {
@@ -293,12 +317,23 @@ fn repeated_eigenvalue_adjacent_eigenvectors_exact() {
                 }
             })
             .collect();
-        assert!(
-            maxdiff(&col(dm, c1), &exact) < 1e-9 * maxabs(&exact),
-            "anti derivative pair {l}: {:e}",
-            maxdiff(&col(dm, c1), &exact)
-        );
+        e_dvec = e_dvec
+            .max(maxabs(&col(dm, c0)) / maxabs(&exact))
+            .max(maxdiff(&col(dm, c1), &exact) / maxabs(&exact));
     }
+    println!(
+        "repeated roots: λ {e_lam:.2e}, λ' {e_dlam:.2e}, adjacent vectors {e_vec:.2e}, \
+         their derivatives {e_dvec:.2e} relative"
+    );
+    // Bounds: the module constants (REP_*), about 3× the measured errors.
+    assert!(
+        e_lam < REP_LAM && e_dlam < REP_DLAM,
+        "λ {e_lam:e}, λ' {e_dlam:e}"
+    );
+    assert!(
+        e_vec < REP_VEC && e_dvec < REP_DVEC,
+        "X {e_vec:e}, X' {e_dvec:e}"
+    );
     // Without K'' the repeated cluster cannot be differentiated.
     let no_d2 = [DesignDerivative { dk: &dk, d2k: None }];
     assert!(matches!(
@@ -531,6 +566,7 @@ fn repeated_eigenvalue_generic_perturbation_matches_branch_fd() {
     };
     let pts = [at(-2.0 * h), at(-h), at(h), at(2.0 * h)];
     let mut in_cluster_coupling = 0.0f64;
+    let (mut worst_l, mut worst_x) = (0.0f64, 0.0f64);
     for c in 0..4 {
         let psi = col(&adj, c);
         // Branch at each point: the mode of largest overlap, sign aligned.
@@ -548,15 +584,17 @@ fn repeated_eigenvalue_generic_perturbation_matches_branch_fd() {
             .collect();
         let fd = |f: &dyn Fn(usize) -> f64| (8.0 * (f(2) - f(1)) - (f(3) - f(0))) / (12.0 * h);
         let fd_l = fd(&|k| branch[k].0);
+        worst_l = worst_l.max((d.dlambda[c] - fd_l).abs());
         assert!(
-            (d.dlambda[c] - fd_l).abs() < 1e-7,
+            (d.dlambda[c] - fd_l).abs() < GEN_L_BOUND,
             "mode {c}: dλ {} vs {fd_l}",
             d.dlambda[c]
         );
         let fd_x: Vec<f64> = (0..n).map(|i| fd(&|k| branch[k].1[i])).collect();
         let dx = col(dm, c);
+        worst_x = worst_x.max(maxdiff(&dx, &fd_x) / maxabs(&fd_x));
         assert!(
-            maxdiff(&dx, &fd_x) < 1e-6 * maxabs(&fd_x),
+            maxdiff(&dx, &fd_x) < GEN_X_BOUND * maxabs(&fd_x),
             "mode {c}: |dψ − FD| = {:e} (scale {:e})",
             maxdiff(&dx, &fd_x),
             maxabs(&fd_x)
@@ -565,6 +603,7 @@ fn repeated_eigenvalue_generic_perturbation_matches_branch_fd() {
         in_cluster_coupling =
             in_cluster_coupling.max(mdot(&mass, &fd_x, &col(&adj, partner)).abs());
     }
+    println!("generic repeated root: dλ against FD {worst_l:.2e}, dX {worst_x:.2e} relative");
     // The test is only meaningful if the in-cluster part is non-zero.
     assert!(
         in_cluster_coupling > 1e-3,

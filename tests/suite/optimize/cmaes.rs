@@ -57,12 +57,13 @@ fn rastrigin_hits(n: usize, budget: usize, restarts: Restarts) -> usize {
 }
 
 #[test]
-fn rastrigin_global_minimum_in_9_of_10_seeds() {
+fn rastrigin_global_minimum_in_10_of_10_seeds() {
     // Global minimum f* = 0 at the origin among ~11ⁿ local minima
     // (Rastrigin 1974). Budgets: 10 000 evaluations in 2-D, 60 000 in 5-D.
+    // Seeds are fixed and the runs bit-reproducible, so the count is exact.
     for (n, budget) in [(2, 10_000), (5, 60_000)] {
         let hits = rastrigin_hits(n, budget, Restarts::Ipop);
-        assert!(hits >= 9, "rastrigin{n}: {hits} of 10 seeds");
+        assert_eq!(hits, 10, "rastrigin{n}: {hits} of 10 seeds");
     }
 }
 
@@ -364,15 +365,16 @@ fn bipop_schedule_properties() {
 }
 
 /// BIPOP reaches the global minimum f* = 0 at the origin of Rastrigin
-/// (Rastrigin 1974; ~11ⁿ local minima) in a majority of ten seeds with the
-/// budgets of the IPOP test above. Measured: 9 of 10 seeds in 2-D (IPOP:
-/// 10) and 9 of 10 in 5-D (IPOP: 10); Rastrigin's global structure is
-/// what IPOP's large populations exploit, so BIPOP spending half its
-/// budget on small runs is not expected to do better here.
+/// (Rastrigin 1974; ~11ⁿ local minima) in 9 of ten seeds, in 2-D and in
+/// 5-D, with the budgets of the IPOP test above (IPOP: 10 of 10). The
+/// seeds are fixed and the runs bit-reproducible, so the counts are
+/// asserted exactly. Rastrigin's global structure is what IPOP's large
+/// populations exploit, so BIPOP spending half its budget on small runs
+/// is not expected to do better here.
 #[test]
-fn bipop_rastrigin_global_minimum_in_most_seeds() {
+fn bipop_rastrigin_global_minimum_in_9_of_10_seeds() {
     for (n, budget) in [(2, 10_000), (5, 60_000)] {
         let hits = rastrigin_hits(n, budget, Restarts::Bipop);
-        assert!(hits >= 6, "bipop rastrigin{n}: {hits} of 10 seeds");
+        assert_eq!(hits, 9, "bipop rastrigin{n}: {hits} of 10 seeds");
     }
 }

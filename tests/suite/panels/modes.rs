@@ -389,3 +389,88 @@ fn free_free_plate_rigid_modes_removed_and_frequencies_match_leissa() {
         assert!((g - w).abs() / w < 1e-2, "{got:?}");
     }
 }
+
+/// Peak resident memory \[bytes\] of a child process: its `VmHWM`
+/// (`/proc/<pid>/status`), read every 2 ms while it runs; the last reading
+/// before it exits is kept (the high-water mark only grows within one
+/// program, and readings taken before the child's `exec` belong to the
+/// test process). `wait4`'s `ru_maxrss` would not do: Linux keeps the
+/// largest resident size across `exec`, so it would report the test
+/// process's own size when that is larger.
+#[cfg(target_os = "linux")]
+fn peak_rss_of(mut cmd: Command) -> (bool, f64) {
+    let mut child = cmd.spawn().unwrap();
+    let status = format!("/proc/{}/status", child.id());
+    let mut last = 0.0;
+    loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            return (st.success(), last);
+        }
+        let hwm = std::fs::read_to_string(&status).ok().and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<f64>().ok())
+        });
+        if let Some(kb) = hwm {
+            last = kb * 1024.0;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+}
+
+/// The memory estimate that refuses oversized panels (`study::memory`:
+/// 12 KB per node DOF, `fe::Mesh` checks it before allocating) against
+/// the peak resident memory of real `plyscape modes` runs of the SAR panel
+/// (14 modes and their derivatives, centre clamp) at 32 and 64 divisions:
+/// the estimate must cover the peak (it guards against running out) and
+/// stay within 2× of it (else it refuses sizes that fit). Measured with
+/// the release binary: 42 MB at 32 divisions (estimate 1.18×), 143 MB at
+/// 64 (1.35×).
+#[cfg(target_os = "linux")]
+#[test]
+fn panel_memory_estimate_bounds_the_measured_peak() {
+    let dir = scratch("memory");
+    for divisions in [32, 64] {
+        let text = format!(
+            "[study]\nname = \"mem\"\n[modes]\nn_modes = 14\nderivatives = true\n\
+             [[panels]]\nname = \"p\"\nlength = 1.994\nwidth = 1.3\ndivisions = {divisions}\n\
+             attachment_points = [[0.797, 0.45], [-0.797, 0.45], [0.797, -0.45], [-0.797, -0.45]]\n\
+             support = \"centre_clamp\"\ndesign = [[1, 4], [2, 3]]\n\
+             material = {{ e1 = 177e9, e2 = 10.8e9, g12 = 7.6e9, g13 = 7.6e9, g23 = 8.504e9, nu12 = 0.27, rho = 1600.0 }}\n\
+             plies = [{{ angle = 55.0, thickness = 0.5e-3 }}, {{ angle = -55.0, thickness = 0.5e-3 }}, {{ angle = -55.0, thickness = 0.5e-3 }}, {{ angle = 55.0, thickness = 0.5e-3 }}]\n"
+        );
+        let study = dir.join(format!("mem{divisions}.toml"));
+        std::fs::write(&study, &text).unwrap();
+        let nodes = plyscape::fe::panels_from_study(&Study::parse("mem.toml", &text).unwrap())
+            .unwrap()[0]
+            .mesh
+            .nodes
+            .len();
+        let estimate = plyscape::study::memory::PANEL_BYTES_PER_DOF * (6 * nodes) as f64;
+        let mut cmd = Command::new(bin());
+        cmd.args([
+            "modes",
+            study.to_str().unwrap(),
+            "-q",
+            "--threads",
+            "1",
+            "--out",
+        ])
+        .arg(dir.join("out"));
+        let (ok, peak) = peak_rss_of(cmd);
+        assert!(ok, "plyscape modes failed at {divisions} divisions");
+        println!(
+            "{divisions} divisions, {} DOF: peak {:.1} MB, estimate {:.1} MB ({:.2}×)",
+            6 * nodes,
+            peak / 1e6,
+            estimate / 1e6,
+            estimate / peak
+        );
+        assert!(
+            estimate >= peak && estimate <= 2.0 * peak,
+            "{divisions} divisions: estimate {estimate:e} B, peak {peak:e} B"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
