@@ -430,7 +430,8 @@ fn peak_rss_of(mut cmd: Command) -> (bool, f64) {
 #[cfg(target_os = "linux")]
 #[test]
 fn panel_memory_estimate_bounds_the_measured_peak() {
-    let dir = scratch("memory");
+    let tmp = crate::common::temp_dir("memory");
+    let dir = tmp.path();
     for divisions in [32, 64] {
         let text = format!(
             "[study]\nname = \"mem\"\n[modes]\nn_modes = 14\nderivatives = true\n\
