@@ -41,7 +41,7 @@
 //!   assembly fills values in a fixed order (bit-for-bit deterministic).
 //! - [`spec`]: the `[[panels]]` study-file section.
 //!
-//! # Measured (tests/fe_*.rs; 2-core x86_64 VM)
+//! # Measured (tests/suite/fe/*.rs; 2-core x86_64 VM)
 //! - SS square plate, uniform load, 32×32 cells: centre deflection within
 //!   0.24 % of the Kirchhoff series at a/h = 1000 and 0.19 % of the FSDT
 //!   Navier series at a/h = 10 (no shear locking; second-order convergence).
