@@ -50,10 +50,13 @@ pub struct FlexEffects {
 
 /// Kinematic state of one flexible body.
 pub struct FlexState<'a, T: Scalar> {
+    /// Rotation matrix `A` of the floating frame (frame axes → global).
     pub a: &'a Matrix3<T>,
     /// Angular velocity in frame axes.
     pub wb: &'a Vector3<T>,
+    /// Modal coordinates `w` (length n).
     pub w: &'a [T],
+    /// Modal rates `ẇ` (length n).
     pub wd: &'a [T],
 }
 

@@ -23,6 +23,8 @@ pub trait Scalar: RealField + Copy {
     /// Number of derivative lanes (0 for `f64`).
     const NL: usize;
 
+    /// True when every component (real part and all `NL` lanes) is exactly
+    /// zero: a structural zero.
     fn is_exact_zero(&self) -> bool;
 
     /// The real part.

@@ -15,7 +15,10 @@ use std::sync::Arc;
 /// modal damping.
 #[derive(Debug, Clone)]
 pub struct Flex {
+    /// The modal basis (nodes, masses, mode shapes, eigenvalues and their
+    /// design derivatives), shared by the clones of the body.
     pub basis: Arc<ModalBasis>,
+    /// Inertia invariants of `basis` at the current design.
     pub inv: Invariants,
     /// `d(invariants)/d(design variable)`, one per `basis.derivatives`.
     pub dinv: Vec<Invariants>,
@@ -48,6 +51,7 @@ impl Flex {
 /// A rigid body (or a fixed one, which is part of the ground).
 #[derive(Debug, Clone)]
 pub struct Body {
+    /// Name, as looked up by [`Model::body`](crate::mbs::Model::body).
     pub name: String,
     /// Mass (kg).
     pub mass: f64,
@@ -129,6 +133,7 @@ impl Body {
 /// A point and frame fixed in a body (or in the ground).
 #[derive(Debug, Clone)]
 pub struct Marker {
+    /// Name, as looked up by [`Model::marker`](crate::mbs::Model::marker).
     pub name: String,
     /// Body index into [`Model::bodies`](crate::mbs::Model::bodies); `None` = ground.
     pub body: Option<usize>,

@@ -328,9 +328,14 @@ impl ModalBasis {
 /// their definitions); matrices are row-major, `n` = number of modes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Invariants {
+    /// Number of modes `n`.
     pub n: usize,
+    /// Total mass `Σ m_k` (kg).
     pub mass: f64,
+    /// First moment `Σ m_k s_k` of the undeformed body, frame axes (kg·m).
     pub s0: Vector3<f64>,
+    /// Second moment `Σ m_k s_k s_kᵀ` of the undeformed body, frame axes
+    /// (kg·m²).
     pub e0: Matrix3<f64>,
     /// `[c·n + j]`.
     pub i3: Vec<f64>,
@@ -342,6 +347,7 @@ pub struct Invariants {
     pub q: Vec<f64>,
     /// `[(i·n + j)·3 + c]`.
     pub v: Vec<f64>,
+    /// Sum of the nodal rotary inertias `Σ J_k`, frame axes (kg·m²).
     pub j_rot: Matrix3<f64>,
     /// `[c·n + j]`.
     pub c_rot: Vec<f64>,

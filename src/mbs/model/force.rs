@@ -11,10 +11,15 @@ use nalgebra::Vector3;
 /// on `lower < θ ≤ upper` the value is `value + slope·(anchor − θ)`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Segment {
+    /// Lower bound of `θ` (rad), excluded.
     pub lower: f64,
+    /// Upper bound of `θ` (rad), included.
     pub upper: f64,
+    /// Value of the law at `θ = anchor` (N·m).
     pub value: f64,
+    /// Slope `k` of the line `value + k·(anchor − θ)` (N·m/rad).
     pub slope: f64,
+    /// Angle at which the line takes `value` (rad).
     pub anchor: f64,
 }
 
@@ -75,22 +80,33 @@ impl PiecewiseLaw {
 #[derive(Debug, Clone)]
 pub enum Force {
     /// Uniform gravity `g` (m/s²) on every moving body.
-    Gravity { g: Vector3<f64> },
+    Gravity {
+        /// Acceleration of gravity, global axes (m/s²).
+        g: Vector3<f64>,
+    },
     /// Rotational spring-damper-actuator on a revolute joint (paper Eq. 32):
     /// torque on marker j about `z_i`: `τ = −(c·θ̇ + law(θ))` (N·m), the
     /// reaction on marker i. `damping` = c (N·m·s), `law` may be absent.
     Rotational {
+        /// Index of the revolute joint into [`Model::joints`](crate::mbs::Model::joints).
         joint: usize,
+        /// Piecewise-linear law `law(θ)` (N·m, θ in rad); `None` = none.
         law: Option<PiecewiseLaw>,
+        /// Damping coefficient `c` (N·m·s/rad).
         damping: f64,
     },
     /// Linear spring-damper between markers i and j: tension
     /// `F = k(l − l0) + c·l̇` (N), pulling the points together when > 0.
     SpringDamper {
+        /// Marker i: index into [`Model::markers`](crate::mbs::Model::markers).
         i: usize,
+        /// Marker j: index into [`Model::markers`](crate::mbs::Model::markers).
         j: usize,
+        /// Stiffness `k` (N/m).
         stiffness: f64,
+        /// Damping coefficient `c` (N·s/m).
         damping: f64,
+        /// Free length `l0` (m).
         length: f64,
     },
     /// Translational spring-damper-actuator along the axis `z_i` of the
@@ -101,10 +117,16 @@ pub enum Force {
     /// i and the torque `−T z_i×(x_j − x_i)` on marker i, which makes the
     /// spring the exact gradient of `½k(s − s0)²` also off the axis.
     JointSpring {
+        /// Index of the prismatic or cylindrical joint into
+        /// [`Model::joints`](crate::mbs::Model::joints).
         joint: usize,
+        /// Stiffness `k` (N/m).
         stiffness: f64,
+        /// Damping coefficient `c` (N·s/m).
         damping: f64,
+        /// Free displacement `s0` (m).
         length: f64,
+        /// Constant actuator force `f` (N), pushing the markers apart along `z_i`.
         force: f64,
     },
     /// Force (N) at the centre of mass and torque (N·m) on a body,
@@ -113,8 +135,11 @@ pub enum Force {
     /// proportion to mass (as a uniform acceleration field `f/m`, so it
     /// also loads the modes through `i3ᵀ`); the torque acts on the frame.
     BodyLoad {
+        /// Index of the body into [`Model::bodies`](crate::mbs::Model::bodies).
         body: usize,
+        /// Force and torque, constant or tabulated in time.
         load: Load,
+        /// Axes of the load's components.
         frame: LoadFrame,
     },
     /// Force (N) at the point of a marker and torque (N·m) on its body,
@@ -123,8 +148,11 @@ pub enum Force {
     /// marker's lever arm `s`, plus the torque; on a flexible node, also
     /// the modal forces `Φ_kᵀAᵀf` and `Ψ_kᵀ(…)τ` of the node.
     MarkerLoad {
+        /// Index of the marker into [`Model::markers`](crate::mbs::Model::markers).
         marker: usize,
+        /// Force and torque, constant or tabulated in time.
         load: Load,
+        /// Axes of the load's components.
         frame: LoadFrame,
     },
 }
@@ -142,8 +170,11 @@ pub enum LoadFrame {
 /// A force and torque, constant or piecewise linear in time.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Load {
+    /// A constant force and torque.
     Constant {
+        /// Force (N).
         force: Vector3<f64>,
+        /// Torque (N·m).
         torque: Vector3<f64>,
     },
     /// Rows `(t, [fx, fy, fz, tx, ty, tz])` with increasing `t`; linear

@@ -26,6 +26,8 @@
 /// revolute joint is the constant polynomial.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Drive {
+    /// Polynomial coefficients `[c_0, c_1, …]` (rad/s^k for `c_k`), in
+    /// increasing powers of `t`.
     pub coefficients: Vec<f64>,
 }
 
@@ -146,10 +148,17 @@ impl JointKind {
 }
 
 #[derive(Debug, Clone)]
+/// A joint connecting marker `i` to marker `j` (see the module doc for
+/// the kinds, their rows, `θ` and `s`).
 pub struct Joint {
+    /// Name, as looked up by [`Model::joint`](crate::mbs::Model::joint) and used in row labels.
     pub name: String,
+    /// Kind of joint ([`JointKind::blocks`] gives its rows).
     pub kind: JointKind,
+    /// Marker i (the reference side: axis `z_i`): index into
+    /// [`Model::markers`](crate::mbs::Model::markers).
     pub i: usize,
+    /// Marker j: index into [`Model::markers`](crate::mbs::Model::markers).
     pub j: usize,
 }
 

@@ -9,9 +9,15 @@ use super::joint::Joint;
 /// The whole rigid model.
 #[derive(Debug, Clone, Default)]
 pub struct Model {
+    /// Bodies (rigid, flexible or fixed); markers, loads and design ties
+    /// refer to them by index.
     pub bodies: Vec<Body>,
+    /// Markers; joints, spring-dampers and marker loads refer to them by
+    /// index.
     pub markers: Vec<Marker>,
+    /// Joints; their constraint rows are assembled in this order.
     pub joints: Vec<Joint>,
+    /// Force elements (only those of the scene's effects).
     pub forces: Vec<Force>,
     /// Baumgarte rate α (1/s): the constraint acceleration equation is
     /// `Φ̈ + 2αΦ̇ + α²Φ = 0` (critically damped drift).
@@ -35,7 +41,9 @@ pub struct Model {
 /// IDAS slider-crank's `G = ∫ T dt` the kinetic energies with 1.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Integral {
+    /// Energy terms summed under the integral.
     pub terms: Vec<Energy>,
+    /// Factor applied to the sum (2 for the paper's Ψ₀ = ∫ 2U dt).
     pub scale: f64,
 }
 

@@ -36,7 +36,10 @@ pub struct Projection {
 /// exerted on the body of marker `j`, in global axes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reaction {
+    /// Force on the body of marker `j`, global axes (N).
     pub force: Vector3<f64>,
+    /// Torque on the body of marker `j` about the joint point, global axes
+    /// (N·m).
     pub torque: Vector3<f64>,
 }
 

@@ -14,18 +14,31 @@ use nalgebra::{Matrix3, Vector3};
 /// evaluations, which never build this lifted copy).
 #[derive(Debug, Clone)]
 pub struct InvT<T: Scalar> {
+    /// Number of modes `n`.
     pub n: usize,
+    /// Total mass `Σ m_k` (kg).
     pub mass: T,
+    /// First moment `Σ m_k s_k`, frame axes (kg·m).
     pub s0: Vector3<T>,
+    /// Second moment `Σ m_k s_k s_kᵀ`, frame axes (kg·m²).
     pub e0: Matrix3<T>,
+    /// `Σ m_k Φ_k`, 3 × n row-major: `[c·n + j]`.
     pub i3: Vec<T>,
+    /// `Σ m_k s_k × Φ_kj`, 3 × n row-major: `[c·n + j]`.
     pub ls: Vec<T>,
+    /// `P_j = Σ m_k Φ_kj s_kᵀ`, n blocks of 3 × 3: `[j·9 + 3r + c]`.
     pub p: Vec<T>,
+    /// `Q_ij = Σ m_k Φ_ki Φ_kjᵀ`, n² blocks of 3 × 3: `[(i·n + j)·9 + 3r + c]`.
     pub q: Vec<T>,
+    /// `V_ij = Σ m_k Φ_ki × Φ_kj`, n² vectors of 3: `[(i·n + j)·3 + c]`.
     pub v: Vec<T>,
+    /// Sum of the nodal rotary inertias `Σ J_k`, frame axes (kg·m²).
     pub j_rot: Matrix3<T>,
+    /// `Σ J_k Ψ_k`, 3 × n row-major: `[c·n + j]`.
     pub c_rot: Vec<T>,
+    /// Modal mass `Σ m_k Φ_kᵀΦ_k + Ψ_kᵀJ_kΨ_k`, n × n row-major: `[i·n + j]`.
     pub mww: Vec<T>,
+    /// Eigenvalues Λ (1/s²), length n.
     pub lambda: Vec<T>,
 }
 

@@ -24,10 +24,15 @@ pub(crate) fn bump(c: &Cell<u64>) {
 /// Evaluation counters (what is not built is never evaluated).
 #[derive(Debug, Default)]
 pub struct Counters {
+    /// Right-hand-side evaluations ([`System::rhs`](crate::mbs::System::rhs)).
     pub rhs: Cell<u64>,
+    /// Gravity force evaluations.
     pub gravity: Cell<u64>,
+    /// Rotational spring-damper-actuator (Eq. 32) evaluations.
     pub actuators: Cell<u64>,
+    /// Linear and joint spring-damper evaluations.
     pub springs: Cell<u64>,
+    /// Body and marker load evaluations.
     pub loads: Cell<u64>,
     /// Flexible-body mass matrices and elastic forces built.
     pub flexible: Cell<u64>,
@@ -40,6 +45,7 @@ pub struct Counters {
 /// The assembled system: model + state layout.
 #[derive(Debug)]
 pub struct System {
+    /// The model the state is laid out for.
     pub model: Model,
     /// Body index → state slot (None for fixed bodies).
     pub slot: Vec<Option<usize>>,
@@ -54,6 +60,7 @@ pub struct System {
     /// Constraint rows left out of the solve (their multipliers are zero):
     /// equations found redundant at the projected initial state.
     pub(crate) drop: Vec<bool>,
+    /// Evaluation counters, bumped through `&self`.
     pub counters: Counters,
 }
 

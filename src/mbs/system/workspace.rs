@@ -32,17 +32,32 @@ pub const RIGID: usize = usize::MAX;
 /// [`Workspace::mjac`] ([`RIGID`] otherwise).
 #[derive(Debug, Clone, Copy)]
 pub struct Row<T: Scalar> {
+    /// Constraint value `Φ` (m for point and line rows, dimensionless for
+    /// axis rows, rad for angle rows).
     pub phi: T,
+    /// Velocity residual `Φ̇ = G v − ν` (holds `−ν` before assembly adds
+    /// the Jacobian-velocity products).
     pub phidot: T,
+    /// Acceleration right-hand side `γ` (with the Baumgarte terms
+    /// `−2αΦ̇ − α²Φ` once assembled).
     pub gamma: T,
+    /// Body blocks of the sides i and j: `(state slot, [∂/∂ṙ (3), ∂/∂ω' (3)])`
+    /// (the ω part is global while a row is built, body-frame `ω'` after
+    /// assembly); slot `None` for the ground or a fixed body.
     pub blocks: [(Option<usize>, [T; 6]); 2],
+    /// Markers `[i, j]` of the joint: indices into
+    /// [`Model::markers`](crate::mbs::Model::markers).
     pub markers: [usize; 2],
+    /// Per side: offset of its n modal entries `∂/∂ẇ` in
+    /// [`Workspace::mjac`], or [`RIGID`].
     pub modal: [usize; 2],
 }
 
 /// Scratch storage reused across evaluations (one per scalar type).
 #[derive(Debug, Clone)]
 pub struct Workspace<T: Scalar> {
+    /// Constraint rows of the current evaluation, joint by joint in the
+    /// order of [`Model::joints`](crate::mbs::Model::joints).
     pub rows: Vec<Row<T>>,
     /// The constraint-space matrix and then its factor (real parts: the
     /// solve is real, its tangent reuses the factor).
@@ -53,6 +68,8 @@ pub struct Workspace<T: Scalar> {
     /// Real scratch of the solve: right-hand side and λ, accelerations,
     /// and per lane of a dual evaluation λ' and v̇'.
     pub(crate) sol: SolveScratch,
+    /// Kinematics of every moving body, indexed by state slot (see
+    /// [`System::moving`](crate::mbs::System::moving)).
     pub kin: Vec<BodyKin<T>>,
     /// Kinematics of every marker at the current state.
     pub mk: Vec<MarkerKin<T>>,
@@ -168,8 +185,11 @@ pub type NodeShapes<T> = (Vec<Vector3<T>>, Vec<Vector3<T>>);
 /// Kinematics of one body at the current state.
 #[derive(Debug, Clone)]
 pub struct BodyKin<T: Scalar> {
+    /// Global position of the frame origin `r` (m).
     pub r: Vector3<T>,
+    /// Rotation matrix `A(p)` (body axes → global).
     pub a: Matrix3<T>,
+    /// Global velocity of the frame origin `ṙ` (m/s).
     pub v: Vector3<T>,
     /// Global angular velocity.
     pub w: Vector3<T>,
@@ -177,6 +197,7 @@ pub struct BodyKin<T: Scalar> {
     pub wb: Vector3<T>,
     /// Modal coordinates and rates (empty for rigid bodies).
     pub q: Vec<T>,
+    /// Modal rates `ẇ` (length n; empty for rigid bodies).
     pub qd: Vec<T>,
     /// Design seeds `(variable, δ)` of a flexible body's basis (dual
     /// parts of [`Param::Design`] values; empty in plain evaluations).
@@ -192,6 +213,8 @@ pub struct BodyKin<T: Scalar> {
 /// [`System::markers_kin`]: crate::mbs::System::markers_kin
 #[derive(Debug, Clone, Copy)]
 pub struct MarkerKin<T: Scalar> {
+    /// State slot of the marker's body (index into [`Workspace::kin`]);
+    /// `None` for the ground or a fixed body.
     pub slot: Option<usize>,
     /// Global position.
     pub x: Vector3<T>,
