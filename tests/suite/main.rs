@@ -3,6 +3,7 @@
 //! helpers and fixtures they share.
 mod common;
 mod docs_reference;
+mod docs_validation;
 mod explore;
 mod fe;
 mod golden;
