@@ -21,6 +21,7 @@ pub const DEFAULT_STUDY: &str = include_str!("../studies/main.toml");
 #[derive(Debug, Parser)]
 #[command(name = "plyscape", version, about, long_about = None)]
 pub struct Cli {
+    /// The subcommand to run.
     #[command(subcommand)]
     pub command: Command,
 }
@@ -50,6 +51,7 @@ pub enum Command {
     Run {
         /// Study file (TOML). Omit to run the built-in main study.
         study: Option<PathBuf>,
+        /// Output, thread and overwrite options.
         #[command(flatten)]
         common: Common,
     },
@@ -58,6 +60,7 @@ pub enum Command {
     Modes {
         /// Study file (TOML) with `[[panels]]` and `[modes]`.
         study: PathBuf,
+        /// Output, thread and overwrite options.
         #[command(flatten)]
         common: Common,
     },
@@ -65,6 +68,7 @@ pub enum Command {
     Simulate {
         /// Study file (TOML) with a `[scene]` section.
         study: PathBuf,
+        /// Output, thread and overwrite options.
         #[command(flatten)]
         common: Common,
     },
@@ -72,8 +76,10 @@ pub enum Command {
     Multistart {
         /// Study file (TOML) with the sections `problem` and `multistart`.
         study: PathBuf,
+        /// Output, thread and overwrite options.
         #[command(flatten)]
         common: Common,
+        /// Resume and shard flags of the multistart driver.
         #[command(flatten)]
         drive: DriveArgs,
     },
@@ -81,6 +87,7 @@ pub enum Command {
     Evolve {
         /// Study file (TOML) with a `problem` section (`evolve` optional).
         study: PathBuf,
+        /// Output, thread and overwrite options.
         #[command(flatten)]
         common: Common,
     },
@@ -88,8 +95,10 @@ pub enum Command {
     Compare {
         /// Study file (TOML) with the sections `problem` and `multistart`.
         study: PathBuf,
+        /// Output, thread and overwrite options.
         #[command(flatten)]
         common: Common,
+        /// Resume and shard flags of the multistart driver.
         #[command(flatten)]
         drive: DriveArgs,
     },
@@ -97,6 +106,7 @@ pub enum Command {
     Map {
         /// Study file (TOML) with a `problem` section (`map` optional).
         study: PathBuf,
+        /// Output, thread and overwrite options.
         #[command(flatten)]
         common: Common,
     },

@@ -17,6 +17,8 @@ use crate::optimize::Problem;
 use crate::study::Study;
 use serde::Deserialize;
 
+/// The `[multistart]` section: start points, local optimizer and budget
+/// of the multistart driver.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MultistartSection {

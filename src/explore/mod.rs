@@ -32,8 +32,8 @@
 //! driver command (what `plyscape multistart`, `evolve`, `compare` and
 //! `map` do around the algorithms); [`context`] is what a command gets
 //! from the command line; [`manifest`] types the commands' entries in
-//! `manifest.json`; [`merge`] joins the shards of a multistart; [`tables`]
-//! reads and writes the CSV files.
+//! `manifest.json`; [`merge`](mod@merge) joins the shards of a multistart;
+//! [`tables`] reads and writes the CSV files.
 //!
 //! A problem from a study, evaluated with its gradient (Himmelblau's
 //! function has a minimum f = 0 at (3, 2)):

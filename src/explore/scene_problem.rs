@@ -183,6 +183,7 @@ pub struct EvalProfile {
     pub steps: usize,
     /// Right-hand-side evaluations and Jacobian-vector products.
     pub rhs_calls: u64,
+    /// Jacobian-vector products (each one dual-number evaluation).
     pub jvp_calls: u64,
     /// Wall time of the integration (states and sensitivities, outputs
     /// excluded) \[s\].

@@ -37,6 +37,8 @@ pub struct EventsSpec {
     pub scene: PathBuf,
     /// End time (s), replacing the scene's.
     pub t_end: f64,
+    /// Integrators to compare (`bdf`, `tsit45`, `esdirk34`), each run with
+    /// and without events at every `rtols` entry.
     pub methods: Vec<Method>,
     /// Relative tolerances (0 < rtol < 1).
     pub rtols: Vec<f64>,

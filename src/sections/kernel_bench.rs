@@ -89,8 +89,12 @@ pub const HEADERS: [&str; 17] = [
 /// What identifies a case, and the bare kernel timings of its scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Case {
+    /// Name of the scene study.
     pub scene: String,
+    /// Integrator of the case.
     pub method: Method,
+    /// Relative tolerance of the case (`atol` scaled with it, keeping the
+    /// scene's `atol / rtol`).
     pub rtol: f64,
     /// Number of sensitivity parameters integrated.
     pub n_sens: usize,
@@ -118,7 +122,9 @@ pub struct Measured {
     pub rhs_calls: u64,
     /// Dual-number evaluations (Jacobian-vector and sensitivity products).
     pub jvp_calls: u64,
+    /// Accepted integration steps.
     pub steps: usize,
+    /// Jacobian / LU set-ups.
     pub jacobians: usize,
     /// Largest `|Φ|` over the output times.
     pub max_violation: f64,
@@ -131,7 +137,9 @@ pub struct Measured {
 /// One row of the table: the case and its measurements or failure message.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BenchRow {
+    /// The case that was run.
     pub case: Case,
+    /// Its measurements, or the error message of the failed run.
     pub outcome: std::result::Result<Measured, String>,
 }
 

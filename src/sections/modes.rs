@@ -89,12 +89,21 @@ pub struct ConvergenceSpec {
 /// One computed mode, as written to `modes.csv`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeRow {
+    /// Panel name (`[[panels]]` entry).
     pub panel: String,
+    /// Lay-up in degrees, e.g. `[0/90/90/0]`.
     pub layup: String,
+    /// Mode number, 1-based, in ascending frequency.
     pub mode: usize,
+    /// Natural frequency \[Hz\].
     pub frequency_hz: f64,
+    /// Scaled eigen-residual `‖Kx − λMx‖₂ / (max(|λ|, |σ|) ‖Mx‖₂)`
+    /// (dimensionless).
     pub residual: f64,
+    /// Where the kinetic energy sits: `flexural`, `in-plane` or `drilling`.
     pub kind: &'static str,
+    /// Mirror symmetry of a flexural mode (`SS`, `SA`, `AS`, `AA`; first
+    /// letter for x), `-` if none is found (module doc).
     pub symmetry: &'static str,
     /// Rigid-body content `‖Pφ‖²_M / ‖φ‖²_M` ([`crate::panels::rigid`]).
     pub rigid_content: f64,
@@ -347,7 +356,9 @@ pub fn print_table(results: &[PanelModes], spec: &ModesSpec) {
 /// One row of `convergence.csv`.
 #[derive(Debug, Clone)]
 pub struct ConvergenceRow {
+    /// Mesh density: cells along the panel's length.
     pub divisions: usize,
+    /// Reduced degrees of freedom of the mesh.
     pub dofs: usize,
     /// First flexural mode with symmetry SS \[Hz\].
     pub symmetric_hz: Option<f64>,
@@ -357,6 +368,8 @@ pub struct ConvergenceRow {
     /// modes; assembly with derivative matrices + modes + derivatives for
     /// every design variable.
     pub modes_seconds: f64,
+    /// Median wall time per design with derivative matrices and the
+    /// derivatives for every design variable \[s\] (see `modes_seconds`).
     pub with_derivatives_seconds: f64,
     /// Median split of the second timing \[s\]: assembly, modes, derivatives.
     pub split_seconds: [f64; 3],

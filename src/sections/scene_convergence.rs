@@ -33,8 +33,12 @@ use std::time::Instant;
 pub struct ConvergenceSpec {
     /// Scene study, relative to this study's folder.
     pub scene: PathBuf,
+    /// Panel mesh densities (cells along the length, each ≥ 1), set on
+    /// every `[[panels]]` entry.
     pub divisions: Vec<usize>,
+    /// Numbers of modes (each ≥ 1), set on every flexible body.
     pub modes: Vec<usize>,
+    /// Timed runs per variant; the median is reported (default 1, ≥ 1).
     #[serde(default = "one")]
     pub repeats: usize,
 }
@@ -46,13 +50,17 @@ fn one() -> usize {
 /// One variant's results.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variant {
+    /// Panel mesh density of the variant (cells along the length).
     pub divisions: usize,
+    /// Modes per flexible body of the variant.
     pub modes: usize,
     /// Building the scene (modal bases included), median (ms).
     pub build_ms: f64,
     /// Integration (diffsol wall time), median (ms).
     pub integrate_ms: f64,
+    /// f64 right-hand-side evaluations of the (last) integration.
     pub rhs_calls: usize,
+    /// Accepted integration steps of the (last) integration.
     pub steps: usize,
     /// `(name, value)` of each response.
     pub responses: Vec<(String, f64)>,

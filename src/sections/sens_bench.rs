@@ -79,6 +79,7 @@ pub const HEADERS: [&str; 16] = [
 pub struct Timed {
     /// `plain`, `fused` or `staggered`.
     pub form: String,
+    /// Sensitivity lanes: the number of the scene's sensitivity parameters.
     pub lanes: usize,
     /// Median integrator wall time (s).
     pub integrate: f64,

@@ -42,17 +42,31 @@ use std::time::Instant;
 pub struct CompareSpec {
     /// Scene study, relative to this study's folder (default: this study).
     pub scene: Option<PathBuf>,
+    /// Panel supports to run, set on every `[[panels]]` entry
+    /// (`centre_clamp`, `central_patch`, `simply_supported`, `free_free`);
+    /// the first is the reference. At least one.
     pub supports: Vec<String>,
+    /// Integrators to run, set as `[scene.integrator] method` (`bdf`,
+    /// `tsit45`, `esdirk34`). At least one.
     pub methods: Vec<String>,
+    /// Scene output whose final value is compared, e.g. `R3.angle`.
     pub angle: String,
+    /// Timed runs per support and method; the median wall time is reported
+    /// (default 1, ≥ 1).
     #[serde(default = "one")]
     pub repeats: usize,
+    /// Mesh density set on every `[[panels]]` entry (default: the scene's).
     pub divisions: Option<usize>,
+    /// Modes set on every flexible body (default: the scene's).
     pub modes: Option<usize>,
+    /// Largest accepted `time_ratio` for `within_limits` (default 3).
     #[serde(default = "three")]
     pub max_time_ratio: f64,
+    /// Largest accepted `angle_diff` for `within_limits` \[rad\] (default 1e-4).
     #[serde(default = "angle_limit")]
     pub max_angle_diff: f64,
+    /// Largest accepted relative response difference for `within_limits`
+    /// (default 0.02).
     #[serde(default = "response_limit")]
     pub max_response_rel: f64,
 }
@@ -73,7 +87,9 @@ fn response_limit() -> f64 {
 /// One run: a support and an integrator.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Run {
+    /// Panel support of the run.
     pub support: String,
+    /// Integrator of the run.
     pub method: String,
     /// Modes kept per flexible body, `B2:11 B3:11`.
     pub modes: String,
@@ -83,7 +99,9 @@ pub struct Run {
     pub build_ms: f64,
     /// Integration wall time, median \[ms\].
     pub integrate_ms: f64,
+    /// f64 right-hand-side evaluations of the (last) integration.
     pub rhs_calls: usize,
+    /// Accepted integration steps of the (last) integration.
     pub steps: usize,
     /// Final value of the compared output \[rad\].
     pub angle_end: f64,
@@ -234,9 +252,13 @@ pub fn run_compare(
 /// and whether all are within the spec's limits.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Comparison {
+    /// Integration wall time over the reference's (median times).
     pub time_ratio: f64,
+    /// `|θ(t_end) − θ_ref(t_end)|` of the compared output \[rad\].
     pub angle_diff: f64,
+    /// `|ψ − ψ_ref| / |ψ_ref|` per response, in the run's order.
     pub response_rel: Vec<f64>,
+    /// Whether all three are within the spec's limits.
     pub within_limits: bool,
 }
 

@@ -15,7 +15,9 @@ use std::path::{Path, PathBuf};
 
 /// A design \[its variables' unit\] and its simulation.
 pub struct Design<'a> {
+    /// Design variables \[the problem's variable unit, e.g. deg\].
     pub x: &'a [f64],
+    /// The scene simulated at `x`; its outputs give the curves.
     pub sim: &'a Simulation,
 }
 
