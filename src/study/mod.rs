@@ -116,12 +116,12 @@ impl Study {
                 let path = e.path().clone();
                 let (dotted, value) = locate_value(key, v, &path);
                 // toml's message without its own (section-relative) key.
-                let msg = e.into_inner().message().to_string();
+                let msg = e.into_inner().message().trim().replace('\n', " ");
                 Error::Input {
                     file: self.path.display().to_string(),
                     key: dotted,
                     value: summarize_opt(value),
-                    expected: msg.trim().replace('\n', " "),
+                    expected: expectation(&msg),
                 }
             })
     }
@@ -159,6 +159,20 @@ impl Study {
 /// The dotted key of `path` inside section `key` (`scene.joints[2].axis`)
 /// and the TOML value there, if the document has one (a missing field has
 /// none).
+/// Serde's message turned into what the error's "expected ..." reads:
+/// `unknown variant `x`, expected one of `a`, `b`` becomes
+/// `one of `a`, `b` (unknown variant `x`)`, and `missing field `m`` becomes
+/// `the field `m` (missing)`.
+fn expectation(msg: &str) -> String {
+    if let Some((what, wanted)) = msg.rsplit_once(", expected ") {
+        format!("{wanted} ({what})")
+    } else if let Some(field) = msg.strip_prefix("missing field ") {
+        format!("the field {field} (missing)")
+    } else {
+        msg.to_string()
+    }
+}
+
 fn locate_value<'v>(
     key: &str,
     section: &'v toml::Value,

@@ -293,13 +293,10 @@ fn error_of(text: &str) -> String {
 fn bad_study_input_gets_a_clear_error() {
     let base = "[problem]\nname = \"himmelblau\"\n[multistart]\nmethod = \"steepest\"\n";
     let e = error_of(&format!("{base}sampler = \"halton\"\nstarts = 4\n"));
-    assert!(
-        e.contains("bad.toml")
-            && e.contains("multistart")
-            && e.contains("`sampler`")
-            && e.contains("halton")
-            && e.contains("`lhs`, `sobol`, `uniform`"),
-        "{e}"
+    assert_eq!(
+        e,
+        "bad.toml: `multistart.sampler` = \"halton\": expected one of `lhs`, `sobol`, \
+         `uniform` (unknown variant `halton`)"
     );
     let e = error_of(&format!("{base}starts = 0\n"));
     assert!(
@@ -331,12 +328,10 @@ fn bad_study_input_gets_a_clear_error() {
     );
     let e =
         error_of("[problem]\nname = \"himmelblau\"\n[multistart]\nmethod = \"bfgs\"\nstarts = 4\n");
-    assert!(
-        e.contains("multistart")
-            && e.contains("`method`")
-            && e.contains("bfgs")
-            && e.contains("mmfd"),
-        "{e}"
+    assert_eq!(
+        e,
+        "bad.toml: `multistart.method` = \"bfgs\": expected `mmfd` or `steepest` \
+         (unknown variant `bfgs`)"
     );
     let e = error_of(&format!("{base}starts = 4\nstrats = 5\n"));
     assert!(e.contains("multistart") && e.contains("strats"), "{e}");

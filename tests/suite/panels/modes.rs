@@ -473,5 +473,4 @@ fn panel_memory_estimate_bounds_the_measured_peak() {
             "{divisions} divisions: estimate {estimate:e} B, peak {peak:e} B"
         );
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
