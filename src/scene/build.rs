@@ -8,7 +8,7 @@ use super::parts::{
     ParamKind,
 };
 use super::quantity::{Columns, Quantity, Response};
-use super::spec::{Effect, JointSpec, SceneSpec};
+use super::spec::{Effect, JointSpec, JointType, SceneSpec};
 use crate::error::{Error, Result};
 use crate::integrate::{Options, SensitivityForm};
 use crate::mbs::math::{axis_angle, frame_from_axis};
@@ -399,23 +399,23 @@ pub(super) fn find_body(key: String, name: &str, model: &Model) -> Result<Option
 
 /// The joint kind of `[[scene.joints]]` entry `j` (`key` = `joints[k]`).
 fn joint_kind(key: &str, j: &JointSpec) -> Result<JointKind> {
-    Ok(match j.kind.as_str() {
-        "spherical" => JointKind::Spherical,
-        "revolute" => JointKind::Revolute,
-        "fixed" => JointKind::Fixed,
-        "cylindrical" => JointKind::Cylindrical,
-        "prismatic" if j.angle != 0.0 => {
+    Ok(match j.kind {
+        JointType::Spherical => JointKind::Spherical,
+        JointType::Revolute => JointKind::Revolute,
+        JointType::Fixed => JointKind::Fixed,
+        JointType::Cylindrical => JointKind::Cylindrical,
+        JointType::Prismatic if j.angle != 0.0 => {
             return Err(Error::input(
                 format!("{key}.angle"),
                 j.angle,
                 "0 for a prismatic joint (its frames stay parallel)",
             ))
         }
-        "prismatic" => JointKind::Prismatic,
-        "locked" => JointKind::Driven(Drive {
+        JointType::Prismatic => JointKind::Prismatic,
+        JointType::Locked => JointKind::Driven(Drive {
             coefficients: vec![j.angle],
         }),
-        "driven" => match &j.drive {
+        JointType::Driven => match &j.drive {
             Some(c) if !c.is_empty() && c.iter().all(|v| v.is_finite()) => {
                 JointKind::Driven(Drive {
                     coefficients: c.clone(),
@@ -429,13 +429,6 @@ fn joint_kind(key: &str, j: &JointSpec) -> Result<JointKind> {
                 ))
             }
         },
-        other => {
-            return Err(Error::input(
-                format!("{key}.type"),
-                other,
-                "spherical, revolute, locked, driven, fixed, prismatic or cylindrical",
-            ))
-        }
     })
 }
 

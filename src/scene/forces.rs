@@ -42,7 +42,7 @@ impl SceneSpec {
                 } => {
                     let at = (body.as_deref(), marker.as_deref());
                     let load = load_of(&key, [*force, *torque], table.as_deref())?;
-                    self.load(model, &key, at, frame.as_deref(), load)?
+                    self.load(model, &key, at, frame.unwrap_or(LoadFrame::Global), load)?
                 }
             };
             if let Some(force) = built {
@@ -282,17 +282,16 @@ impl SceneSpec {
     }
 
     /// A load at a body's centre of mass or at a marker (exactly one of
-    /// `at = (body, marker)`), in `frame` axes (None without the `loads`
-    /// effect).
+    /// `at = (body, marker)`), in `frame` axes (`global` unless the study
+    /// says `body`); None without the `loads` effect.
     fn load(
         &self,
         model: &Model,
         key: &str,
         at: (Option<&str>, Option<&str>),
-        frame: Option<&str>,
+        frame: LoadFrame,
         load: Load,
     ) -> Result<Option<Force>> {
-        let frame = load_frame(key, frame)?;
         let force =
             match at {
                 (Some(body), None) => {
@@ -337,20 +336,6 @@ fn load_of(key: &str, [force, torque]: [[f64; 3]; 2], table: Option<&[[f64; 7]]>
         None => Load::Constant { force, torque },
         Some(rows) => Load::Table(load_table(&format!("{key}.table"), rows)?),
     })
-}
-
-/// The axes of a load: `global` (default) or `body`.
-fn load_frame(key: &str, frame: Option<&str>) -> Result<LoadFrame> {
-    match frame {
-        None | Some("global") => Ok(LoadFrame::Global),
-        Some("body") => Ok(LoadFrame::Body),
-        Some(other) => Err(Error::input(
-            format!("{key}.frame"),
-            format!("\"{other}\""),
-            "\"global\" (components in global axes) or \"body\" (in the body's axes, \
-             turning with it)",
-        )),
-    }
 }
 
 /// A marker by name; an unknown name is an input error on `key` listing

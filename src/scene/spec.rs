@@ -264,11 +264,9 @@ fn unit_y() -> [f64; 3] {
 pub struct JointSpec {
     /// Unique joint name.
     pub name: String,
-    /// `type`: `spherical`, `revolute`, `locked`, `driven`, `fixed`,
-    /// `prismatic` or `cylindrical`, as written (checked when the scene is
-    /// built).
+    /// `type`: the kind of joint ([`JointType`]).
     #[serde(rename = "type")]
-    pub kind: String,
+    pub kind: JointType,
     /// First body (`ground` allowed).
     pub body_i: String,
     /// Second body (`ground` allowed).
@@ -285,6 +283,28 @@ pub struct JointSpec {
     /// `driven`: polynomial coefficients `[c0, c1, ..]` of `θ(t) = Σ c_k t^k`
     /// (rad, rad/s, ..).
     pub drive: Option<Vec<f64>>,
+}
+
+/// A joint's `type` in a study file. Each maps to one
+/// [`crate::mbs::JointKind`] (`locked` and `driven` to a driven revolute).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum JointType {
+    /// A common point (3 equations).
+    Spherical,
+    /// A common point and a common axis: one rotation left (5 equations).
+    Revolute,
+    /// A revolute joint held at its initial `angle` (6 equations).
+    Locked,
+    /// A revolute joint whose angle follows the polynomial `drive`
+    /// θ(t) = Σ c_k t^k (6 equations).
+    Driven,
+    /// No relative motion (6 equations).
+    Fixed,
+    /// A sliding joint along `axis`: one translation left (5 equations).
+    Prismatic,
+    /// A sliding and turning joint about `axis` (4 equations).
+    Cylindrical,
 }
 
 /// One `[[scene.markers]]` entry: a named point fixed on a body (for
@@ -374,8 +394,9 @@ pub enum ForceSpec {
         body: Option<String>,
         /// The marker loaded (or `body`).
         marker: Option<String>,
-        /// `global` (default) or `body`, as written.
-        frame: Option<String>,
+        /// Axes of the components: `global` (default) or `body` (turning
+        /// with the body).
+        frame: Option<crate::mbs::LoadFrame>,
         /// Constant force (N, default 0).
         #[serde(default)]
         force: [f64; 3],

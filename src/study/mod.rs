@@ -114,9 +114,16 @@ impl Study {
             .map(Some)
             .map_err(|e| {
                 let path = e.path().clone();
-                let (dotted, value) = locate_value(key, v, &path);
+                let (mut dotted, mut value) = locate_value(key, v, &path);
                 // toml's message without its own (section-relative) key.
                 let msg = e.into_inner().message().trim().replace('\n', " ");
+                // Inside an internally tagged enum (`[[scene.forces]]`) the
+                // path stops at the entry: an unknown kind is then found
+                // by its value among the entry's keys.
+                if let Some((k, found)) = value.and_then(|t| unknown_variant_in(&msg, t)) {
+                    dotted = format!("{dotted}.{k}");
+                    value = Some(found);
+                }
                 Error::Input {
                     file: self.path.display().to_string(),
                     key: dotted,
@@ -171,6 +178,17 @@ fn expectation(msg: &str) -> String {
     } else {
         msg.to_string()
     }
+}
+
+/// The key and value of the entry of `table` holding the unknown variant
+/// that serde's `msg` names (`unknown variant `x`, expected ...`).
+fn unknown_variant_in<'v>(msg: &str, table: &'v toml::Value) -> Option<(&'v str, &'v toml::Value)> {
+    let name = msg.strip_prefix("unknown variant `")?.split('`').next()?;
+    table
+        .as_table()?
+        .iter()
+        .find(|(_, v)| v.as_str() == Some(name))
+        .map(|(k, v)| (k.as_str(), v))
 }
 
 fn locate_value<'v>(

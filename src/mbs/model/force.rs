@@ -157,8 +157,10 @@ pub enum Force {
     },
 }
 
-/// The axes a load's components are given in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The axes a load's components are given in (a study's `frame`:
+/// `global` or `body`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum LoadFrame {
     /// Global axes: the load keeps its direction in space.
     Global,

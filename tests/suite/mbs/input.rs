@@ -63,6 +63,7 @@ fn each_bad_input_names_file_key_and_value() {
         (BASE.replace("t_end = 0.5", "t_end = -0.5"), "scene.integrator.t_end", "-0.5"),
         (BASE.replace("effects = [\"gravity\"]", "effects = [\"gravitee\"]"), "scene.effects[0]", "gravitee"),
         (BASE.replace("\"pin.angle\"", "\"pn.angle\""), "scene.outputs.quantities[0]", "pn.angle"),
+        (BASE.replace("type = \"revolute\"", "type = \"hinge\""), "scene.joints[0].type", "hinge"),
         (
             BASE.replace("quantities = [\"pin.angle\"]", "quantities = [\"pin.angle\"]\nplot = \"pin.angle\"\nplot_file = \"../x\""),
             "scene.outputs.plot_file",
@@ -159,7 +160,7 @@ fn force_and_response_errors_name_key_value_and_the_expected_values() {
             load("marker = \"pin.j\"\nframe = \"bodyy\"\n"),
             "scene.forces[0].frame",
             "bodyy",
-            &["\"global\"", "\"body\""],
+            &["`global`", "`body`"],
         ),
         (
             load("force = [1.0, 0.0, 0.0]\n"),
