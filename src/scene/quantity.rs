@@ -61,7 +61,7 @@ pub enum Subject {
 impl Subject {
     /// How the head is written in messages (`<joint>`), empty for
     /// [`Subject::Scene`].
-    pub fn placeholder(self) -> &'static str {
+    pub fn name_pattern(self) -> &'static str {
         match self {
             Subject::Scene => "",
             Subject::AngleJoint => "<revolute, locked or driven joint>",
@@ -204,7 +204,7 @@ impl QuantityKind {
                 let i = k.info();
                 match i.subject {
                     Subject::Scene => i.name.to_string(),
-                    s => format!("{}.{}", s.placeholder(), i.name),
+                    s => format!("{}.{}", s.name_pattern(), i.name),
                 }
             })
             .collect();
