@@ -41,6 +41,10 @@ pub struct MultistartSection {
     pub max_evaluations: Option<usize>,
     /// Stop launching runs after this wall time \[s\].
     pub max_wall_seconds: Option<f64>,
+    /// Rows of `runs.csv` evaluated again on `--resume` (default 2; see
+    /// [`super::fingerprint`]).
+    #[serde(default = "default_resume_checks")]
+    pub resume_checks: usize,
     /// Same optimum: coordinates within this fraction of each range
     /// (default 1e-2: 1.8° on a 180° ply angle; MMFD with DOT's default
     /// DELOBJ = 1e-3 stops that far from the exact optimum on flat valleys).
@@ -61,6 +65,9 @@ pub struct MultistartSection {
     pub mmfd: MmfdSettings,
 }
 
+fn default_resume_checks() -> usize {
+    super::fingerprint::DEFAULT_RESUME_CHECKS
+}
 fn default_x_tol() -> f64 {
     1e-2
 }
@@ -171,6 +178,10 @@ pub struct MapSection {
     /// Variable pairs for more than two variables (default: consecutive
     /// pairs (0,1), (2,3), ...).
     pub pairs: Option<Vec<[usize; 2]>>,
+    /// Cells evaluated again on `--resume` (default 2; see
+    /// [`super::fingerprint`]).
+    #[serde(default = "default_resume_checks")]
+    pub resume_checks: usize,
 }
 
 fn default_resolution() -> usize {
@@ -280,6 +291,7 @@ pub fn map_section(study: &Study) -> Result<MapSection> {
     let sec: MapSection = study.section("map")?.unwrap_or(MapSection {
         resolution: default_resolution(),
         pairs: None,
+        resume_checks: default_resume_checks(),
     });
     if !(2..=2001).contains(&sec.resolution) {
         return Err(study.error("map.resolution", sec.resolution, "2 <= resolution <= 2001"));
