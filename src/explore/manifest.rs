@@ -122,15 +122,24 @@ pub struct CmaesRunEntry {
     pub generations: usize,
 }
 
-/// `map`.
+/// `map`: written with `complete = false` before the first cell, then
+/// again when every table is whole.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MapEntry {
+    /// Every slice's table has all its cells (absent in manifests written
+    /// before resumable maps, which wrote the entry at the end only).
+    #[serde(default = "whole")]
+    pub complete: bool,
     /// Grid points per axis.
     pub resolution: usize,
     /// With more than two variables: the design the slices pass through
     /// (each held variable's value, by name).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub slices_through: Option<std::collections::BTreeMap<String, f64>>,
+}
+
+fn whole() -> bool {
+    true
 }
 
 /// `optimum_report`.

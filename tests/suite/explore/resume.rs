@@ -177,3 +177,90 @@ fn a_hand_edited_f_is_caught_by_the_spot_check() {
     // The table is left as it was.
     assert!(std::fs::read_to_string(&runs).unwrap().contains(",-1,"));
 }
+
+const MAP: &str =
+    "[study]\nname = \"m\"\nseed = 2\n[problem]\nname = \"hs22\"\n[map]\nresolution = 9\n";
+
+/// Run `plyscape map` on `study` into `out` (with `--resume` if asked).
+fn map(
+    study: &plyscape::study::Study,
+    out: &std::path::Path,
+    resume: bool,
+) -> plyscape::Result<()> {
+    let flags = DriveFlags {
+        resume,
+        ..Default::default()
+    };
+    explore::run_map(&ctx(study, out, 2, flags)).map(|_| ())
+}
+
+#[test]
+fn an_interrupted_map_resumes_to_the_same_table_byte_for_byte() {
+    let tmp = temp_dir("resume-map");
+    let dir = tmp.path().to_path_buf();
+    let s = study("m", MAP);
+    let full = dir.join("full");
+    map(&s, &full, false).unwrap();
+    let table = std::fs::read(full.join("m/map.csv")).unwrap();
+    let text = String::from_utf8(table.clone()).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 1 + 81);
+    // What an interrupt leaves: the header, the first k cells in grid
+    // order and half of the next line.
+    let part = dir.join("part");
+    std::fs::create_dir_all(part.join("m")).unwrap();
+    let k = 30;
+    let mut cut = lines[..=k].join("\n") + "\n";
+    cut.push_str(&lines[k + 1][..lines[k + 1].len() / 2]);
+    std::fs::write(part.join("m/map.csv"), &cut).unwrap();
+    map(&s, &part, true).unwrap();
+    assert_eq!(std::fs::read(part.join("m/map.csv")).unwrap(), table);
+    assert_eq!(
+        std::fs::read(part.join("m/map.svg")).unwrap(),
+        std::fs::read(full.join("m/map.svg")).unwrap()
+    );
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(part.join("m/manifest.json")).unwrap())
+            .unwrap();
+    assert_eq!(m["commands"]["map"]["complete"], true);
+    assert!(m["commands"]["map"]["fingerprint"]["parts"]["problem"].is_string());
+
+    // A finished map resumes to itself, computing nothing.
+    map(&s, &part, true).unwrap();
+    assert_eq!(std::fs::read(part.join("m/map.csv")).unwrap(), table);
+
+    // Another resolution: the rows are not its grid's cells.
+    std::fs::write(part.join("m/map.csv"), lines[..=k].join("\n") + "\n").unwrap();
+    let finer = study("m", &MAP.replace("resolution = 9", "resolution = 11"));
+    let e = map(&finer, &part, true).unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    assert!(e.to_string().contains("the grid (resolution"), "{e}");
+    // Another problem: refused by the fingerprint.
+    let other = study("m", &MAP.replace("hs22", "himmelblau"));
+    let e = map(&other, &part, true).unwrap_err().to_string();
+    assert!(
+        e.contains("problem changed (problem.name: \"hs22\" → \"himmelblau\")"),
+        "{e}"
+    );
+    // A hand-edited cell, every cell checked: refused with its values.
+    let edited: Vec<String> = lines[..=k]
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 12 {
+                let mut f: Vec<&str> = l.split(',').collect();
+                f[2] = "7.25";
+                f.join(",")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect();
+    std::fs::write(part.join("m/map.csv"), edited.join("\n") + "\n").unwrap();
+    let all = study(
+        "m",
+        &MAP.replace("resolution = 9", "resolution = 9\nresume_checks = 1000"),
+    );
+    let e = map(&all, &part, true).unwrap_err().to_string();
+    assert!(e.contains("(line 13)") && e.contains("f = 7.25e0"), "{e}");
+}
