@@ -264,3 +264,61 @@ fn an_interrupted_map_resumes_to_the_same_table_byte_for_byte() {
     let e = map(&all, &part, true).unwrap_err().to_string();
     assert!(e.contains("(line 13)") && e.contains("f = 7.25e0"), "{e}");
 }
+
+/// Kill the real `plyscape map` process mid-run, then `map --resume` with
+/// the fast study (the evaluation cost is no part of the fingerprint): the
+/// table equals an uninterrupted run's byte for byte.
+#[test]
+fn a_killed_map_process_resumes_to_the_uninterrupted_table() {
+    use std::time::{Duration, Instant};
+    let tmp = temp_dir("resume-map-kill");
+    let dir = tmp.path().to_path_buf();
+    let fast = dir.join("m.toml");
+    let text = MAP.replace("resolution = 9", "resolution = 11");
+    std::fs::write(&fast, &text).unwrap();
+    // 121 cells sleeping 40 ms each: about 2.4 s on 2 threads.
+    let slow = dir.join("slow.toml");
+    std::fs::write(
+        &slow,
+        text.replace("hs22\"", "hs22\"\ncost_ms = 40.0\ncost_mode = \"sleep\""),
+    )
+    .unwrap();
+    let (full, part) = (dir.join("full"), dir.join("part"));
+    let run = |study: &std::path::Path, out: &std::path::Path, resume: bool| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_plyscape"));
+        c.args([
+            "map",
+            study.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .args(["--threads", "2", "-q"]);
+        if resume {
+            c.arg("--resume");
+        }
+        c
+    };
+    assert!(run(&fast, &full, false).status().unwrap().success());
+    let mut child = run(&slow, &part, false).spawn().unwrap();
+    let table = part.join("m/map.csv");
+    let t0 = Instant::now();
+    while std::fs::read_to_string(&table).map_or(0, |t| t.lines().count()) < 11
+        && t0.elapsed() < Duration::from_secs(60)
+    {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    assert!(!child.wait().unwrap().success(), "finished before the kill");
+    let rows = std::fs::read_to_string(&table).unwrap().lines().count() - 1;
+    assert!((10..121).contains(&rows), "{rows} rows at the kill");
+    let out = run(&fast, &part, true).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read(&table).unwrap(),
+        std::fs::read(full.join("m/map.csv")).unwrap()
+    );
+}
