@@ -225,7 +225,7 @@ fn read_cells(
 /// parallel but appended in grid order, one line per cell, flushed, so an
 /// interrupted map leaves a prefix of its final table (and at worst a torn
 /// last line). With `opts.resume` the cells already in the table are read
-/// back ([`read_cells`]: a torn line is cut, a row off the grid refused),
+/// back (a torn line is cut, a row off the grid refused),
 /// `opts.checks` of them are evaluated again
 /// ([`super::fingerprint::reproduces`]), and only the missing cells are
 /// computed: the final table is byte for byte the uninterrupted one.
