@@ -58,6 +58,7 @@ impl SceneSpec {
         let mut model = Model {
             baumgarte: self.baumgarte,
             quadratic_velocity: self.has(Effect::QuadraticVelocity),
+            geometric_stiffening: self.has(Effect::GeometricStiffening),
             ..Model::default()
         };
         self.add_bodies(&mut model, panels)?;

@@ -9,7 +9,7 @@ use serde::Deserialize;
 
 /// What a scene may switch on (`[scene] effects`, written in snake case:
 /// `gravity`, `actuators`, `damping`, `springs`, `loads`, `flexibility`,
-/// `quadratic_velocity`): what is not listed is neither built nor
+/// `quadratic_velocity`, `geometric_stiffening`): what is not listed is neither built nor
 /// evaluated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -28,11 +28,14 @@ pub enum Effect {
     Flexibility,
     /// Quadratic-velocity (gyroscopic and centrifugal) terms.
     QuadraticVelocity,
+    /// Geometric stiffening of flexible bodies by their inertial
+    /// prestress ([`crate::mbs::model::geometric`]).
+    GeometricStiffening,
 }
 
 impl Effect {
     /// Every effect, in the order of the documentation.
-    pub const ALL: [Effect; 7] = [
+    pub const ALL: [Effect; 8] = [
         Effect::Gravity,
         Effect::Actuators,
         Effect::Damping,
@@ -40,6 +43,7 @@ impl Effect {
         Effect::Loads,
         Effect::Flexibility,
         Effect::QuadraticVelocity,
+        Effect::GeometricStiffening,
     ];
 
     /// The name written in study files.
@@ -52,6 +56,7 @@ impl Effect {
             Effect::Loads => "loads",
             Effect::Flexibility => "flexibility",
             Effect::QuadraticVelocity => "quadratic_velocity",
+            Effect::GeometricStiffening => "geometric_stiffening",
         }
     }
 }

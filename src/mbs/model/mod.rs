@@ -1,5 +1,6 @@
 //! The model as data: bodies and markers ([`body`]), modal bases and
-//! their inertia invariants ([`flex`]), joints and the table of joint
+//! their inertia invariants ([`flex`]), the geometric stiffness of
+//! their inertial prestress ([`geometric`]), joints and the table of joint
 //! kinds ([`joint`]), force elements ([`force`]), the whole model with its
 //! energy terms ([`mechanism`]) and sensitivity parameters ([`param`]),
 //! with their validation. SI units throughout. Nothing here depends on
@@ -8,6 +9,7 @@
 pub mod body;
 pub mod flex;
 pub mod force;
+pub mod geometric;
 pub mod joint;
 pub mod mechanism;
 pub mod param;
