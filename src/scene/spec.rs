@@ -280,9 +280,89 @@ pub struct JointSpec {
     /// held angle of a `locked` joint.
     #[serde(default)]
     pub angle: f64,
-    /// `driven`: polynomial coefficients `[c0, c1, ..]` of `θ(t) = Σ c_k t^k`
-    /// (rad, rad/s, ..).
-    pub drive: Option<Vec<f64>>,
+    /// `driven`: the prescribed angle θ(t) ([`DriveSpec`]): polynomial
+    /// coefficients `[c0, c1, ..]` of `θ(t) = Σ c_k t^k` (rad, rad/s, ..),
+    /// a piecewise law `{ pieces = [..] }` or a table `{ table = [..] }`.
+    pub drive: Option<DriveSpec>,
+}
+
+/// A driven joint's `drive` as written: an array (polynomial
+/// coefficients) or a table with `pieces` or `table`
+/// ([`crate::mbs::model::drive`] for the laws and their derivatives).
+#[derive(Debug, Clone, PartialEq)]
+pub enum DriveSpec {
+    /// `drive = [c0, c1, ..]`: `θ(t) = Σ c_k t^k`.
+    Polynomial(Vec<f64>),
+    /// `drive = { pieces = [..] }` or `drive = { table = [..] }`.
+    Law(DriveLawSpec),
+}
+
+impl<'de> Deserialize<'de> for DriveSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = DriveSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "polynomial coefficients [c0, c1, ..], { pieces = [..] } or \
+                     { table = [[t, θ], ..] }",
+                )
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, a: A) -> Result<DriveSpec, A::Error> {
+                Vec::<f64>::deserialize(SeqAccessDeserializer::new(a)).map(DriveSpec::Polynomial)
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, a: A) -> Result<DriveSpec, A::Error> {
+                DriveLawSpec::deserialize(MapAccessDeserializer::new(a)).map(DriveSpec::Law)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// `drive = { pieces = [..] }` (a piecewise law) or `drive = { table =
+/// [[t, θ], ..] }` (a cubic spline through the rows): exactly one of the
+/// two.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveLawSpec {
+    /// The pieces in time order; each one's time τ starts at 0 where
+    /// the piece starts (the first at t = 0).
+    pub pieces: Option<Vec<PieceSpec>>,
+    /// Rows `[t, θ]` (s, rad), `t` strictly increasing, at least 4: the
+    /// not-a-knot C² cubic spline through them, continued linearly
+    /// outside.
+    pub table: Option<Vec<[f64; 2]>>,
+}
+
+/// One piece of a piecewise drive: `θ = Σ c_k τ^k + Σ a sin(ωτ + φ)` with
+/// `τ` the time since the piece's start.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PieceSpec {
+    /// End time of the piece (s, absolute): required on every piece but
+    /// the last, refused on the last.
+    pub until: Option<f64>,
+    /// Polynomial coefficients `[c0, c1, ..]` in powers of τ (rad, rad/s,
+    /// ..; default none).
+    #[serde(default)]
+    pub poly: Vec<f64>,
+    /// Harmonic terms (default none).
+    #[serde(default)]
+    pub harmonics: Vec<HarmonicSpec>,
+}
+
+/// A harmonic term `amplitude · sin(omega·τ + phase)` of a piece.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HarmonicSpec {
+    /// Amplitude (rad).
+    pub amplitude: f64,
+    /// Angular frequency (rad/s).
+    pub omega: f64,
+    /// Phase at the piece's start (rad, default 0).
+    #[serde(default)]
+    pub phase: f64,
 }
 
 /// A joint's `type` in a study file. Each maps to one
@@ -296,8 +376,8 @@ pub enum JointType {
     Revolute,
     /// A revolute joint held at its initial `angle` (6 equations).
     Locked,
-    /// A revolute joint whose angle follows the polynomial `drive`
-    /// θ(t) = Σ c_k t^k (6 equations).
+    /// A revolute joint whose angle follows the `drive` law θ(t)
+    /// (polynomial, pieces or table; 6 equations).
     Driven,
     /// No relative motion (6 equations).
     Fixed,

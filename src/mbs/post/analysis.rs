@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::mbs::kinematics::{angle_of, slide_of};
 use crate::mbs::math::Scalar;
-use crate::mbs::model::{Energy, Force, JointKind};
+use crate::mbs::model::{Energy, Force};
 use crate::mbs::system::{BodyKin, System, Workspace, RANK_REG, RANK_TOL};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
@@ -280,7 +280,7 @@ impl System {
             .model
             .joints
             .iter()
-            .all(|j| !matches!(j.kind, JointKind::Driven(ref d) if d.coefficients.len() > 1));
+            .all(|j| j.kind.drive().is_none_or(|d| d.is_constant()));
         forces_ok && joints_ok && modal_ok
     }
 
