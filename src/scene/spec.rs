@@ -442,9 +442,11 @@ pub enum ForceSpec {
         segments: Vec<SegmentSpec>,
     },
     /// A spring-damper between two markers (`marker_i`, `marker_j`; rest
-    /// `length` default: the initial distance) or along a prismatic or
+    /// `length` default: the initial distance), along a prismatic or
     /// cylindrical `joint` (rest displacement `length`, default 0, and a
-    /// constant actuator `force` along the axis, default 0).
+    /// constant actuator `force` along the axis, default 0), or about a
+    /// revolute `joint` (a torsion spring: free `angle`, default 0, and a
+    /// constant preload `torque`, default 0).
     Spring {
         /// Name for sensitivity parameters (`<name>.stiffness`,
         /// `<name>.damping`).
@@ -453,12 +455,13 @@ pub enum ForceSpec {
         marker_i: Option<String>,
         /// Second marker.
         marker_j: Option<String>,
-        /// A prismatic or cylindrical joint to act along (instead of the
-        /// markers).
+        /// A prismatic or cylindrical joint to act along, or a revolute
+        /// joint to act about (instead of the markers).
         joint: Option<String>,
-        /// Stiffness (N/m).
+        /// Stiffness (N/m; N·m/rad about a revolute joint).
         stiffness: f64,
-        /// Viscous damping (N·s/m, default 0).
+        /// Viscous damping (N·s/m; N·m·s/rad about a revolute joint;
+        /// default 0).
         #[serde(default)]
         damping: f64,
         /// Rest length (m; default: the initial distance of the markers, or
@@ -466,6 +469,12 @@ pub enum ForceSpec {
         length: Option<f64>,
         /// Constant force along a joint's axis (N, default 0).
         force: Option<f64>,
+        /// Free angle θ0 of a torsion spring (rad, default 0): τ = −k(θ −
+        /// θ0) − cθ̇ + torque.
+        angle: Option<f64>,
+        /// Constant preload torque of a torsion spring (N·m, default 0),
+        /// turning body j positively about the axis.
+        torque: Option<f64>,
     },
     /// A force and torque at a body's centre of mass (`body`) or at a
     /// marker (`marker`), in global or body axes (`frame`).

@@ -1,6 +1,7 @@
 //! Force elements as data: gravity, the paper's Eq. 32
 //! spring-damper-actuator with its piecewise-linear law, linear
-//! spring-dampers between markers or along a sliding joint, and constant
+//! spring-dampers between markers or along a sliding joint, torsion
+//! spring-dampers on revolute joints, and constant
 //! or time-tabulated loads (SI units). They are applied by
 //! `crate::mbs::forces`.
 
@@ -128,6 +129,25 @@ pub enum Force {
         length: f64,
         /// Constant actuator force `f` (N), pushing the markers apart along `z_i`.
         force: f64,
+    },
+    /// Torsion spring-damper on a revolute joint: torque on marker j about
+    /// `z_i`, `τ = −k·(θ − θ0) − c·θ̇ + τ0` (N·m), the reaction on marker
+    /// i, with `θ − θ0` taken in (−π, π] (the joint angle is measured
+    /// there: the spring holds within half a turn of `θ0`). Positive `τ`
+    /// turns body j in the positive sense about the axis: the natural sign
+    /// of a spring of potential `½k(θ − θ0)²`.
+    TorsionSpring {
+        /// Index of the revolute joint into
+        /// [`Model::joints`](crate::mbs::Model::joints).
+        joint: usize,
+        /// Stiffness `k` (N·m/rad).
+        stiffness: f64,
+        /// Damping coefficient `c` (N·m·s/rad).
+        damping: f64,
+        /// Free angle `θ0` (rad).
+        angle: f64,
+        /// Constant preload torque `τ0` (N·m), turning body j positively.
+        torque: f64,
     },
     /// Force (N) at the centre of mass and torque (N·m) on a body,
     /// constant or tabulated in time, with components in global or body

@@ -130,18 +130,19 @@ fn force_and_response_errors_name_key_value_and_the_expected_values() {
     };
     let load = |body: &str| BASE.to_string() + "[[scene.forces]]\ntype = \"load\"\n" + body;
     let cases: Vec<(String, &str, &str, &[&str])> = vec![
-        // A spring along an unknown joint, and along a revolute one.
+        // A spring along an unknown joint, and a rest length on a torsion
+        // spring (about a revolute joint).
         (
             spring("joint = \"slid\"\n"),
             "scene.forces[0].joint",
             "slid",
-            &["prismatic or cylindrical joint", "none in this scene"],
+            &["prismatic, cylindrical or revolute joint", "(pin)"],
         ),
         (
-            spring("joint = \"pin\"\n"),
-            "scene.forces[0].joint",
-            "pin",
-            &["type = \"actuator\""],
+            spring("joint = \"pin\"\nlength = 0.2\n"),
+            "scene.forces[0].length",
+            "0.2",
+            &["no length or force on a torsion spring"],
         ),
         (
             spring("joint = \"pin\"\nmarker_i = \"pin.i\"\nmarker_j = \"pin.j\"\n"),

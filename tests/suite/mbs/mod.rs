@@ -19,3 +19,4 @@ mod scene_convergence;
 mod sens;
 mod slider_crank;
 mod studies;
+mod torsion;
