@@ -268,6 +268,20 @@ impl SceneSpec {
         }
         if let Some(p) = &self.outputs.plot {
             let plotted = parse_quantity(model, flex_names, "outputs.plot", p)?;
+            if !self.outputs.quantities.iter().any(|q| q == p) {
+                return Err(Error::input(
+                    "outputs.plot",
+                    p,
+                    format!(
+                        "one of outputs.quantities ({}): the plot draws a column of history.csv",
+                        if self.outputs.quantities.is_empty() {
+                            "none listed".to_string()
+                        } else {
+                            self.outputs.quantities.join(", ")
+                        }
+                    ),
+                ));
+            }
             if plotted.kind.info().columns != Columns::One {
                 return Err(Error::input(
                     "outputs.plot",

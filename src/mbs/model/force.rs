@@ -24,8 +24,9 @@ pub struct Segment {
     pub anchor: f64,
 }
 
-/// Piecewise-linear law `M(θ)` (Eq. 32 without the damping term). Outside
-/// the union of the segments the nearest boundary segment extends its line.
+/// Piecewise-linear law `M(θ)` (Eq. 32 without the damping term): the
+/// segments tile an interval of `θ`; outside it the nearest boundary
+/// segment extends its line.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PiecewiseLaw {
     /// Segments sorted by `lower`.
@@ -33,8 +34,11 @@ pub struct PiecewiseLaw {
 }
 
 impl PiecewiseLaw {
-    /// Validates (non-empty, `lower < upper`, finite) and sorts.
-    pub fn new(key: &str, mut segments: Vec<Segment>) -> Result<PiecewiseLaw> {
+    /// Validates (non-empty, `lower < upper`, finite; sorted by `lower`,
+    /// each segment's `upper` is the next one's `lower`: no gap, no
+    /// overlap) and sorts. `key` (e.g. `forces[0].segments`) names the
+    /// offending segment in errors, with the bounds of both neighbours.
+    pub fn new(key: &str, segments: Vec<Segment>) -> Result<PiecewiseLaw> {
         if segments.is_empty() {
             return Err(Error::input(key, "[]", "at least one segment"));
         }
@@ -48,7 +52,30 @@ impl PiecewiseLaw {
                 ));
             }
         }
-        segments.sort_by(|a, b| a.lower.total_cmp(&b.lower));
+        // Sorted by lower bound, remembering the written index of each.
+        let mut order: Vec<usize> = (0..segments.len()).collect();
+        order.sort_by(|&a, &b| segments[a].lower.total_cmp(&segments[b].lower));
+        for w in order.windows(2) {
+            let (a, b) = (&segments[w[0]], &segments[w[1]]);
+            if a.upper != b.lower {
+                let what = if a.upper < b.lower {
+                    "a gap"
+                } else {
+                    "an overlap"
+                };
+                return Err(Error::input(
+                    format!("{key}[{}]", w[1]),
+                    format!("({}, {}]", b.lower, b.upper),
+                    format!(
+                        "lower = {} (the upper bound of {key}[{}], ({}, {}]): the segments \
+                         must tile the angle range without gaps or overlaps; here {what} \
+                         between the two",
+                        a.upper, w[0], a.lower, a.upper
+                    ),
+                ));
+            }
+        }
+        let segments = order.into_iter().map(|k| segments[k].clone()).collect();
         Ok(PiecewiseLaw { segments })
     }
 
