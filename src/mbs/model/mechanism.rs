@@ -116,9 +116,7 @@ mod tests {
         let kinds = [
             JointKind::Spherical,
             JointKind::Revolute,
-            JointKind::Driven(Drive {
-                coefficients: vec![0.0],
-            }),
+            JointKind::Driven(Drive::Polynomial(vec![0.0])),
             JointKind::Fixed,
             JointKind::Cylindrical,
             JointKind::Prismatic,

@@ -1,6 +1,7 @@
 //! Tests of `plyscape::mbs` and the scenes built on it: kernel, joints, loads, flexible bodies, sensitivities, the SAR scenes and the shipped studies.
 mod andrews;
 mod convergence;
+mod drives;
 mod energy;
 mod events;
 mod flex;
@@ -18,3 +19,4 @@ mod scene_convergence;
 mod sens;
 mod slider_crank;
 mod studies;
+mod torsion;
