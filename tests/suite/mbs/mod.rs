@@ -18,5 +18,6 @@ mod sar_holddown;
 mod scene_convergence;
 mod sens;
 mod slider_crank;
+mod stiffening;
 mod studies;
 mod torsion;
