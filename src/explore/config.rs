@@ -98,6 +98,13 @@ pub struct EvolveSection {
     /// rtol 1e-6), below which no progress is real, and a run whose f
     /// never settles within 1e-12 never restarts: set it above the noise.
     pub tol_fun: Option<f64>,
+    /// Stop a schedule when a design feasible to the tolerance reaches
+    /// `f <= target` (stop reason `target_reached`). Default: none.
+    pub target: Option<f64>,
+    /// Active CMA-ES (negative weights for the worst samples). Default
+    /// false.
+    #[serde(default)]
+    pub active: bool,
 }
 
 /// A checked `[evolve]`.
@@ -119,6 +126,11 @@ pub fn evolve_plan(study: &Study) -> Result<EvolvePlan> {
     if let Some(t) = section.tol_fun {
         if !(t.is_finite() && t >= 0.0) {
             return Err(study.error("evolve.tol_fun", t, "a finite range >= 0"));
+        }
+    }
+    if let Some(t) = section.target {
+        if !t.is_finite() {
+            return Err(study.error("evolve.target", t, "a finite objective value"));
         }
     }
     let schedules = schedules(section.restarts.as_ref()).map_err(study.locate("evolve"))?;
@@ -410,6 +422,17 @@ mod tests {
             e.contains("evolve.restarts[1]") && e.contains("restarts[0]"),
             "{e}"
         );
+        let s = study(&format!(
+            "{HIMMELBLAU}[evolve]\ntarget = 1e-6\nactive = true\n"
+        ));
+        let plan = evolve_plan(&s).unwrap();
+        assert_eq!(
+            (plan.section.target, plan.section.active),
+            (Some(1e-6), true)
+        );
+        let s = study(&format!("{HIMMELBLAU}[evolve]\ntarget = nan\n"));
+        let e = evolve_plan(&s).unwrap_err().to_string();
+        assert!(e.contains("evolve.target"), "{e}");
         let s = study(&format!("{HIMMELBLAU}[evolve]\nmax_evaluations = 0\n"));
         let e = evolve_plan(&s).unwrap_err().to_string();
         assert!(e.contains("evolve.max_evaluations"), "{e}");
