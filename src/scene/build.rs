@@ -143,6 +143,18 @@ impl SceneSpec {
                     Body::new(&key, &b.name, mass, inertia, (com, [1.0, 0.0, 0.0, 0.0]))?
                 }
             };
+            let no_geometric = body
+                .flex
+                .as_ref()
+                .is_some_and(|f| f.basis.geometric.is_none());
+            if self.has(Effect::GeometricStiffening) && no_geometric {
+                return Err(Error::input(
+                    format!("{key}.flexible.kind"),
+                    "panel",
+                    "a `beam` body with `geometric_stiffening` in scene.effects (panels \
+                     have no geometric stiffness yet: remove the effect or use a beam)",
+                ));
+            }
             body.fixed = b.fixed;
             body.v0 = finite3(format!("{key}.velocity"), b.velocity)?;
             body.w0 = body.orientation().transpose()
