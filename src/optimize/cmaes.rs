@@ -8,10 +8,10 @@
 //! `c_c`, rank-one `c_1`, rank-μ `c_μ`, damping `d_σ`) and the `h_σ` stall
 //! of the evolution path. Option `active` (Jastrebski & Arnold, CEC 2006;
 //! Hansen 2016 eqs. 46–47, 53): the λ − μ worst samples get the negative
-//! weights `ln((λ+1)/2) − ln i`, scaled to `min(1 + c₁/c_μ, 1 + 2μ⁻_eff/(μ_eff
-//! + 2), (1 − c₁ − c_μ)/(n c_μ)) / Σ|w⁻|`, each times `n / |C^{−1/2} y_i|²`,
-//! and the decay of C is `1 − c₁ − c_μ Σ_all w`. Restarts ([`Restarts`])
-//! start from a uniformly random mean in the box:
+//! weights `ln((λ+1)/2) − ln i`, scaled to
+//! `min(1 + c₁/c_μ, 1 + 2μ⁻_eff/(μ_eff + 2), (1 − c₁ − c_μ)/(n c_μ)) / Σ|w⁻|`,
+//! each times `n / |C^{−1/2} y_i|²`; C decays by `1 − c₁ − c_μ Σ_all w`.
+//! Restarts ([`Restarts`]) start from a uniformly random mean in the box:
 //! - IPOP (default; A. Auger, N. Hansen, "A restart CMA evolution strategy
 //!   with increasing population size", CEC 2005): restart `i` has the
 //!   population `λ_i = round(λ_def · F^i)` (F = `popsize_factor` = 2) and
