@@ -284,21 +284,11 @@ impl SceneSpec {
                 )
             })?;
         let (length, force) = (length.unwrap_or(0.0), force.unwrap_or(0.0));
-        for (name, v, min) in [
-            ("stiffness", stiffness, 0.0),
-            ("damping", damping, 0.0),
-            ("length", length, f64::NEG_INFINITY),
-            ("force", force, f64::NEG_INFINITY),
-        ] {
-            if !(v.is_finite() && v >= min) {
-                let what = if min == 0.0 {
-                    "a finite value ≥ 0"
-                } else {
-                    "a finite value"
-                };
-                return Err(Error::input(format!("{key}.{name}"), v, what));
-            }
-        }
+        check_spring_values(
+            key,
+            [stiffness, damping],
+            [("length", length), ("force", force)],
+        )?;
         Ok(self.has(Effect::Springs).then_some(Force::JointSpring {
             joint: jt,
             stiffness,
@@ -329,21 +319,11 @@ impl SceneSpec {
             ));
         }
         let (angle, torque) = (angle.unwrap_or(0.0), torque.unwrap_or(0.0));
-        for (name, v, min) in [
-            ("stiffness", stiffness, 0.0),
-            ("damping", damping, 0.0),
-            ("angle", angle, f64::NEG_INFINITY),
-            ("torque", torque, f64::NEG_INFINITY),
-        ] {
-            if !(v.is_finite() && v >= min) {
-                let what = if min == 0.0 {
-                    "a finite value ≥ 0"
-                } else {
-                    "a finite value"
-                };
-                return Err(Error::input(format!("{key}.{name}"), v, what));
-            }
-        }
+        check_spring_values(
+            key,
+            [stiffness, damping],
+            [("angle", angle), ("torque", torque)],
+        )?;
         Ok(self.has(Effect::Springs).then_some(Force::TorsionSpring {
             joint: jt,
             stiffness,
@@ -433,4 +413,25 @@ fn name_list(names: &[&str]) -> String {
         n if n <= 12 => names.join(", "),
         _ => format!("{}, …", names[..12].join(", ")),
     }
+}
+
+/// A joint spring's `stiffness` and `damping` finite and ≥ 0, and its two
+/// free values (free length and preload, or free angle and preload)
+/// finite; the error names `<key>.<name>`.
+fn check_spring_values(key: &str, [k, c]: [f64; 2], free: [(&str, f64); 2]) -> Result<()> {
+    for (name, v) in [("stiffness", k), ("damping", c)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(Error::input(
+                format!("{key}.{name}"),
+                v,
+                "a finite value ≥ 0",
+            ));
+        }
+    }
+    for (name, v) in free {
+        if !v.is_finite() {
+            return Err(Error::input(format!("{key}.{name}"), v, "a finite value"));
+        }
+    }
+    Ok(())
 }
