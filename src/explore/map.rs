@@ -10,7 +10,7 @@
 //! angle, which keeps the picture closed at the seam. Cells are evaluated in
 //! parallel (rayon, one evaluation per task) and written in grid order.
 
-use super::tables::{csv_line, num};
+use super::tables::{csv_line, num, read_csv_lines};
 use crate::error::{Error, Result};
 use crate::optimize::{Evaluation, Problem};
 use crate::report::{heat_map, HeatMap, Progress};
@@ -137,43 +137,19 @@ fn read_cells(
     ys: &[f64],
     m: usize,
 ) -> Result<Vec<Evaluation>> {
-    let bytes = match std::fs::read(path) {
-        Ok(b) => b,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(Error::io(path, e)),
+    let Some(lines) = read_csv_lines(path, header, "is not this study's map")? else {
+        return Ok(Vec::new());
     };
-    let mut keep = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
-    let mut records = Vec::new();
-    let mut rd = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .from_reader(&bytes[..keep]);
-    for r in rd.records() {
-        let r = r.map_err(|e| Error::csv(path, e))?;
-        let at = r.position().map_or(0, |p| p.byte() as usize);
-        records.push((r, at));
-    }
+    let mut keep = lines.keep;
     let ny = ys.len();
     let mut cells = Vec::new();
-    for (k, (r, at)) in records.iter().enumerate() {
-        if k == 0 {
-            if r.iter().ne(header.iter().map(String::as_str)) {
-                return Err(Error::csv(
-                    path,
-                    format!(
-                        "header {:?} is not this study's map (expected {:?})",
-                        r.iter().collect::<Vec<_>>().join(","),
-                        header.join(",")
-                    ),
-                ));
-            }
-            continue;
-        }
+    for (i, (r, at)) in lines.rows.iter().enumerate() {
+        let k = i + 1; // the header is record 0
         let nums: Option<Vec<f64>> = (r.len() == header.len())
             .then(|| (0..3 + m).map(|i| r.get(i)?.parse().ok()).collect())
             .flatten();
         let Some(v) = nums else {
-            if k + 1 == records.len() {
+            if i + 1 == lines.rows.len() {
                 keep = *at;
                 break;
             }
@@ -201,7 +177,7 @@ fn read_cells(
             grad_g: None,
         });
     }
-    if keep < bytes.len() {
+    if keep < lines.len {
         let f = std::fs::OpenOptions::new()
             .write(true)
             .open(path)
@@ -212,7 +188,7 @@ fn read_cells(
             "warning: {}: removed a torn last line ({} bytes) left by an interrupted map; \
              that cell is evaluated again",
             path.display(),
-            bytes.len() - keep
+            lines.len - keep
         );
     }
     Ok(cells)
