@@ -243,7 +243,7 @@ pub struct CsvLines {
 }
 
 /// Read a table's whole lines (`None` when the file does not exist); a
-/// first line other than `header` is refused as "header .. <what>".
+/// first line other than `header` is refused as "header .. `what`".
 pub fn read_csv_lines(path: &Path, header: &[String], what: &str) -> Result<Option<CsvLines>> {
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
