@@ -1,5 +1,9 @@
 //! Merge local optima that are the same design.
 //!
+//! Only certified runs (class `converged`: feasible, Kuhn–Tucker
+//! conditions met; see [`crate::optimize::kkt`]) are optima; the others
+//! keep an empty optimum id and are counted by class ([`ClassCounts`]).
+//!
 //! Two run results are the same optimum when every coordinate differs by at
 //! most `x_tolerance` times its variable's range (on the circle for periodic
 //! variables, so 89.9° and −89.9° are 0.2° apart) and their objectives differ
@@ -11,7 +15,8 @@
 //! data alone, so the clusters do not depend on the order in which runs
 //! finished, on the thread count or on sharding.
 
-use super::tables::RunRecord;
+use super::tables::{class_name, RunRecord};
+use crate::optimize::kkt::EndClass;
 use crate::optimize::Variable;
 
 /// Tolerances of the clustering (see the module doc).
@@ -59,13 +64,102 @@ pub fn scaled_distance(vars: &[Variable], a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Cluster the finished runs (`runs` in any order); sets `optimum` on each
-/// record with a result and returns the optima sorted by id.
+/// Is the run a certified optimum (a result whose certificate says
+/// `converged`)?
+pub fn certified(r: &RunRecord) -> bool {
+    r.result.is_some()
+        && r.certificate
+            .as_ref()
+            .is_some_and(|c| c.class == EndClass::Converged)
+}
+
+/// How the runs ended, by class (`runs.csv`'s `class` column).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub struct ClassCounts {
+    /// All runs in the tables.
+    pub runs: usize,
+    /// Certified optima: feasible, Kuhn–Tucker conditions met.
+    pub converged: usize,
+    /// Feasible but not stationary (stopped short, also after the polish).
+    pub stopped: usize,
+    /// Not feasible within the tolerance.
+    pub infeasible: usize,
+    /// Of the infeasible: at a stationary point of the violation (descent
+    /// on the violation cannot reach the feasible set from there).
+    pub infeasible_stationary: usize,
+    /// Of the infeasible, the others whose restoration stalled (exit
+    /// `infeasible`: no shortening of the restoration step lowered the
+    /// violation, or three steps in a row lowered it by less than 1 %): a
+    /// kink or a flat valley of the violation the gradient test cannot see.
+    #[serde(default)]
+    pub infeasible_stalled: usize,
+    /// Failed runs (an error) and results whose certificate failed.
+    pub failed: usize,
+}
+
+impl ClassCounts {
+    /// Count the classes of `runs`.
+    pub fn of(runs: &[RunRecord]) -> ClassCounts {
+        let mut c = ClassCounts {
+            runs: runs.len(),
+            ..Default::default()
+        };
+        for r in runs {
+            match class_name(r) {
+                "converged" => c.converged += 1,
+                "stopped" => c.stopped += 1,
+                "infeasible" => {
+                    c.infeasible += 1;
+                    let stationary = r.certificate.as_ref().and_then(|c| c.violation_stationary);
+                    if stationary == Some(true) {
+                        c.infeasible_stationary += 1;
+                    } else if r.exit == "infeasible" {
+                        c.infeasible_stalled += 1;
+                    }
+                }
+                _ => c.failed += 1,
+            }
+        }
+        c
+    }
+
+    /// `count / runs` (0 without runs).
+    pub fn share(&self, count: usize) -> f64 {
+        if self.runs == 0 {
+            0.0
+        } else {
+            count as f64 / self.runs as f64
+        }
+    }
+
+    /// One line: counts and shares of each class.
+    pub fn summary(&self) -> String {
+        let pct = |k: usize| 100.0 * self.share(k);
+        format!(
+            "{} converged ({:.1} %), {} stopped ({:.1} %), {} infeasible ({:.1} %; {} at a \
+             stationary point of the violation, {} where descent on it stalled), {} failed",
+            self.converged,
+            pct(self.converged),
+            self.stopped,
+            pct(self.stopped),
+            self.infeasible,
+            pct(self.infeasible),
+            self.infeasible_stationary,
+            self.infeasible_stalled,
+            self.failed
+        )
+    }
+}
+
+/// Cluster the certified runs (`runs` in any order); sets `optimum` on
+/// each certified record (clears it on the others) and returns the optima
+/// sorted by id.
 pub fn cluster(vars: &[Variable], runs: &mut [RunRecord], tol: Tolerances) -> Vec<Optimum> {
     let total = runs.len();
-    let mut order: Vec<usize> = (0..runs.len())
-        .filter(|&i| runs[i].result.is_some())
-        .collect();
+    for r in runs.iter_mut() {
+        r.optimum = None;
+    }
+    let mut order: Vec<usize> = (0..runs.len()).filter(|&i| certified(&runs[i])).collect();
     let key = |i: usize| runs[i].result.as_ref().map_or(f64::INFINITY, |r| r.f);
     order.sort_by(|&a, &b| {
         key(a)
@@ -141,7 +235,17 @@ mod tests {
     use crate::explore::tables::RunResult;
 
     fn rec(start: usize, x: Vec<f64>, f: f64) -> RunRecord {
+        let certificate = Some(crate::optimize::kkt::Certificate {
+            class: EndClass::Converged,
+            max_g: f64::NEG_INFINITY,
+            kt_residual: Some(0.0),
+            multipliers: vec![],
+            violation_residual: None,
+            violation_stationary: None,
+        });
         RunRecord {
+            certificate,
+            polish: String::new(),
             start,
             x0: x.clone(),
             result: Some(RunResult { x, f, g: vec![] }),

@@ -10,7 +10,7 @@ use super::cluster::Tolerances;
 use super::problems;
 use super::sampling::{self, Sampler};
 use super::scene_problem;
-use super::solvers::{LocalMethod, MmfdSettings};
+use super::solvers::{LocalMethod, MmfdPreset, MmfdSettings};
 use crate::error::{Error, Result};
 use crate::optimize::cmaes::Restarts;
 use crate::optimize::Problem;
@@ -56,13 +56,55 @@ pub struct MultistartSection {
     /// by `x_tolerance`).
     #[serde(default = "default_f_tol")]
     pub f_tolerance: f64,
-    /// Feasible: `max g <= feasibility_tolerance` (default 3e-3, DOT's
-    /// CTMIN, the violation MMFD accepts at its optimum).
+    /// Feasible: `max g <= feasibility_tolerance` (default 1e-6). The one
+    /// tolerance of the study: MMFD's CTMIN, the certificate, the polish,
+    /// CMA-ES's ranking and the tables' `feasible` columns all use it.
     #[serde(default = "default_feas_tol")]
     pub feasibility_tolerance: f64,
-    /// MMFD convergence settings (`[multistart.mmfd]`; DOT defaults).
+    /// The certificate's stationarity tolerance: a feasible end is
+    /// `converged` when its relative Kuhn–Tucker residual is at most this
+    /// (default 1e-4; see `optimize::kkt`).
+    #[serde(default = "default_kt_tol")]
+    pub kt_tolerance: f64,
+    /// The certificate's active set: `g_j >= −active_tolerance` (default
+    /// 1e-4).
+    #[serde(default = "default_active_tol")]
+    pub active_tolerance: f64,
+    /// Polish every end that is not converged (default true; see
+    /// [`super::settle`]).
+    #[serde(default = "default_polish")]
+    pub polish: bool,
+    /// Infeasible runs checked by a pure descent on the violation from
+    /// their starts (default 0; see [`super::violation`]).
+    #[serde(default)]
+    pub violation_checks: usize,
+    /// MMFD's settings before `[multistart.mmfd]`: `dot` (default, DOT's
+    /// own, with its absolute-change exit) or `standard` (without it, the
+    /// Kuhn–Tucker exit relative to the gradient).
+    #[serde(default)]
+    pub preset: MmfdPreset,
+    /// MMFD convergence settings (`[multistart.mmfd]`; over the preset).
     #[serde(default)]
     pub mmfd: MmfdSettings,
+}
+
+impl MultistartSection {
+    /// The certificate's tolerances.
+    pub fn kkt_tolerances(&self) -> crate::optimize::kkt::KktTolerances {
+        crate::optimize::kkt::KktTolerances {
+            feasibility: self.feasibility_tolerance,
+            active: self.active_tolerance,
+            stationarity: self.kt_tolerance,
+        }
+    }
+
+    /// What happens at every run's end.
+    pub fn end_policy(&self) -> super::settle::EndPolicy {
+        super::settle::EndPolicy {
+            tolerances: self.kkt_tolerances(),
+            polish: self.polish,
+        }
+    }
 }
 
 fn default_resume_checks() -> usize {
@@ -75,7 +117,16 @@ fn default_f_tol() -> f64 {
     1e-2
 }
 fn default_feas_tol() -> f64 {
-    3e-3
+    1e-6
+}
+fn default_kt_tol() -> f64 {
+    1e-4
+}
+fn default_active_tol() -> f64 {
+    1e-4
+}
+fn default_polish() -> bool {
+    true
 }
 
 /// The `[evolve]` section.
@@ -237,6 +288,8 @@ pub fn multistart_section(study: &Study) -> Result<MultistartSection> {
     for (key, v) in [
         ("x_tolerance", s.x_tolerance),
         ("f_tolerance", s.f_tolerance),
+        ("kt_tolerance", s.kt_tolerance),
+        ("active_tolerance", s.active_tolerance),
     ] {
         crate::error::require_positive(key, v).map_err(&loc)?;
     }
@@ -357,7 +410,7 @@ mod tests {
                 plan.tolerances.f,
                 plan.tolerances.feasibility
             ),
-            (1e-2, 1e-2, 3e-3)
+            (1e-2, 1e-2, 1e-6)
         );
         // The same study gives the same starts; another seed other ones.
         let again = multistart_plan(&s, p.as_ref()).unwrap();

@@ -14,7 +14,7 @@
 //! | `scene` | `[scene]` without `responses` and `outputs` (a scene problem drops the output columns) |
 //! | `responses` | `[[scene.responses]]` |
 //! | `panels` | `[[panels]]` |
-//! | `solver` | `[multistart]` without the keys that choose starts, budgets, clustering and checks (`starts`, `points`, `sampler`, `feasible_only`, `max_evaluations`, `max_wall_seconds`, `x_tolerance`, `f_tolerance`, `resume_checks`) and without `feasibility_tolerance`: the method and `[multistart.mmfd]` (a key added later counts here) |
+//! | `solver` | `[multistart]` without the keys that choose starts, budgets, clustering and checks (`starts`, `points`, `sampler`, `feasible_only`, `max_evaluations`, `max_wall_seconds`, `x_tolerance`, `f_tolerance`, `resume_checks`, `violation_checks`) and without `feasibility_tolerance`: the method and `[multistart.mmfd]` (a key added later counts here) |
 //! | `feasibility_tolerance` | `[multistart] feasibility_tolerance` |
 //!
 //! With an analytic problem (`[problem] name` other than `scene`) the
@@ -67,9 +67,10 @@ use std::path::Path;
 
 /// The version of the code's evaluations: raised by hand with every change
 /// that moves the value of an evaluation (physics, integration, objective
-/// or constraint formulas), so that `--resume` refuses tables computed
-/// before it.
-pub const EVALUATION_VERSION: u32 = 1;
+/// or constraint formulas) or the end of a run, so that `--resume` refuses
+/// tables computed before it. 2: every run's end certified and polished,
+/// MMFD's CTMIN the study's feasibility tolerance (default 1e-6).
+pub const EVALUATION_VERSION: u32 = 2;
 
 /// Relative tolerance of the spot check (see the module doc).
 pub const RECHECK_RTOL: f64 = 1e-9;
@@ -149,6 +150,7 @@ pub const PARTS: [Part; 8] = [
             "multistart.x_tolerance",
             "multistart.f_tolerance",
             "multistart.resume_checks",
+            "multistart.violation_checks",
             "multistart.feasibility_tolerance",
         ],
         scene_only: false,
@@ -745,7 +747,7 @@ mod tests {
         let what = b.differences(&old, None, &modes.table);
         assert_eq!(
             what,
-            ["code changed (evaluation version 0 → 1)", "scene changed"]
+            ["code changed (evaluation version 0 → 2)", "scene changed"]
         );
         // The map's evaluation parts leave the solver out.
         let e = b.evaluation_only();

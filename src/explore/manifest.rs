@@ -53,6 +53,16 @@ pub struct MultistartCounts {
     pub filter_evaluations: usize,
     /// Wall time of the runs \[s\].
     pub wall_seconds: f64,
+    /// How the runs in the tables ended, by class.
+    #[serde(default)]
+    pub classes: crate::explore::cluster::ClassCounts,
+    /// The study's one feasibility tolerance (certificate, CTMIN, CMA-ES).
+    #[serde(default)]
+    pub feasibility_tolerance: f64,
+    /// Infeasible runs checked by a pure descent on the violation, and how
+    /// many of those descents reached the feasible set.
+    #[serde(default)]
+    pub violation_checks: (usize, usize),
 }
 
 /// `evolve`: the budget and TolFun, and the schedules.
@@ -217,6 +227,17 @@ mod tests {
                     runs_this_invocation: 10,
                     filter_evaluations: 0,
                     wall_seconds: 90.5,
+                    classes: crate::explore::cluster::ClassCounts {
+                        runs: 64,
+                        converged: 40,
+                        stopped: 3,
+                        infeasible: 20,
+                        infeasible_stationary: 18,
+                        infeasible_stalled: 1,
+                        failed: 1,
+                    },
+                    feasibility_tolerance: 1e-6,
+                    violation_checks: (8, 1),
                 }),
             },
         };

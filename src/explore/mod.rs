@@ -83,8 +83,10 @@ pub mod problems;
 pub mod sampling;
 pub mod scaling;
 pub mod scene_problem;
+pub mod settle;
 pub mod solvers;
 pub mod tables;
+pub mod violation;
 
 pub use commands::compare::{comparison_table, run_compare, ComparisonRow};
 pub use commands::evolve::{regime_counts, run_evolve};

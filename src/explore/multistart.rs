@@ -18,7 +18,8 @@
 //! - `max_wall_seconds`: stops launching after that time. This one depends
 //!   on the machine; `--resume` continues where it stopped.
 
-use super::cluster::{cluster, Optimum, Tolerances};
+use super::cluster::{cluster, ClassCounts, Optimum, Tolerances};
+use super::settle::{settle, EndPolicy};
 use super::tables::{num, read_runs, write_atomic, RunRecord, RunResult, RunsAppender};
 use crate::error::{Error, Result};
 use crate::optimize::{
@@ -83,6 +84,8 @@ pub struct Settings {
     pub quiet: bool,
     /// Keep the iteration records of this start (when it runs here).
     pub history_start: Option<usize>,
+    /// Certificate and polish of every run's end.
+    pub end: EndPolicy,
 }
 
 /// The result of a multistart.
@@ -90,8 +93,12 @@ pub struct Settings {
 pub struct Report {
     /// Runs sorted by start index, with optimum ids.
     pub runs: Vec<RunRecord>,
-    /// Distinct optima, best first.
+    /// Distinct certified optima, best first.
     pub optima: Vec<Optimum>,
+    /// How the runs ended, by class.
+    pub classes: ClassCounts,
+    /// The clustering tolerances the optima were formed with.
+    pub tolerances: Tolerances,
     /// Function calls over all runs in the tables.
     pub function_calls: usize,
     /// Gradient calls over all runs in the tables.
@@ -106,17 +113,31 @@ pub struct Report {
 }
 
 impl Report {
-    /// Fraction of runs that reached the best optimum (its basin share).
-    pub fn p_best(&self) -> Option<f64> {
-        self.optima.first().map(|o| o.basin_share)
+    /// Fraction of runs that reached a best optimum: the certified optima
+    /// whose f is within the clustering tolerance of the best's
+    /// (`|f − f_best| <= f_tolerance · max(1, |f_best|)`) are equally good,
+    /// and a start that reaches any of them counts. `None` without a
+    /// certified optimum.
+    pub fn p_single_start(&self) -> Option<f64> {
+        let best = self.optima.first()?;
+        let band = self.tolerances.f * best.f.abs().max(1.0);
+        Some(
+            self.optima
+                .iter()
+                .filter(|o| (o.f - best.f).abs() <= band)
+                .map(|o| o.basin_share)
+                .sum(),
+        )
     }
 }
 
-/// One run from `x0`: counts, time, and the outcome as a table row; the
-/// solver's iteration records go to `observer`.
+/// One run from `x0`: counts, time, and the outcome settled by `end`
+/// (certificate, polish: [`settle`]) as a table row; the solver's and the
+/// polish's iteration records go to `observer`.
 pub fn one_run(
     problem: &dyn Problem,
     solver: &LocalSolver,
+    end: &EndPolicy,
     start: usize,
     x0: &[f64],
     observer: &mut dyn Observer,
@@ -126,7 +147,7 @@ pub fn one_run(
     // A panic inside one run (a solver bug) becomes that run's error
     // instead of ending a long campaign.
     let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        solver(&counted, x0, observer)
+        solver(&counted, x0, observer).map(|o| settle(&counted, o, end, observer))
     }))
     .unwrap_or_else(|p| {
         let msg = p
@@ -140,21 +161,26 @@ pub fn one_run(
         ))
     });
     let wall_seconds = t.elapsed().as_secs_f64();
+    let mut certificate = None;
+    let mut polish = String::new();
     let (result, exit, iterations) = match out {
-        Ok(o) if o.f.is_finite() && o.x.iter().chain(&o.g).all(|v| v.is_finite()) => (
-            Some(RunResult {
-                x: o.x,
-                f: o.f,
-                g: o.g,
-            }),
-            o.termination.to_string(),
-            o.iterations,
-        ),
-        Ok(o) => (
-            None,
-            format!("error: non-finite result f = {} at x = {:?}", o.f, o.x),
-            o.iterations,
-        ),
+        Ok(s) => {
+            let o = s.outcome;
+            if o.f.is_finite() && o.x.iter().chain(&o.g).all(|v| v.is_finite()) {
+                certificate = s.certificate;
+                polish = s.polish;
+                let exit = o.termination.to_string();
+                let result = RunResult {
+                    x: o.x,
+                    f: o.f,
+                    g: o.g,
+                };
+                (Some(result), exit, o.iterations)
+            } else {
+                let msg = format!("error: non-finite result f = {} at x = {:?}", o.f, o.x);
+                (None, msg, o.iterations)
+            }
+        }
         Err(e) => (None, format!("error: {e}"), 0),
     };
     RunRecord {
@@ -167,6 +193,8 @@ pub fn one_run(
         gradient_calls: counted.gradient_calls(),
         wall_seconds,
         optimum: None,
+        certificate,
+        polish,
     }
 }
 
@@ -259,10 +287,19 @@ pub fn run(
                         }
                         let (row, history) = if settings.history_start == Some(k) {
                             let mut h = TimedHistory::start();
-                            (one_run(problem, solver, k, &starts[k], &mut h), Some(h))
+                            let row =
+                                one_run(problem, solver, &settings.end, k, &starts[k], &mut h);
+                            (row, Some(h))
                         } else {
                             (
-                                one_run(problem, solver, k, &starts[k], &mut NoObserver),
+                                one_run(
+                                    problem,
+                                    solver,
+                                    &settings.end,
+                                    k,
+                                    &starts[k],
+                                    &mut NoObserver,
+                                ),
                                 None,
                             )
                         };
@@ -337,8 +374,10 @@ pub fn budget_prefix(runs: Vec<RunRecord>, budget: usize) -> Vec<RunRecord> {
         .collect()
 }
 
-/// Cluster `runs` (sorted by start), rewrite `runs.csv` with optimum ids and
-/// write `optima.csv`; also used by `merge`.
+/// Cluster `runs` (sorted by start), rewrite `runs.csv` with optimum ids,
+/// write `optima.csv` (certified optima only) and its companion
+/// `run_classes.csv` (how many runs ended in each class); also used by
+/// `merge`.
 pub fn finish(
     vars: &[Variable],
     m: usize,
@@ -353,7 +392,11 @@ pub fn finish(
     rows.extend(runs.iter().map(|r| r.fields(vars.len(), m)));
     write_atomic(&dir.join("runs.csv"), &rows)?;
     write_atomic(&dir.join("optima.csv"), &optima_table(vars, m, &optima))?;
+    let classes = ClassCounts::of(&runs);
+    write_atomic(&dir.join("run_classes.csv"), &classes_table(&classes))?;
     Ok(Report {
+        classes,
+        tolerances: tol,
         function_calls: runs.iter().map(|r| r.function_calls).sum(),
         gradient_calls: runs.iter().map(|r| r.gradient_calls).sum(),
         runs,
@@ -401,6 +444,26 @@ pub fn optima_table(vars: &[Variable], m: usize, optima: &[Optimum]) -> Vec<Vec<
     rows
 }
 
+/// `run_classes.csv`: one row per class (`converged`, `stopped`,
+/// `infeasible`, `infeasible_stationary` (of the infeasible, those at a
+/// stationary point of the violation), `infeasible_stalled` (the other
+/// infeasible ends where descent on the violation stalled), `failed`) with
+/// count and share of all runs.
+pub fn classes_table(c: &ClassCounts) -> Vec<Vec<String>> {
+    let mut rows = vec![["class", "count", "share"].map(String::from).to_vec()];
+    for (name, k) in [
+        ("converged", c.converged),
+        ("stopped", c.stopped),
+        ("infeasible", c.infeasible),
+        ("infeasible_stationary", c.infeasible_stationary),
+        ("infeasible_stalled", c.infeasible_stalled),
+        ("failed", c.failed),
+    ] {
+        rows.push(vec![name.into(), k.to_string(), num(c.share(k))]);
+    }
+    rows
+}
+
 /// A row read back must belong to this study and shard.
 fn check_row(row: &RunRecord, starts: &[Vec<f64>], shard: Shard, path: &Path) -> Result<()> {
     let ok = row.start < starts.len()
@@ -433,13 +496,17 @@ mod tests {
         let fails: &LocalSolver = &|_: &dyn Problem, _: &[f64], _: &mut dyn Observer| {
             Err(Error::numerical("test", "singular"))
         };
-        let row = one_run(&p, fails, 3, &[0.0, 1.0], &mut NoObserver);
+        let end = crate::explore::settle::EndPolicy {
+            tolerances: Default::default(),
+            polish: true,
+        };
+        let row = one_run(&p, fails, &end, 3, &[0.0, 1.0], &mut NoObserver);
         assert!(row.result.is_none() && row.exit.contains("singular"));
         let panics: &LocalSolver = &|q: &dyn Problem, x: &[f64], _: &mut dyn Observer| {
             q.evaluate(x, true)?;
             panic!("index out of bounds")
         };
-        let row = one_run(&p, panics, 4, &[0.0, 1.0], &mut NoObserver);
+        let row = one_run(&p, panics, &end, 4, &[0.0, 1.0], &mut NoObserver);
         assert!(
             row.exit.contains("solver panicked: index out of bounds"),
             "{}",

@@ -1,7 +1,9 @@
 //! The optimizers the drivers can call, by the names study files use.
 //!
 //! - `mmfd` (default): the modified method of feasible directions of
-//!   `optimize::mmfd` with its default options.
+//!   `optimize::mmfd` with the preset's options (`[multistart] preset`:
+//!   DOT's, or `standard`), `[multistart.mmfd]` over them, and CTMIN the
+//!   study's feasibility tolerance.
 //! - `steepest`: projected steepest descent with Armijo backtracking, for
 //!   problems without general constraints. A cheap baseline for the
 //!   multistart (and a solver the driver tests can rely on independently
@@ -17,6 +19,7 @@
 use super::evolve::{GlobalSolver, Request};
 use super::multistart::LocalSolver;
 use crate::error::{Error, Result};
+use crate::optimize::mmfd::MmfdOptions;
 use crate::optimize::{
     Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination,
 };
@@ -40,6 +43,30 @@ impl LocalMethod {
         match self {
             LocalMethod::Mmfd => "mmfd",
             LocalMethod::Steepest => "steepest",
+        }
+    }
+}
+
+/// The MMFD option set a study's `[multistart.mmfd]` keys change
+/// (`[multistart] preset`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MmfdPreset {
+    /// DOT's settings ([`MmfdOptions::dot`]), with the absolute-change exit
+    /// DABOBJ = 1e-4 |f(x0)|.
+    #[default]
+    Dot,
+    /// DOT's without DABOBJ, Kuhn–Tucker exit relative to the gradient
+    /// ([`MmfdOptions::standard`]).
+    Standard,
+}
+
+impl MmfdPreset {
+    /// The preset's options.
+    pub fn options(self) -> MmfdOptions {
+        match self {
+            MmfdPreset::Dot => MmfdOptions::dot(),
+            MmfdPreset::Standard => MmfdOptions::standard(),
         }
     }
 }
@@ -84,10 +111,11 @@ impl MmfdSettings {
         Ok(())
     }
 
-    /// The full option set.
-    pub fn options(&self) -> crate::optimize::mmfd::MmfdOptions {
-        let d = crate::optimize::mmfd::MmfdOptions::default();
-        crate::optimize::mmfd::MmfdOptions {
+    /// The full option set: these settings over `preset`'s, with CTMIN
+    /// the study's feasibility tolerance ([`MmfdOptions::with_feasibility`]).
+    pub fn options(&self, preset: MmfdPreset, feasibility: f64) -> MmfdOptions {
+        let d = preset.options();
+        MmfdOptions {
             delobj: self.delobj.unwrap_or(d.delobj),
             dabobj: self.dabobj.or(d.dabobj),
             itrmop: self.itrmop.unwrap_or(d.itrmop),
@@ -95,12 +123,19 @@ impl MmfdSettings {
             kt_tolerance: self.kt_tolerance.unwrap_or(d.kt_tolerance),
             ..d
         }
+        .with_feasibility(feasibility)
     }
 }
 
-/// The local solver `method` (MMFD with `mmfd`'s settings).
-pub fn local(method: LocalMethod, mmfd: &MmfdSettings) -> Result<Box<LocalSolver<'static>>> {
-    let options = mmfd.options();
+/// The local solver `method` (MMFD with `mmfd`'s settings over `preset`,
+/// CTMIN = `feasibility`).
+pub fn local(
+    method: LocalMethod,
+    mmfd: &MmfdSettings,
+    preset: MmfdPreset,
+    feasibility: f64,
+) -> Result<Box<LocalSolver<'static>>> {
+    let options = mmfd.options(preset, feasibility);
     Ok(match method {
         LocalMethod::Steepest => {
             Box::new(|p: &dyn Problem, x0: &[f64], obs: &mut dyn Observer| steepest(p, x0, obs))

@@ -15,6 +15,7 @@
 //! empty fields; no NaN is ever written.
 
 use crate::error::{Error, Result};
+use crate::optimize::kkt::{Certificate, EndClass};
 use crate::optimize::Variable;
 pub use crate::report::csv::{csv_line, num, write_atomic, write_bytes_atomic};
 use std::io::Write;
@@ -57,8 +58,25 @@ pub struct RunRecord {
     pub gradient_calls: usize,
     /// Wall time of this run \[s\] (not reproducible; excluded from checks).
     pub wall_seconds: f64,
-    /// Optimum id after clustering (empty while running).
+    /// Optimum id after clustering (empty while running; only certified
+    /// runs belong to an optimum).
     pub optimum: Option<usize>,
+    /// The Kuhn–Tucker certificate of the end design (`None`: the run
+    /// failed, or its certificate could not be computed, said in `polish`).
+    pub certificate: Option<Certificate>,
+    /// How the polish from the solver's end stopped (its termination, or
+    /// `error: ...`); empty when no polish ran.
+    pub polish: String,
+}
+
+/// The class column of a row: the certificate's class, `failed` for a run
+/// without result, `uncertified` for a result without certificate.
+pub fn class_name(row: &RunRecord) -> &'static str {
+    match (&row.result, &row.certificate) {
+        (None, _) => "failed",
+        (Some(_), None) => "uncertified",
+        (Some(_), Some(c)) => c.class.name(),
+    }
 }
 
 fn opt_num(x: Option<f64>) -> String {
@@ -72,10 +90,12 @@ pub fn runs_header(vars: &[Variable], m: usize) -> Vec<String> {
     h.extend(vars.iter().map(|v| format!("x_{}", v.name)));
     h.push("f".into());
     h.extend((1..=m).map(|j| format!("g{j}")));
+    h.extend(["max_g"].map(String::from));
+    h.extend(certificate_header(m));
     h.extend(
         [
-            "max_g",
             "exit",
+            "polish",
             "iterations",
             "function_calls",
             "gradient_calls",
@@ -84,6 +104,14 @@ pub fn runs_header(vars: &[Variable], m: usize) -> Vec<String> {
         ]
         .map(String::from),
     );
+    h
+}
+
+/// The certificate columns of `runs.csv` (after `max_g`).
+fn certificate_header(m: usize) -> Vec<String> {
+    let mut h = vec!["class".to_string(), "kt_residual".into()];
+    h.extend((1..=m).map(|j| format!("lambda{j}")));
+    h.extend(["violation_residual", "violation_stationary"].map(String::from));
     h
 }
 
@@ -105,7 +133,20 @@ impl RunRecord {
             }
             None => r.extend(std::iter::repeat_n(String::new(), n + 1 + m + 1)),
         }
+        r.push(class_name(self).into());
+        let c = self.certificate.as_ref();
+        r.push(opt_num(c.and_then(|c| c.kt_residual)));
+        for j in 0..m {
+            r.push(opt_num(c.and_then(|c| c.multipliers[j])));
+        }
+        r.push(opt_num(c.and_then(|c| c.violation_residual)));
+        r.push(
+            c.and_then(|c| c.violation_stationary)
+                .map(|b| b.to_string())
+                .unwrap_or_default(),
+        );
         r.push(self.exit.replace(['\n', '\r'], " "));
+        r.push(self.polish.replace(['\n', '\r'], " "));
         r.push(self.iterations.to_string());
         r.push(self.function_calls.to_string());
         r.push(self.gradient_calls.to_string());
@@ -131,7 +172,15 @@ impl RunRecord {
                 .collect::<std::result::Result<Vec<_>, _>>()
         };
         let x0 = vec(1, n)?;
-        let base = 1 + 2 * n + 1 + m + 1;
+        let opt_float = |i: usize| -> std::result::Result<Option<f64>, String> {
+            if f(i).is_empty() {
+                Ok(None)
+            } else {
+                float(i).map(Some)
+            }
+        };
+        let at = 1 + 2 * n + 1 + m + 1; // the class column
+        let base = at + 2 + m + 2;
         let result = if f(1 + n + n).is_empty() {
             None
         } else {
@@ -141,20 +190,47 @@ impl RunRecord {
                 g: vec(2 + 2 * n, m)?,
             })
         };
+        let certificate = match (&result, EndClass::parse(f(at))) {
+            (Some(res), Some(class)) => Some(Certificate {
+                class,
+                max_g: res.max_g(),
+                kt_residual: opt_float(at + 1)?,
+                multipliers: (0..m)
+                    .map(|j| opt_float(at + 2 + j))
+                    .collect::<std::result::Result<_, _>>()?,
+                violation_residual: opt_float(at + 2 + m)?,
+                violation_stationary: match f(at + 3 + m) {
+                    "" => None,
+                    s => Some(s.parse::<bool>().map_err(|_| {
+                        format!("field {} = \"{s}\" is not true/false", at + 4 + m)
+                    })?),
+                },
+            }),
+            _ if ["failed", "uncertified"].contains(&f(at)) => None,
+            _ => {
+                return Err(format!(
+                    "field {} = \"{}\" is not a run class",
+                    at + 1,
+                    f(at)
+                ))
+            }
+        };
         Ok(RunRecord {
             start: int(0)?,
             x0,
             result,
             exit: f(base).to_string(),
-            iterations: int(base + 1)?,
-            function_calls: int(base + 2)?,
-            gradient_calls: int(base + 3)?,
-            wall_seconds: float(base + 4)?,
-            optimum: if f(base + 5).is_empty() {
+            polish: f(base + 1).to_string(),
+            iterations: int(base + 2)?,
+            function_calls: int(base + 3)?,
+            gradient_calls: int(base + 4)?,
+            wall_seconds: float(base + 5)?,
+            optimum: if f(base + 6).is_empty() {
                 None
             } else {
-                Some(int(base + 5)?)
+                Some(int(base + 6)?)
             },
+            certificate,
         })
     }
 }
@@ -355,6 +431,19 @@ mod tests {
             gradient_calls: 4,
             wall_seconds: 0.125,
             optimum: None,
+            certificate: ok.then(|| Certificate {
+                class: EndClass::Infeasible,
+                max_g: 0.25,
+                kt_residual: None,
+                multipliers: vec![None],
+                violation_residual: Some(1.0 / 3.0),
+                violation_stationary: Some(false),
+            }),
+            polish: if ok {
+                "relative_change".into()
+            } else {
+                String::new()
+            },
         }
     }
 

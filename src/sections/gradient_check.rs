@@ -217,9 +217,12 @@ pub const OPTIMIZE_HEADERS: [&str; 10] = [
 
 /// One MMFD run from the start per approach.
 fn optimize_rows(name: &str, p: &mut SceneProblem) -> Result<Vec<Vec<String>>> {
+    // DOT's settings as they are, CTMIN included (the paper's runs).
     let solver = crate::explore::solvers::local(
         crate::explore::solvers::LocalMethod::Mmfd,
         &Default::default(),
+        crate::explore::solvers::MmfdPreset::Dot,
+        crate::optimize::mmfd::MmfdOptions::dot().ctmin,
     )?;
     let start = p.start().to_vec();
     let mut rows = Vec::new();

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::explore::config::{multistart_plan, problem, MultistartPlan};
 use crate::explore::context::Context;
 use crate::explore::manifest::{MultistartCounts, MultistartEntry};
-use crate::explore::{fingerprint, multistart, optimum_report, solvers};
+use crate::explore::{fingerprint, multistart, optimum_report, solvers, violation};
 use crate::optimize::Problem;
 use std::path::{Path, PathBuf};
 
@@ -38,7 +38,13 @@ pub fn multistart_with(
         counts: None,
     };
     ctx.manifest(&dir, "multistart", started)?;
-    let solver = solvers::local(plan.section.method, &plan.section.mmfd)?;
+    let section = &plan.section;
+    let solver = solvers::local(
+        section.method,
+        &section.mmfd,
+        section.preset,
+        section.feasibility_tolerance,
+    )?;
     let report_plan = optimum_report::prepare(ctx, problem, plan)?;
     let settings = multistart::Settings {
         threads: ctx.threads,
@@ -49,6 +55,7 @@ pub fn multistart_with(
         shard: ctx.flags.shard,
         quiet: ctx.quiet,
         history_start: report_plan.as_ref().map(|_| optimum_report::REPORTED_START),
+        end: section.end_policy(),
     };
     let report = multistart::run(
         problem,
@@ -57,6 +64,7 @@ pub fn multistart_with(
         &settings,
         &dir,
     )?;
+    let checks = violation_checks(ctx, problem, &report, section.violation_checks, &dir)?;
     let mine = (0..plan.starts.points.len())
         .filter(|&k| ctx.flags.shard.owns(k))
         .count();
@@ -68,6 +76,9 @@ pub fn multistart_with(
             runs_this_invocation: report.new_runs,
             filter_evaluations: plan.starts.filter_evaluations,
             wall_seconds: report.wall_seconds,
+            classes: report.classes,
+            feasibility_tolerance: section.feasibility_tolerance,
+            violation_checks: checks,
         }),
     };
     ctx.manifest(&dir, "multistart", done)?;
@@ -78,6 +89,36 @@ pub fn multistart_with(
         p.finish(ctx, &dir, problem, plan, &report)?;
     }
     Ok(report)
+}
+
+/// `[multistart] violation_checks`: the pure descent on the violation from
+/// the starts of a sample of infeasible runs ([`violation`]), written to
+/// `violation_checks.csv`; returns (checked, reached the feasible set).
+fn violation_checks(
+    ctx: &Context,
+    problem: &dyn Problem,
+    report: &multistart::Report,
+    count: usize,
+    dir: &Path,
+) -> Result<(usize, usize)> {
+    let sample = violation::sample(&report.runs, count);
+    if sample.is_empty() {
+        return Ok((0, 0));
+    }
+    let tol = report.tolerances.feasibility;
+    let checks = violation::check(problem, &sample, tol)?;
+    let table = violation::table(problem, &checks, tol);
+    crate::explore::tables::write_atomic(&dir.join("violation_checks.csv"), &table)?;
+    let reached = checks.iter().filter(|c| c.reached(tol)).count();
+    if !ctx.quiet {
+        println!(
+            "  violation check: from {} infeasible runs' starts, pure descent on the violation \
+             reached the feasible set {} times (violation_checks.csv)",
+            checks.len(),
+            reached
+        );
+    }
+    Ok((checks.len(), reached))
 }
 
 /// A run without `--resume` starts a new `runs.csv`. An earlier one with
@@ -119,10 +160,10 @@ pub fn keep_earlier_runs(dir: &Path, force: bool, quiet: bool) -> Result<Option<
     Ok(Some(kept))
 }
 
-/// The summary of a multistart: counts and the ten best optima.
+/// The summary of a multistart: counts, classes and the ten best optima.
 pub fn print_optima(problem: &dyn Problem, r: &multistart::Report) {
     println!(
-        "multistart on {}: {} runs, {} distinct optima, {} function + {} gradient calls, {:.3} s",
+        "multistart on {}: {} runs, {} distinct certified optima, {} function + {} gradient calls, {:.3} s",
         problem.name(),
         r.runs.len(),
         r.optima.len(),
@@ -130,6 +171,10 @@ pub fn print_optima(problem: &dyn Problem, r: &multistart::Report) {
         r.gradient_calls,
         r.wall_seconds
     );
+    println!("  runs: {}", r.classes.summary());
+    if let Some(p) = r.p_single_start() {
+        println!("  p_single_start (a start reaches a best optimum): {p:.3}");
+    }
     for o in r.optima.iter().take(10) {
         println!(
             "  optimum {:>3}: f = {:>14.8e}  x = {:?}  feasible = {}  basin share = {:.3}",

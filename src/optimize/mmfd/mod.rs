@@ -17,8 +17,12 @@
 //! 2. Infeasible design → feasibility-restoration move: the shortest step
 //!    `S` with `g_j + ∇g_jᵀS <= −ctmin/2` for the active and violated
 //!    constraints and inside the bounds (push-off past the limit by half the
-//!    tolerance), solved exactly by [`super::qp`], then halved until the
-//!    largest violation decreases.
+//!    tolerance), solved exactly by [`super::qp`], then shortened until the
+//!    largest violation decreases (quadratic backtracking with the known
+//!    slope, factors 0.1–0.5, down to a move of 1e-10 of the ranges).
+//!    The run ends `infeasible` when no shortening lowers the violation,
+//!    or when three restorations in a row lower it by less than 1 % each
+//!    (a stall: the violation's valley is a kink or a local minimum).
 //! 3. Feasible, nothing active → steepest descent, conjugated by
 //!    Fletcher–Reeves (`β = |∇f_k|²/|∇f_{k−1}|²`) while consecutive
 //!    iterations stay unconstrained, restarted every n iterations.
@@ -102,6 +106,9 @@ pub struct Mmfd {
     abs_count: usize,
     rel_count: usize,
     failed_searches: usize,
+    /// Consecutive restorations that lowered the largest violation by
+    /// less than 1 % (three end the run as infeasible: a stall).
+    slow_restorations: usize,
     iteration: usize,
     termination: Option<Termination>,
     /// The start's evaluation (made by `init`, used by the first
@@ -195,6 +202,7 @@ impl Mmfd {
             abs_count: 0,
             rel_count: 0,
             failed_searches: 0,
+            slow_restorations: 0,
             iteration: 0,
             termination: None,
             start_evaluation: None,
@@ -516,9 +524,20 @@ impl Mmfd {
         if sol.s.iter().all(|&v| v == 0.0) {
             return Ok(None);
         }
+        // Backtrack until the largest violation decreases: the next length
+        // from the quadratic through v(0), its slope along S (the most
+        // violated constraint's ∇gᵀS) and the failed trial, kept within
+        // [0.1, 0.5] of it, down to a move of 1e-10 of the ranges (then no
+        // descent on the violation is left along S: a local minimum of the
+        // violation, often at a kink of a peak constraint).
         let v0 = base.max_g();
+        let worst = (0..base.g.len())
+            .max_by(|&a, &b| base.g[a].total_cmp(&base.g[b]))
+            .unwrap_or(0);
+        let slope = dot(&gg[worst], &sol.s).min(0.0);
+        let length = norm(&sol.s);
         let mut alpha = 1.0;
-        for _ in 0..6 {
+        while alpha * length > 1e-10 {
             let z: Vec<f64> = sol.s.iter().map(|s| alpha * s).collect();
             let x = self.moved(problem, &base.x, &z);
             let ev = evaluate(problem, &x, false)?;
@@ -527,10 +546,17 @@ impl Mmfd {
                 f: ev.f,
                 g: ev.g,
             };
-            if p.max_g() < v0 {
+            let v = p.max_g();
+            if v < v0 {
                 return Ok(Some(p));
             }
-            alpha *= 0.5;
+            let curvature = v - v0 - slope * alpha;
+            let fit = if curvature > 0.0 && slope < 0.0 {
+                -slope * alpha * alpha / (2.0 * curvature)
+            } else {
+                0.5 * alpha
+            };
+            alpha = fit.clamp(0.1 * alpha, 0.5 * alpha);
         }
         Ok(None)
     }
@@ -586,8 +612,13 @@ impl Mmfd {
             self.prev_step = None;
             match self.restore(problem, &base, &gg)? {
                 Some(p) => {
+                    let slow = base.max_g() - p.max_g() < 0.01 * base.max_g();
+                    self.slow_restorations = if slow { self.slow_restorations + 1 } else { 0 };
                     let step = self.scaled_distance(problem, &p.x, &base.x);
                     self.finish_iteration(problem, &base, p, step);
+                    if self.slow_restorations >= 3 && self.termination.is_none() {
+                        self.termination = Some(Termination::Infeasible);
+                    }
                 }
                 None => {
                     self.current = Some(base.clone());

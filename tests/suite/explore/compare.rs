@@ -41,9 +41,11 @@ fn comparison_names_the_global_minimum() {
         [-3.779310, -3.283186],
         [3.584428, -1.848126],
     ];
-    assert_eq!(rows.len(), 2);
+    // A tolerance row and a strict row per method; no constraints, so
+    // both hold the method's best design.
+    assert_eq!(rows.len(), 4);
     for r in &rows {
-        assert!(r.best_f.abs() < 1e-6, "{r:?}");
+        assert!(r.best_f.unwrap().abs() < 1e-6, "{r:?}");
         assert!(
             minima
                 .iter()
@@ -62,22 +64,31 @@ fn comparison_names_the_global_minimum() {
         .iter()
         .map(|c| c.parse().unwrap())
         .collect();
-    assert!(calls[1] <= calls[0] + 64, "{calls:?}");
-    // The multistart's p_single_start is its best optimum's basin share,
-    // recomputed here from runs.csv.
+    assert!(calls[2] <= calls[0] + 64, "{calls:?}");
+    // The four minima are equally good (f = 0 to the clustering
+    // tolerance), so p_single_start counts every start that reaches any of
+    // them: the certified runs, recomputed here from runs.csv.
     let runs = table_without(&dir.join("h/runs.csv"), &[]);
     let hits = column(&runs, "optimum")
         .iter()
-        .filter(|o| *o == "0")
+        .filter(|o| !o.is_empty())
         .count();
+    assert_eq!(
+        column(&runs, "class")
+            .iter()
+            .filter(|c| *c == "converged")
+            .count(),
+        hits
+    );
     assert_eq!(ms.p_single_start, Some(hits as f64 / 16.0));
+    assert!(hits >= 15, "{hits} of 16 starts certified");
 
     // Periodic2: the unique global minimum f = -5 at theta1 = +-90 (seam),
     // theta2 = -30 (closed form, explore::problems::Periodic2).
     let s = study("p", &text("p", "periodic2", ""));
     let rows = explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
     for r in &rows {
-        assert!((r.best_f + 5.0).abs() < 1e-6, "{r:?}");
+        assert!((r.best_f.unwrap() + 5.0).abs() < 1e-6, "{r:?}");
         assert!(
             (r.best_x[0].abs() - 90.0).abs() < 1e-2 && (r.best_x[1] + 30.0).abs() < 1e-2,
             "{r:?}"
@@ -179,10 +190,22 @@ fn bipop_is_chosen_in_the_study_and_reported() {
         ),
     );
     let rows = explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
-    assert_eq!(rows[1].method, "cmaes-bipop");
-    assert!(rows[1].best_f.abs() < 1e-6, "{:?}", rows[1]);
+    assert_eq!(rows[2].method, "cmaes-bipop");
+    assert!(rows[2].best_f.unwrap().abs() < 1e-6, "{:?}", rows[2]);
     let t = table_without(&dir.join("b/comparison.csv"), &[]);
-    assert_eq!(column(&t, "method"), ["multistart-mmfd", "cmaes-bipop"]);
+    assert_eq!(
+        column(&t, "method"),
+        [
+            "multistart-mmfd",
+            "multistart-mmfd",
+            "cmaes-bipop",
+            "cmaes-bipop"
+        ]
+    );
+    assert_eq!(
+        column(&t, "basis"),
+        ["tolerance", "strict", "tolerance", "strict"]
+    );
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("b/manifest.json")).unwrap())
             .unwrap();
@@ -198,7 +221,7 @@ fn bipop_is_chosen_in_the_study_and_reported() {
         .iter()
         .map(|r| r["evaluations"].as_u64().unwrap())
         .sum();
-    assert_eq!(spent as usize, rows[1].function_calls);
+    assert_eq!(spent as usize, rows[2].function_calls);
     let svg = std::fs::read_to_string(dir.join("b/convergence.svg")).unwrap();
     assert!(svg.contains("BIPOP-CMA-ES (best so far)"));
     // The default stays IPOP, under the method name it always had.
@@ -207,7 +230,7 @@ fn bipop_is_chosen_in_the_study_and_reported() {
         &text("i", "himmelblau", "[evolve]\nrestarts = \"ipop\"\n"),
     );
     let rows = explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
-    assert_eq!(rows[1].method, "cmaes");
+    assert_eq!(rows[2].method, "cmaes");
     // A bad value names the file, the key, the value and the choices, and
     // is refused before the multistart runs.
     let bad = study(
@@ -250,23 +273,22 @@ fn listed_schedules_each_equal_their_run_alone_on_one_budget() {
         let (rows, d) = run("both", both);
         let (_, ipop) = run("ipop", "");
         let (_, bipop) = run("bipop", "[evolve]\nrestarts = \"bipop\"\n");
-        let methods: Vec<&str> = rows.iter().map(|r| r.method.as_str()).collect();
+        let methods: Vec<&str> = rows.iter().map(|r| r.method.as_str()).step_by(2).collect();
         assert_eq!(
             methods,
             ["multistart-mmfd", "cmaes", "cmaes-bipop"],
             "{problem}"
         );
-        // comparison.csv: the multistart and IPOP rows of the IPOP study,
-        // then the BIPOP row of the BIPOP study.
+        // comparison.csv: the multistart and IPOP rows (tolerance and
+        // strict) of the IPOP study, then the BIPOP rows of the BIPOP study.
         let t = without_wall(&d.join("comparison.csv"));
         let (ti, tb) = (
             without_wall(&ipop.join("comparison.csv")),
             without_wall(&bipop.join("comparison.csv")),
         );
-        assert_eq!(
-            t,
-            [ti[0].clone(), ti[1].clone(), ti[2].clone(), tb[2].clone()]
-        );
+        let mut expect = ti[..5].to_vec();
+        expect.extend(tb[3..5].iter().cloned());
+        assert_eq!(t, expect);
         // evolution.csv: each schedule's rows, told apart by `method`,
         // equal the table of its study alone (which has no such column).
         let ev = table_without(&d.join("evolution.csv"), &[]);
@@ -287,7 +309,7 @@ fn listed_schedules_each_equal_their_run_alone_on_one_budget() {
             .iter()
             .map(|c| c.parse().unwrap())
             .collect();
-        assert!(calls[1] <= calls[0] && calls[2] <= calls[0], "{calls:?}");
+        assert!(calls[2] <= calls[0] && calls[4] <= calls[0], "{calls:?}");
         let m: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(d.join("manifest.json")).unwrap())
                 .unwrap();
@@ -303,7 +325,7 @@ fn listed_schedules_each_equal_their_run_alone_on_one_budget() {
             assert_eq!(sched[k]["solver"], solver);
             assert_eq!(
                 sched[k]["function_calls"].as_u64(),
-                Some(calls[k + 1] as u64)
+                Some(calls[2 * k + 2] as u64)
             );
             let spent: u64 = sched[k]["runs"]
                 .as_array()
@@ -311,7 +333,7 @@ fn listed_schedules_each_equal_their_run_alone_on_one_budget() {
                 .iter()
                 .map(|r| r["evaluations"].as_u64().unwrap())
                 .sum();
-            assert_eq!(spent as usize, calls[k + 1], "{problem} {method}");
+            assert_eq!(spent as usize, calls[2 * k + 2], "{problem} {method}");
         }
         // Each schedule drawn on the convergence plot and marked on the map.
         let svg = std::fs::read_to_string(d.join("convergence.svg")).unwrap();

@@ -1,4 +1,5 @@
 //! Tests of `plyscape::explore`: optimization drivers, multistart, shards, reports.
+mod certified;
 mod compare;
 mod kill;
 mod multistart;

@@ -147,7 +147,7 @@ fn hs22_history_and_summary_are_the_runs() {
     }
     assert_eq!(cell(&s, 1, "active_constraints"), "2");
     assert_eq!(cell(&s, 1, "active"), "g1; g2");
-    assert_eq!(cell(&s, 1, "feasibility_tolerance"), "0.003");
+    assert_eq!(cell(&s, 1, "feasibility_tolerance"), "1e-6");
     assert_eq!(
         (cell(&s, 1, "variables"), cell(&s, 1, "constraints")),
         ("2", "2")

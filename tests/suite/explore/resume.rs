@@ -43,7 +43,7 @@ fn a_changed_evaluation_is_refused_with_what_changed_and_more_starts_resume() {
         serde_json::from_str(&std::fs::read_to_string(out.join("r/manifest.json")).unwrap())
             .unwrap();
     let fp = &m["commands"]["multistart"]["fingerprint"];
-    assert_eq!(fp["evaluation_version"], 1);
+    assert_eq!(fp["evaluation_version"], 2);
     assert_eq!(fp["parts"]["solver"].as_str().unwrap().len(), 16);
 
     // The solver's settings changed: refused, exit code 2, the key named.
@@ -111,13 +111,13 @@ fn a_changed_evaluation_is_refused_with_what_changed_and_more_starts_resume() {
     let text = std::fs::read_to_string(&path).unwrap();
     std::fs::write(
         &path,
-        text.replace("\"evaluation_version\": 1", "\"evaluation_version\": 0"),
+        text.replace("\"evaluation_version\": 2", "\"evaluation_version\": 0"),
     )
     .unwrap();
     let e = explore::run_multistart(&ctx(&s, &out, 1, RESUME))
         .unwrap_err()
         .to_string();
-    assert!(e.contains("code changed (evaluation version 0 → 1)"), "{e}");
+    assert!(e.contains("code changed (evaluation version 0 → 2)"), "{e}");
 }
 
 /// Change the `f` of the row of start `start` in `runs.csv` to `f`.

@@ -1,0 +1,388 @@
+//! The end of a local run, settled: certified, polished when it stopped
+//! short, and (for comparisons) moved strictly inside the feasible set.
+//!
+//! A local solver stops by its own rules (DOT's relative and absolute
+//! change exits, an iteration limit, a line search that found nothing), so
+//! its end point is not yet an optimum. [`settle`] decides what it is:
+//!
+//! 1. The Kuhn–Tucker certificate at the end ([`kkt::certify_at`], one
+//!    evaluation with gradients): `converged`, `stopped` or `infeasible`
+//!    (see [`crate::optimize::kkt`] for the formulas and tolerances).
+//! 2. When the end is not converged and the polish is on: MMFD continued
+//!    from the end with [`MmfdOptions::polish_for`] (the active set from the
+//!    first iteration, CTMIN = the feasibility tolerance, change exits at
+//!    round-off, the Kuhn–Tucker exit at half the certificate's tolerance),
+//!    and the certificate again at its end. An infeasible end that is a
+//!    stationary point of the violation is not polished: descent on the
+//!    violation cannot leave it, which is the answer for that start.
+//!    The polish's result replaces the solver's unless it is worse
+//!    (feasible before and not after, or higher f at equal feasibility).
+//!
+//! Every evaluation goes through the caller's problem, so a counting
+//! wrapper counts the certificate and the polish with the run.
+//!
+//! [`strictly_feasible`] is the comparison's step: from a design, the
+//! polish (when not converged), then [`kkt::nudge_inside`] when the design
+//! stands on the tolerance (`0 < max g <= feasibility`), so that every
+//! method is compared at `max g <= 0`.
+
+use crate::error::Result;
+use crate::optimize::kkt::{self, Certificate, EndClass, KktTolerances};
+use crate::optimize::mmfd::{self, MmfdOptions};
+use crate::optimize::{Counted, IterRecord, LocalOutcome, NoObserver, Observer, Problem};
+
+/// What happens at the end of every local run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EndPolicy {
+    /// The certificate's tolerances (`[multistart] feasibility_tolerance`,
+    /// `active_tolerance`, `kt_tolerance`).
+    pub tolerances: KktTolerances,
+    /// Polish the ends that are not converged (`[multistart] polish`).
+    pub polish: bool,
+}
+
+/// A settled run end.
+#[derive(Debug, Clone)]
+pub struct Settled {
+    /// The final outcome (the polish's when it was kept).
+    pub outcome: LocalOutcome,
+    /// Its certificate (`None` when it could not be computed; the reason is
+    /// in `polish`).
+    pub certificate: Option<Certificate>,
+    /// How the polish ended: its termination, `kept: ...` when the solver's
+    /// end was better, `error: ...`; empty when no polish ran.
+    pub polish: String,
+}
+
+/// Passes the polish's records on as continuations of the run: iteration
+/// numbers and call counts after the solver's.
+struct Continued<'a> {
+    inner: &'a mut dyn Observer,
+    iterations: usize,
+    function_calls: usize,
+    gradient_calls: usize,
+    /// The last iteration number passed on.
+    last: usize,
+}
+
+impl Observer for Continued<'_> {
+    fn observe(&mut self, r: &IterRecord) {
+        if r.iteration == 0 {
+            return; // the start of the polish is the solver's end
+        }
+        let mut r = r.clone();
+        r.iteration += self.iterations;
+        r.function_calls += self.function_calls;
+        r.gradient_calls += self.gradient_calls;
+        self.last = r.iteration;
+        self.inner.observe(&r);
+    }
+}
+
+/// Is outcome `b` no worse than `a`: feasible (to `tol`) beats infeasible,
+/// then lower f among feasible ends, lower largest violation among
+/// infeasible ones.
+fn no_worse(b: &LocalOutcome, a: &LocalOutcome, tol: f64) -> bool {
+    let max_g = |o: &LocalOutcome| o.g.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let (fa, fb) = (max_g(a) <= tol, max_g(b) <= tol);
+    match (fa, fb) {
+        (true, false) => false,
+        (false, true) => true,
+        (true, true) => b.f <= a.f,
+        (false, false) => max_g(b) <= max_g(a),
+    }
+}
+
+/// The certificate at `o`'s design, recorded to `observer` as a check of
+/// the run's last iteration (one evaluation with gradients, counted after
+/// `calls`; its active set `g_j >= −active` as the record's CT).
+fn certify_recorded(
+    problem: &dyn Problem,
+    o: &LocalOutcome,
+    calls: (usize, usize),
+    tol: &KktTolerances,
+    observer: &mut dyn Observer,
+) -> Result<Certificate> {
+    let (ev, c) = kkt::certify_at(problem, &o.x, tol)?;
+    observer.observe(&IterRecord {
+        iteration: o.iterations,
+        x: o.x.clone(),
+        f: ev.f,
+        g: ev.g.clone(),
+        max_g: ev.max_g(),
+        ct: Some(-tol.active),
+        step: 0.0,
+        function_calls: calls.0 + 1,
+        gradient_calls: calls.1 + 1,
+    });
+    Ok(c)
+}
+
+/// Settle the solver's `outcome` (see the module doc). Each certificate is
+/// recorded to `observer` as a final check of the run, and the polish's
+/// iterations as continuations of it; the returned outcome's counts
+/// include both.
+pub fn settle(
+    problem: &dyn Problem,
+    outcome: LocalOutcome,
+    policy: &EndPolicy,
+    observer: &mut dyn Observer,
+) -> Settled {
+    let tol = &policy.tolerances;
+    let calls = (outcome.function_calls, outcome.gradient_calls);
+    let first = match certify_recorded(problem, &outcome, calls, tol, observer) {
+        Ok(c) => c,
+        Err(e) => {
+            return Settled {
+                outcome,
+                certificate: None,
+                polish: format!("error: certificate: {e}"),
+            }
+        }
+    };
+    let calls = (calls.0 + 1, calls.1 + 1);
+    // No polish from an infeasible end where descent on the violation
+    // cannot go on: a stationary point of the violation, or an end where
+    // the solver's own restoration found no decrease or stalled (a kink of
+    // a peak constraint, which the gradient test cannot see); the polish
+    // would repeat that restoration.
+    let stuck = first.violation_stationary == Some(true)
+        || (first.class == EndClass::Infeasible
+            && outcome.termination == crate::optimize::Termination::Infeasible);
+    if !policy.polish || first.class == EndClass::Converged || stuck {
+        return Settled {
+            outcome: LocalOutcome {
+                function_calls: calls.0,
+                gradient_calls: calls.1,
+                ..outcome
+            },
+            certificate: Some(first),
+            polish: String::new(),
+        };
+    }
+    let counted = Counted::new(problem);
+    let mut continued = Continued {
+        inner: observer,
+        iterations: outcome.iterations,
+        function_calls: calls.0,
+        gradient_calls: calls.1,
+        last: outcome.iterations,
+    };
+    let polished = mmfd::minimize(
+        &counted,
+        &outcome.x,
+        &MmfdOptions::polish_for(tol),
+        &mut continued,
+    );
+    let last = continued.last;
+    let polished = polished.and_then(|p| {
+        let o = LocalOutcome {
+            iterations: outcome.iterations + p.iterations,
+            function_calls: calls.0 + p.function_calls,
+            gradient_calls: calls.1 + p.gradient_calls,
+            termination: outcome.termination.clone(),
+            ..p.clone()
+        };
+        let at = (o.function_calls, o.gradient_calls);
+        let c = certify_recorded(&counted, &o, at, tol, observer)?;
+        Ok((p.termination, o, c))
+    });
+    let (polish, c) = match polished {
+        Ok((t, o, c)) if no_worse(&o, &outcome, tol.feasibility) => {
+            return Settled {
+                polish: t.to_string(),
+                outcome: LocalOutcome {
+                    function_calls: o.function_calls + 1,
+                    gradient_calls: o.gradient_calls + 1,
+                    ..o
+                },
+                certificate: Some(c),
+            }
+        }
+        Ok((t, o, _)) => (
+            format!("kept: the polish ended worse ({t}, f = {})", o.f),
+            o.iterations,
+        ),
+        Err(e) => (format!("error: {e}"), last),
+    };
+    // The solver's end stays the result: recorded once more after the
+    // polish's iterations, so that the history ends at the result.
+    let end = LocalOutcome {
+        iterations: c,
+        function_calls: calls.0 + counted.function_calls(),
+        gradient_calls: calls.1 + counted.gradient_calls(),
+        ..outcome
+    };
+    observer.observe(&IterRecord {
+        iteration: end.iterations,
+        x: end.x.clone(),
+        f: end.f,
+        g: end.g.clone(),
+        max_g: end.g.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        ct: None,
+        step: 0.0,
+        function_calls: end.function_calls,
+        gradient_calls: end.gradient_calls,
+    });
+    Settled {
+        outcome: end,
+        certificate: Some(first),
+        polish,
+    }
+}
+
+/// A design with `max g <= 0`, reached from `x` by the polish (when `x` is
+/// not converged) and [`kkt::nudge_inside`]: the design, its objective and
+/// largest constraint, or `None` when neither reaches `max g <= 0`.
+pub fn strictly_feasible(
+    problem: &dyn Problem,
+    x: &[f64],
+    policy: &EndPolicy,
+) -> Result<Option<(Vec<f64>, f64, f64)>> {
+    let start = problem.evaluate(x, false)?;
+    let outcome = LocalOutcome {
+        x: x.to_vec(),
+        f: start.f,
+        g: start.g.clone(),
+        iterations: 0,
+        function_calls: 0,
+        gradient_calls: 0,
+        active_constraints: 0,
+        active_side_constraints: 0,
+        termination: crate::optimize::Termination::MaxIterations,
+    };
+    let s = settle(problem, outcome, policy, &mut NoObserver);
+    let end = s.outcome;
+    let max_g = end.g.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if max_g <= 0.0 {
+        return Ok(Some((end.x, end.f, max_g)));
+    }
+    if max_g > policy.tolerances.feasibility {
+        return Ok(None);
+    }
+    let ev = problem.evaluate(&end.x, true)?;
+    Ok(kkt::nudge_inside(problem, &end.x, &ev)?.map(|(x, e)| {
+        let m = e.max_g();
+        (x, e.f, m)
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optimize::testproblems::Analytic;
+    use crate::optimize::{Termination, Variable};
+
+    /// min x on [−3, 3] subject to g = 0.5 + x² − x⁴/4 <= 0: feasible for
+    /// x² >= 2 + √6 (|x| >= 2.10938), so a local optimum on the constraint
+    /// at x* = +2.10938 (λ = 1/|g'(x*)| = 0.19354, g' = 2x − x³) and the
+    /// global one on the bound −3; the violation has a local minimum
+    /// g = 0.5 > 0 at x = 0 (closed form, derived here).
+    fn islands() -> Analytic {
+        fn k(x: &[f64]) -> (f64, Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+            let x = x[0];
+            let g = 0.5 + x * x - 0.25 * x.powi(4);
+            (x, vec![g], vec![1.0], vec![vec![2.0 * x - x.powi(3)]])
+        }
+        Analytic {
+            name: "islands".into(),
+            variables: vec![Variable::bounded("x", -3.0, 3.0).unwrap()],
+            n_constraints: 1,
+            kernel: k,
+            x0: vec![0.3],
+            optima: vec![vec![-3.0]],
+            f_opt: -3.0,
+        }
+    }
+
+    const X_STAR: f64 = 2.109_381_364_946_409_5; // sqrt(2 + sqrt(6))
+
+    fn end(p: &dyn Problem, x: f64) -> LocalOutcome {
+        let e = p.evaluate(&[x], false).unwrap();
+        LocalOutcome {
+            x: vec![x],
+            f: e.f,
+            g: e.g,
+            iterations: 3,
+            function_calls: 10,
+            gradient_calls: 3,
+            active_constraints: 0,
+            active_side_constraints: 0,
+            termination: Termination::RelativeChange,
+        }
+    }
+
+    fn policy(polish: bool) -> EndPolicy {
+        EndPolicy {
+            tolerances: KktTolerances::default(),
+            polish,
+        }
+    }
+
+    #[test]
+    fn a_stopped_end_is_polished_to_the_certified_optimum() {
+        let p = islands();
+        assert!((0.5 + X_STAR * X_STAR - 0.25 * X_STAR.powi(4)).abs() < 1e-12);
+        // Without the polish: feasible, not stationary.
+        let s = settle(&p, end(&p, 2.5), &policy(false), &mut NoObserver);
+        let c = s.certificate.unwrap();
+        assert_eq!(c.class, EndClass::Stopped);
+        assert_eq!(c.kt_residual, Some(1.0), "all of ∇f is left: {c:?}");
+        assert!(s.polish.is_empty());
+        // With it: on the constraint, certified, the multiplier 1/|g'(x*)|.
+        let s = settle(&p, end(&p, 2.5), &policy(true), &mut NoObserver);
+        let c = s.certificate.as_ref().unwrap();
+        assert_eq!(c.class, EndClass::Converged, "{s:?}");
+        assert!((s.outcome.x[0] - X_STAR).abs() < 1e-6, "{s:?}");
+        let lambda = 1.0 / (X_STAR.powi(3) - 2.0 * X_STAR);
+        // The multiplier in scaled variables: ∂/∂y = 6 ∂/∂x for both, so
+        // the ratio is the same.
+        assert!(
+            (c.multipliers[0].unwrap() - lambda).abs() < 1e-4 * lambda,
+            "{c:?}"
+        );
+        // The solver's exit stays, the polish's is reported beside it.
+        assert_eq!(s.outcome.termination, Termination::RelativeChange);
+        assert!(
+            !s.polish.is_empty() && !s.polish.starts_with("error"),
+            "{}",
+            s.polish
+        );
+    }
+
+    #[test]
+    fn an_end_at_a_local_minimum_of_the_violation_is_infeasible_and_stationary() {
+        let p = islands();
+        let s = settle(&p, end(&p, 0.0), &policy(true), &mut NoObserver);
+        let c = s.certificate.unwrap();
+        assert_eq!(c.class, EndClass::Infeasible);
+        assert_eq!(c.violation_stationary, Some(true));
+        assert!(s.polish.is_empty(), "no polish from a stationary violation");
+        // Off the minimum of the violation: not stationary, and the polish
+        // (MMFD's feasibility moves) reaches the feasible set.
+        let s = settle(&p, end(&p, 1.9), &policy(false), &mut NoObserver);
+        assert_eq!(s.certificate.unwrap().violation_stationary, Some(false));
+        let s = settle(&p, end(&p, 1.9), &policy(true), &mut NoObserver);
+        assert_eq!(
+            s.certificate.unwrap().class,
+            EndClass::Converged,
+            "{}",
+            s.polish
+        );
+        assert!((s.outcome.x[0] - X_STAR).abs() < 1e-6);
+    }
+
+    #[test]
+    fn strictly_feasible_moves_a_design_on_the_tolerance_inside() {
+        let p = islands();
+        // 1e-7 left of x*: g = |g'(x*)| 1e-7 = 5.2e-7, within the 1e-6
+        // tolerance and certified, but not strictly feasible.
+        let x = X_STAR - 1e-7;
+        let (x2, f, max_g) = strictly_feasible(&p, &[x], &policy(true)).unwrap().unwrap();
+        assert!(max_g <= 0.0 && f >= X_STAR && (x2[0] - X_STAR).abs() < 1e-9);
+        // A design far inside the infeasible gap has none.
+        assert!(strictly_feasible(&p, &[0.0], &policy(true))
+            .unwrap()
+            .is_none());
+    }
+}

@@ -1,0 +1,93 @@
+//! Certified optima: every run's end classified, stopped ends polished,
+//! optima.csv certified only, class counts beside it.
+
+use crate::common::explore::{column, ctx, study, table_without};
+use crate::common::temp_dir;
+use plyscape::explore::{self, DriveFlags};
+
+/// HS 100's optimum f* = 680.6300573 (Hock & Schittkowski 1981, problem
+/// 100) and its standard start (1, 2, 0, 4, 0, 1, 1).
+const HS100_F: f64 = 680.630_057_3;
+
+fn hs100(extra: &str) -> String {
+    format!(
+        "[study]\nname = \"hs100\"\nseed = 3\n[problem]\nname = \"hs100\"\n\
+         [multistart]\nsampler = \"lhs\"\nstarts = 19\npoints = [[1.0, 2.0, 0.0, 4.0, 0.0, 1.0, 1.0]]\n{extra}"
+    )
+}
+
+/// With DOT's settings (the default preset) the runs stop up to hundreds
+/// above f* (DABOBJ = 1e-4 |f(x0)|); the polish from every end makes them
+/// one certified optimum at f* to 1e-6, and the counts add up.
+#[test]
+fn hs100_with_dot_settings_and_the_polish_has_one_optimum() {
+    let tmp = temp_dir("cert-hs100");
+    let dir = tmp.path().to_path_buf();
+    let s = study("hs100", &hs100(""));
+    let r = explore::run_multistart(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    let d = dir.join("hs100");
+    let o = table_without(&d.join("optima.csv"), &[]);
+    assert_eq!(o.len(), 2, "one optimum: {o:?}");
+    let f: f64 = column(&o, "f")[0].parse().unwrap();
+    assert!((f - HS100_F).abs() <= 1e-6 * HS100_F, "f = {f}");
+    let max_g: f64 = column(&o, "max_g")[0].parse().unwrap();
+    assert!(max_g <= 1e-6, "{max_g}");
+    // Every run in the optimum is certified; runs.csv says so per row.
+    let runs = table_without(&d.join("runs.csv"), &[]);
+    let class = column(&runs, "class");
+    let optimum = column(&runs, "optimum");
+    for (c, o) in class.iter().zip(&optimum) {
+        assert_eq!(c == "converged", o == "0", "{c} {o}");
+    }
+    let converged = class.iter().filter(|c| *c == "converged").count();
+    assert_eq!(r.classes.converged, converged);
+    assert_eq!(r.classes.runs, 20);
+    assert!(converged >= 19, "{:?}", r.classes);
+    // Multipliers of the active constraints (1 and 4 at x*) are reported
+    // and non-negative on certified rows.
+    for (k, c) in class.iter().enumerate() {
+        if c == "converged" {
+            for j in [1, 4] {
+                let l: f64 = column(&runs, &format!("lambda{j}"))[k].parse().unwrap();
+                assert!(l > 0.0, "start {k}: lambda{j} = {l}");
+            }
+            let kt: f64 = column(&runs, "kt_residual")[k].parse().unwrap();
+            assert!(kt <= 1e-4);
+        }
+    }
+    // The companion table and the manifest carry the same counts.
+    let t = table_without(&d.join("run_classes.csv"), &[]);
+    assert_eq!(column(&t, "class")[0], "converged");
+    assert_eq!(column(&t, "count")[0], converged.to_string());
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("manifest.json")).unwrap()).unwrap();
+    let counts = &m["commands"]["multistart"];
+    assert_eq!(
+        counts["classes"]["converged"].as_u64(),
+        Some(converged as u64)
+    );
+    assert_eq!(counts["feasibility_tolerance"].as_f64(), Some(1e-6));
+}
+
+/// Without the polish, DOT's exits leave runs stopped short: they are
+/// classified `stopped`, belong to no optimum, and optima.csv lists only
+/// certified designs (so fewer runs, never a stopped one).
+#[test]
+fn stopped_runs_are_counted_and_never_listed_as_optima() {
+    let tmp = temp_dir("cert-stopped");
+    let dir = tmp.path().to_path_buf();
+    let s = study("hs100", &hs100("polish = false\n"));
+    let r = explore::run_multistart(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+    let runs = table_without(&dir.join("hs100/runs.csv"), &[]);
+    let class = column(&runs, "class");
+    let stopped = class.iter().filter(|c| *c == "stopped").count();
+    assert!(stopped >= 5, "DOT's exits stop most runs short: {class:?}");
+    assert_eq!(r.classes.stopped, stopped);
+    for (c, o) in class.iter().zip(column(&runs, "optimum")) {
+        assert_eq!(c == "converged", !o.is_empty(), "{c} {o}");
+    }
+    assert!(column(&runs, "polish").iter().all(|p| p.is_empty()));
+    // Every listed optimum is one of the certified runs' designs.
+    let certified: usize = r.optima.iter().map(|o| o.count).sum();
+    assert_eq!(certified, r.classes.converged);
+}
