@@ -540,6 +540,9 @@ impl Mmfd {
         while alpha * length > 1e-10 {
             let z: Vec<f64> = sol.s.iter().map(|s| alpha * s).collect();
             let x = self.moved(problem, &base.x, &z);
+            if x == base.x {
+                break; // the bounds leave no move
+            }
             let ev = evaluate(problem, &x, false)?;
             let p = Point {
                 x,
