@@ -58,6 +58,7 @@ impl SceneSpec {
         let mut model = Model {
             baumgarte: self.baumgarte,
             quadratic_velocity: self.has(Effect::QuadraticVelocity),
+            divergence_limit: Some(self.divergence_limit),
             ..Model::default()
         };
         self.add_bodies(&mut model, panels)?;
@@ -98,6 +99,13 @@ impl SceneSpec {
                 "baumgarte",
                 self.baumgarte,
                 "a finite rate ≥ 0 (1/s)",
+            ));
+        }
+        if !(self.divergence_limit > 0.0) {
+            return Err(Error::input(
+                "divergence_limit",
+                self.divergence_limit,
+                "a factor > 0 of the body size (inf: no divergence guard)",
             ));
         }
         Ok(())
