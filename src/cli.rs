@@ -109,6 +109,9 @@ pub enum Command {
         /// Output, thread and overwrite options.
         #[command(flatten)]
         common: Common,
+        /// Continue from the cells already in the map's tables.
+        #[arg(long)]
+        resume: bool,
     },
     /// Combine the shard directories of one multistart into one set of tables.
     Merge {
@@ -229,10 +232,18 @@ pub fn execute(cli: Cli) -> Result<()> {
             let _lock = lock(&cfg, "compare", Some(&ctx))?;
             crate::explore::run_compare(&ctx).map(|_| ())
         }
-        Command::Map { study, common } => {
+        Command::Map {
+            study,
+            common,
+            resume,
+        } => {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
             let _lock = lock(&cfg, "map", None)?;
-            crate::explore::run_map(&cfg.explore(Default::default())).map(|_| ())
+            let flags = crate::explore::DriveFlags {
+                resume,
+                ..Default::default()
+            };
+            crate::explore::run_map(&cfg.explore(flags)).map(|_| ())
         }
         Command::Merge { dirs, out, quiet } => {
             crate::explore::merge(&dirs, &out, quiet).map(|_| ())

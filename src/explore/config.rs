@@ -41,6 +41,10 @@ pub struct MultistartSection {
     pub max_evaluations: Option<usize>,
     /// Stop launching runs after this wall time \[s\].
     pub max_wall_seconds: Option<f64>,
+    /// Rows of `runs.csv` evaluated again on `--resume` (default 2; see
+    /// [`super::fingerprint`]).
+    #[serde(default = "default_resume_checks")]
+    pub resume_checks: usize,
     /// Same optimum: coordinates within this fraction of each range
     /// (default 1e-2: 1.8° on a 180° ply angle; MMFD with DOT's default
     /// DELOBJ = 1e-3 stops that far from the exact optimum on flat valleys).
@@ -61,6 +65,9 @@ pub struct MultistartSection {
     pub mmfd: MmfdSettings,
 }
 
+fn default_resume_checks() -> usize {
+    super::fingerprint::DEFAULT_RESUME_CHECKS
+}
 fn default_x_tol() -> f64 {
     1e-2
 }
@@ -91,6 +98,13 @@ pub struct EvolveSection {
     /// rtol 1e-6), below which no progress is real, and a run whose f
     /// never settles within 1e-12 never restarts: set it above the noise.
     pub tol_fun: Option<f64>,
+    /// Stop a schedule when a design feasible to the tolerance reaches
+    /// `f <= target` (stop reason `target_reached`). Default: none.
+    pub target: Option<f64>,
+    /// Active CMA-ES (negative weights for the worst samples). Default
+    /// false.
+    #[serde(default)]
+    pub active: bool,
 }
 
 /// A checked `[evolve]`.
@@ -112,6 +126,11 @@ pub fn evolve_plan(study: &Study) -> Result<EvolvePlan> {
     if let Some(t) = section.tol_fun {
         if !(t.is_finite() && t >= 0.0) {
             return Err(study.error("evolve.tol_fun", t, "a finite range >= 0"));
+        }
+    }
+    if let Some(t) = section.target {
+        if !t.is_finite() {
+            return Err(study.error("evolve.target", t, "a finite objective value"));
         }
     }
     let schedules = schedules(section.restarts.as_ref()).map_err(study.locate("evolve"))?;
@@ -171,6 +190,10 @@ pub struct MapSection {
     /// Variable pairs for more than two variables (default: consecutive
     /// pairs (0,1), (2,3), ...).
     pub pairs: Option<Vec<[usize; 2]>>,
+    /// Cells evaluated again on `--resume` (default 2; see
+    /// [`super::fingerprint`]).
+    #[serde(default = "default_resume_checks")]
+    pub resume_checks: usize,
 }
 
 fn default_resolution() -> usize {
@@ -280,6 +303,7 @@ pub fn map_section(study: &Study) -> Result<MapSection> {
     let sec: MapSection = study.section("map")?.unwrap_or(MapSection {
         resolution: default_resolution(),
         pairs: None,
+        resume_checks: default_resume_checks(),
     });
     if !(2..=2001).contains(&sec.resolution) {
         return Err(study.error("map.resolution", sec.resolution, "2 <= resolution <= 2001"));
@@ -398,6 +422,17 @@ mod tests {
             e.contains("evolve.restarts[1]") && e.contains("restarts[0]"),
             "{e}"
         );
+        let s = study(&format!(
+            "{HIMMELBLAU}[evolve]\ntarget = 1e-6\nactive = true\n"
+        ));
+        let plan = evolve_plan(&s).unwrap();
+        assert_eq!(
+            (plan.section.target, plan.section.active),
+            (Some(1e-6), true)
+        );
+        let s = study(&format!("{HIMMELBLAU}[evolve]\ntarget = nan\n"));
+        let e = evolve_plan(&s).unwrap_err().to_string();
+        assert!(e.contains("evolve.target"), "{e}");
         let s = study(&format!("{HIMMELBLAU}[evolve]\nmax_evaluations = 0\n"));
         let e = evolve_plan(&s).unwrap_err().to_string();
         assert!(e.contains("evolve.max_evaluations"), "{e}");

@@ -1,6 +1,7 @@
 //! What a driver command gets from the command line ([`Context`],
 //! [`DriveFlags`]), the directory it writes into and its manifest entry.
 
+use super::fingerprint::Fingerprint;
 use super::multistart::Shard;
 use crate::error::{Error, Result};
 use crate::report::manifest::ShardRecord;
@@ -59,12 +60,14 @@ impl Context<'_> {
     }
 
     /// Update `manifest.json` ([`crate::report::record_command`]) with the
-    /// shard, the threads, the resume flag and the command's own `detail`
+    /// shard, the threads, the resume flag, the study's fingerprint
+    /// ([`Fingerprint::of_study`]) and the command's own `detail`
     /// ([`super::manifest`]).
     pub fn manifest<D: Serialize>(&self, dir: &Path, command: &str, detail: D) -> Result<()> {
         let entry = super::manifest::DriverEntry {
             threads: self.threads,
             resume: self.flags.resume,
+            fingerprint: Some(Fingerprint::of_study(self.study)),
             detail,
         };
         let shard = ShardRecord {

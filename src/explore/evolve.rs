@@ -38,6 +38,12 @@ pub struct Request {
     /// A run restarts when its recent best values and current values of f
     /// lie within this range (CMA-ES TolFun).
     pub tol_fun: f64,
+    /// Stop when a design feasible to `feasibility_tolerance` reaches
+    /// `f <= target` (stop reason `target_reached`); `None`: never.
+    pub target: Option<f64>,
+    /// Active covariance update (negative weights for the worst samples,
+    /// `optimize::cmaes` module doc).
+    pub active: bool,
 }
 
 /// An evolutionary solver: CMA-ES in the binary, anything in tests.

@@ -1,22 +1,28 @@
 //! The exploration drivers' entries in `manifest.json`, typed.
 //!
 //! Every driver entry is a [`DriverEntry`]: the threads and the resume flag
-//! of the invocation, then the command's own fields flattened beside them
+//! of the invocation, the study's fingerprint
+//! ([`super::fingerprint::Fingerprint`], what `--resume` compares), then the command's own fields flattened beside them
 //! ([`MultistartEntry`], [`EvolveEntry`], [`MapEntry`],
 //! [`OptimumReportEntry`], [`MergeEntry`]). The file around them is
 //! [`crate::report::manifest::Manifest`]; `started` and `ended` are added by
 //! [`crate::report::record_command`].
 
+use super::fingerprint::Fingerprint;
 use serde::{Deserialize, Serialize};
 
-/// A driver's entry: the invocation's threads and `--resume`, and the
-/// command's own fields `detail` at the same level.
+/// A driver's entry: the invocation's threads and `--resume`, the study's
+/// fingerprint, and the command's own fields `detail` at the same level.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DriverEntry<D> {
     /// Worker threads.
     pub threads: usize,
     /// `--resume` given.
     pub resume: bool,
+    /// The fingerprint of the study the command ran
+    /// ([`super::fingerprint`]; absent in manifests written before them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fingerprint: Option<Fingerprint>,
     /// The command's fields.
     #[serde(flatten)]
     pub detail: D,
@@ -116,15 +122,24 @@ pub struct CmaesRunEntry {
     pub generations: usize,
 }
 
-/// `map`.
+/// `map`: written with `complete = false` before the first cell, then
+/// again when every table is whole.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MapEntry {
+    /// Every slice's table has all its cells (absent in manifests written
+    /// before resumable maps, which wrote the entry at the end only).
+    #[serde(default = "whole")]
+    pub complete: bool,
     /// Grid points per axis.
     pub resolution: usize,
     /// With more than two variables: the design the slices pass through
     /// (each held variable's value, by name).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub slices_through: Option<std::collections::BTreeMap<String, f64>>,
+}
+
+fn whole() -> bool {
+    true
 }
 
 /// `optimum_report`.
@@ -178,6 +193,7 @@ mod tests {
         let first = DriverEntry {
             threads: 2,
             resume: false,
+            fingerprint: None,
             detail: MultistartEntry {
                 complete: false,
                 counts: None,
@@ -192,6 +208,7 @@ mod tests {
         let done = DriverEntry {
             threads: 2,
             resume: true,
+            fingerprint: None,
             detail: MultistartEntry {
                 complete: true,
                 counts: Some(MultistartCounts {

@@ -5,6 +5,7 @@
 use super::commands::multistart::print_optima;
 use super::config::{multistart_plan, problem, MultistartPlan};
 use super::context::{Context, DriveFlags};
+use super::fingerprint::{self, Fingerprint};
 use super::manifest::{DriverEntry, MergeEntry, MultistartEntry};
 use super::multistart::{self, Shard};
 use super::tables;
@@ -20,7 +21,9 @@ use std::path::{Path, PathBuf};
 /// line is refused, not repaired: finish that shard with `--resume`); a
 /// directory of an unsharded run is not a shard; every start a shard owns
 /// must have its row unless the study's `max_evaluations` budget stopped
-/// the shard early (the missing starts are named).
+/// the shard early (the missing starts are named); a shard whose recorded
+/// fingerprint differs from this build's ([`fingerprint`]: computed by code
+/// of another evaluation version) is refused with what differs.
 pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<multistart::Report> {
     if dirs.is_empty() {
         return Err(Error::input(
@@ -31,6 +34,21 @@ pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<multistart::Re
     }
     let (text, file, n, indices) = shard_manifests(dirs)?;
     let study = Study::parse(&file, &text)?;
+    // The shards' evaluations are this build's: the merged manifest
+    // records this build's fingerprint, which a later --resume compares.
+    let now = Fingerprint::of_study(&study);
+    for d in dirs {
+        fingerprint::check_recorded_for(
+            &study,
+            (d, &["multistart"]),
+            &now,
+            &d.join("runs.csv"),
+            (
+                "merge",
+                "run that shard again with this build (without --resume)",
+            ),
+        )?;
+    }
     let problem = problem(&study)?;
     let plan = multistart_plan(&study, problem.as_ref())?;
     let vars = problem.variables();

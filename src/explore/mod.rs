@@ -73,6 +73,7 @@ pub mod commands;
 pub mod config;
 pub mod context;
 pub mod evolve;
+pub mod fingerprint;
 pub mod manifest;
 pub mod map;
 pub mod merge;

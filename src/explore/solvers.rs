@@ -123,6 +123,8 @@ pub fn global() -> Box<GlobalSolver<'static>> {
                 restarts: r.restarts,
                 feasibility_tolerance: r.feasibility_tolerance,
                 tol_fun: r.tol_fun,
+                target: r.target,
+                active: r.active,
                 ..Default::default()
             };
             crate::optimize::cmaes::minimize(p, &options, obs)

@@ -193,48 +193,21 @@ pub fn read_runs(path: &Path, vars: &[Variable], m: usize) -> Result<ReadRuns> {
 /// line (`repaired_bytes`, what [`read_runs`] would cut) and the length of
 /// the intact part.
 pub fn scan_runs(path: &Path, vars: &[Variable], m: usize) -> Result<(ReadRuns, usize)> {
-    let bytes = match std::fs::read(path) {
-        Ok(b) => b,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Ok((
-                ReadRuns {
-                    rows: vec![],
-                    repaired_bytes: 0,
-                },
-                0,
-            ))
-        }
-        Err(e) => return Err(Error::io(path, e)),
-    };
     let header = runs_header(vars, m);
     let width = header.len();
-    // Keep whole lines only.
-    let mut keep = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
+    let Some(lines) = read_csv_lines(path, &header, "does not match this study")? else {
+        return Ok((
+            ReadRuns {
+                rows: vec![],
+                repaired_bytes: 0,
+            },
+            0,
+        ));
+    };
+    let mut keep = lines.keep;
     let mut rows = Vec::new();
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .from_reader(&bytes[..keep]);
-    let mut records = Vec::new();
-    for r in reader.records() {
-        let r = r.map_err(|e| Error::csv(path, e))?;
-        let end = r.position().map_or(0, |p| p.byte() as usize);
-        records.push((r, end));
-    }
-    for (k, (r, at)) in records.iter().enumerate() {
-        if k == 0 {
-            if r.iter().ne(header.iter().map(String::as_str)) {
-                return Err(Error::csv(
-                    path,
-                    format!(
-                        "header {:?} does not match this study (expected {:?})",
-                        r.iter().collect::<Vec<_>>().join(","),
-                        header.join(",")
-                    ),
-                ));
-            }
-            continue;
-        }
+    for (i, (r, at)) in lines.rows.iter().enumerate() {
+        let k = i + 1; // the header is record 0
         let parsed = if r.len() == width {
             RunRecord::parse(r, vars.len(), m)
         } else {
@@ -243,7 +216,7 @@ pub fn scan_runs(path: &Path, vars: &[Variable], m: usize) -> Result<(ReadRuns, 
         match parsed {
             Ok(row) => rows.push(row),
             // A bad last line is a torn write: cut it off.
-            Err(_) if k + 1 == records.len() => keep = *at,
+            Err(_) if i + 1 == lines.rows.len() => keep = *at,
             Err(e) => {
                 return Err(Error::csv(path, format!("line {}: {e}", k + 1)));
             }
@@ -252,10 +225,60 @@ pub fn scan_runs(path: &Path, vars: &[Variable], m: usize) -> Result<(ReadRuns, 
     Ok((
         ReadRuns {
             rows,
-            repaired_bytes: bytes.len() - keep,
+            repaired_bytes: lines.len - keep,
         },
         keep,
     ))
+}
+
+/// The whole lines of a resumable CSV table (`runs.csv`, a map's table).
+pub struct CsvLines {
+    /// Length of the file (bytes).
+    pub len: usize,
+    /// Length of its whole lines (up to the last newline).
+    pub keep: usize,
+    /// The data records after the header, each with the byte where its
+    /// line starts (where a torn last line is cut).
+    pub rows: Vec<(csv::StringRecord, usize)>,
+}
+
+/// Read a table's whole lines (`None` when the file does not exist); a
+/// first line other than `header` is refused as "header .. `what`".
+pub fn read_csv_lines(path: &Path, header: &[String], what: &str) -> Result<Option<CsvLines>> {
+    let bytes = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(Error::io(path, e)),
+    };
+    let keep = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(&bytes[..keep]);
+    let mut rows = Vec::new();
+    for r in reader.records() {
+        let r = r.map_err(|e| Error::csv(path, e))?;
+        let at = r.position().map_or(0, |p| p.byte() as usize);
+        rows.push((r, at));
+    }
+    if let Some((first, _)) = rows.first() {
+        if first.iter().ne(header.iter().map(String::as_str)) {
+            return Err(Error::csv(
+                path,
+                format!(
+                    "header {:?} {what} (expected {:?})",
+                    first.iter().collect::<Vec<_>>().join(","),
+                    header.join(",")
+                ),
+            ));
+        }
+        rows.remove(0);
+    }
+    Ok(Some(CsvLines {
+        len: bytes.len(),
+        keep,
+        rows,
+    }))
 }
 
 /// Appends complete lines to `runs.csv`, flushing after each.

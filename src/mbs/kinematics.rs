@@ -145,7 +145,9 @@ impl System {
         }
         for force in &self.model.forces {
             match force {
-                Force::Rotational { joint, .. } | Force::JointSpring { joint, .. } => {
+                Force::Rotational { joint, .. }
+                | Force::JointSpring { joint, .. }
+                | Force::TorsionSpring { joint, .. } => {
                     let jt = &self.model.joints[*joint];
                     out[jt.i] = true;
                     out[jt.j] = true;
@@ -363,4 +365,16 @@ pub fn angle_of<T: Scalar>(mi: &MarkerKin<T>, mj: &MarkerKin<T>) -> (T, T) {
     let xj: Vector3<T> = mj.frame.column(0).into();
     let th = zi.dot(&xi.cross(&xj)).atan2(xi.dot(&xj));
     (th, zi.dot(&(mj.w - mi.w)))
+}
+
+/// `a` shifted by a multiple of 2π into (−π, π].
+pub(crate) fn wrap_angle<T: Scalar>(mut a: T) -> T {
+    let (pi, two_pi) = (T::pi(), T::two_pi());
+    while a > pi {
+        a -= two_pi;
+    }
+    while a <= -pi {
+        a += two_pi;
+    }
+    a
 }

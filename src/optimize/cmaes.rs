@@ -6,8 +6,12 @@
 //! (arXiv:1604.00772, 2016), with the default parameters of its Table 1
 //! (weights `ln((λ+1)/2) − ln i` on the best μ = ⌊λ/2⌋, cumulation `c_σ`,
 //! `c_c`, rank-one `c_1`, rank-μ `c_μ`, damping `d_σ`) and the `h_σ` stall
-//! of the evolution path. Restarts ([`Restarts`]) start from a uniformly
-//! random mean in the box:
+//! of the evolution path. Option `active` (Jastrebski & Arnold, CEC 2006;
+//! Hansen 2016 eqs. 46–47, 53): the λ − μ worst samples get the negative
+//! weights `ln((λ+1)/2) − ln i`, scaled to
+//! `min(1 + c₁/c_μ, 1 + 2μ⁻_eff/(μ_eff + 2), (1 − c₁ − c_μ)/(n c_μ)) / Σ|w⁻|`,
+//! each times `n / |C^{−1/2} y_i|²`; C decays by `1 − c₁ − c_μ Σ_all w`.
+//! Restarts ([`Restarts`]) start from a uniformly random mean in the box:
 //! - IPOP (default; A. Auger, N. Hansen, "A restart CMA evolution strategy
 //!   with increasing population size", CEC 2005): restart `i` has the
 //!   population `λ_i = round(λ_def · F^i)` (F = `popsize_factor` = 2) and
@@ -27,12 +31,9 @@
 //!   otherwise; the first run is charged to the large regime (it is IPOP's
 //!   run 0). `max_restarts` counts the large restarts only; the search ends
 //!   when the large regime is due and has used them all (or at the budget).
-//!   (Hansen's BBOB default σ0 = 2 on [−5, 5]ⁿ gives the paper's
-//!   `σ_s = 2 · 10^(−2U)`.) Implementations differ in where the first
-//!   run's evaluations go; charging them to the large regime makes the
-//!   first restart a small one with `λ_s = λ_def`. Units: λ and the
-//!   evaluation counts are numbers of designs, σ is a fraction of each
-//!   variable's range.
+//!   Charging the first run to the large regime makes the first restart a
+//!   small one with `λ_s = λ_def`. Units: λ and the evaluation counts are
+//!   numbers of designs, σ is a fraction of each variable's range.
 //!
 //! Search space: range-scaled `y = (x − lower)/range ∈ [0, 1]ⁿ`, so σ is a
 //! fraction of each variable's range (σ0 = 0.3 by default) and every
@@ -101,6 +102,9 @@ pub struct CmaesOptions {
     /// the exploration passes the multistart's tolerance so that both
     /// methods search the same feasible set).
     pub feasibility_tolerance: f64,
+    /// Active covariance update (module doc): the worst `λ − μ` samples
+    /// enter the rank-μ update with negative weights. Default false.
+    pub active: bool,
 }
 
 /// Restart schedule of [`Cmaes`] (module doc for the formulas); written
@@ -230,6 +234,7 @@ impl Default for CmaesOptions {
             tol_x: 1e-12,
             target: None,
             feasibility_tolerance: 0.0,
+            active: false,
         }
     }
 }
@@ -308,6 +313,8 @@ fn better(a: &Sample, b: &Sample) -> std::cmp::Ordering {
 struct Params {
     lambda: usize,
     weights: Vec<f64>,
+    /// Negative weights of ranks μ+1..λ (active update; empty otherwise).
+    negative: Vec<f64>,
     mueff: f64,
     cs: f64,
     ds: f64,
@@ -318,7 +325,7 @@ struct Params {
 }
 
 impl Params {
-    fn new(n: usize, lambda: usize) -> Params {
+    fn new(n: usize, lambda: usize, active: bool) -> Params {
         let nf = n as f64;
         let mu = lambda / 2;
         let raw: Vec<f64> = (1..=mu)
@@ -333,9 +340,30 @@ impl Params {
         let c1 = 2.0 / ((nf + 1.3).powi(2) + mueff);
         let cmu = (1.0 - c1).min(2.0 * (mueff - 2.0 + 1.0 / mueff) / ((nf + 2.0).powi(2) + mueff));
         let chi_n = nf.sqrt() * (1.0 - 1.0 / (4.0 * nf) + 1.0 / (21.0 * nf * nf));
+        // Hansen (2016) eq. (53): raw `ln((λ+1)/2) − ln i` for i > μ,
+        // scaled to min(α_μ⁻, α_μeff⁻, α_posdef⁻) / Σ|w⁻|.
+        let raw_neg: Vec<f64> = if active {
+            (mu + 1..=lambda)
+                .map(|i| ((lambda as f64 + 1.0) / 2.0).ln() - (i as f64).ln())
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let sum_neg: f64 = raw_neg.iter().map(|w| w.abs()).sum();
+        let negative = if sum_neg > 0.0 {
+            let sq: f64 = raw_neg.iter().map(|w| w * w).sum();
+            let mueff_neg = sum_neg * sum_neg / sq;
+            let scale = (1.0 + c1 / cmu)
+                .min(1.0 + 2.0 * mueff_neg / (mueff + 2.0))
+                .min((1.0 - c1 - cmu) / (nf * cmu));
+            raw_neg.iter().map(|w| w * scale / sum_neg).collect()
+        } else {
+            Vec::new()
+        };
         Params {
             lambda,
             weights,
+            negative,
             mueff,
             cs,
             ds,
@@ -363,9 +391,9 @@ struct Run {
 }
 
 impl Run {
-    fn new(n: usize, lambda: usize, mean: Vec<f64>, sigma: f64) -> Run {
+    fn new(n: usize, lambda: usize, mean: Vec<f64>, sigma: f64, active: bool) -> Run {
         Run {
-            p: Params::new(n, lambda),
+            p: Params::new(n, lambda, active),
             mean: DVector::from_vec(mean),
             sigma,
             cov: DMatrix::identity(n, n),
@@ -474,7 +502,7 @@ impl Cmaes {
             evaluations: 0,
             generations: 0,
         });
-        self.run = Some(Run::new(n, lambda, mean, sigma0));
+        self.run = Some(Run::new(n, lambda, mean, sigma0, self.options.active));
     }
 
     /// The regime of the run after the current one, or `None` when the
@@ -665,7 +693,18 @@ impl Cmaes {
         for (w, s) in p.weights.iter().zip(&steps) {
             rank_mu += *w * (s * s.transpose());
         }
-        let decay = 1.0 - p.c1 - p.cmu + (1.0 - h) * p.c1 * p.cc * (2.0 - p.cc);
+        // Active update: ranks μ+1..λ with `w_i n / |C^{-1/2} y_i|²`
+        // (Hansen 2016, eqs. 46–47), and Σw over all λ weights in the decay.
+        let worst = order.iter().skip(p.weights.len()).take(p.negative.len());
+        for (w, &k) in p.negative.iter().zip(worst) {
+            let s = (DVector::from_column_slice(&samples[k].y) - &old_mean) / run.sigma;
+            let white = (run.b.transpose() * &s)
+                .component_div(&run.d)
+                .norm_squared();
+            rank_mu += (*w * n as f64 / white.max(1e-300)) * (&s * s.transpose());
+        }
+        let wsum = 1.0 + p.negative.iter().sum::<f64>();
+        let decay = 1.0 - p.c1 - p.cmu * wsum + (1.0 - h) * p.c1 * p.cc * (2.0 - p.cc);
         run.cov = decay * &run.cov + p.c1 * (&run.pc * run.pc.transpose()) + p.cmu * rank_mu;
         run.cov = 0.5 * (&run.cov + run.cov.transpose());
         run.sigma *= ((p.cs / p.ds) * (ps_norm / p.chi_n - 1.0)).exp();
@@ -795,69 +834,5 @@ pub fn minimize(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The message list is the serde names of every schedule, and each
-    /// parses back; an unknown name lists them.
-    #[test]
-    fn restart_names_are_the_serde_names() {
-        let names: Vec<&str> = Restarts::ALL.iter().map(|r| r.name()).collect();
-        assert_eq!(names.join(", "), Restarts::NAMES);
-        for r in Restarts::ALL {
-            assert_eq!(Restarts::parse(r.name()).unwrap(), r);
-        }
-        let e = Restarts::parse("ipopp").unwrap_err().to_string();
-        assert!(
-            e.contains("`restarts` = \"ipopp\"") && e.contains("ipop, bipop"),
-            "{e}"
-        );
-    }
-
-    /// Hansen (2016) Table 1 identities: positive decreasing weights that
-    /// sum to 1, `1 <= μ_eff <= μ`, learning rates with `c_1 + c_μ <= 1`;
-    /// for n = 10, λ = 10 the weights computed by hand from
-    /// `ln 5.5 − ln i` give μ_eff = 3.16726 (closed form derived here).
-    #[test]
-    fn strategy_parameters() {
-        for (n, lambda) in [(2, 6), (10, 10), (5, 64)] {
-            let p = Params::new(n, lambda);
-            assert!((p.weights.iter().sum::<f64>() - 1.0).abs() < 1e-15);
-            assert!(p.weights.windows(2).all(|w| w[0] > w[1] && w[1] > 0.0));
-            assert!(p.mueff >= 1.0 && p.mueff <= (lambda / 2) as f64);
-            assert!(p.c1 + p.cmu <= 1.0 && p.cs < 1.0 && p.cc < 1.0 && p.ds > 1.0);
-        }
-        let p = Params::new(10, 10);
-        assert!((p.mueff - 3.16726).abs() < 1e-4, "{}", p.mueff);
-    }
-
-    /// Deb's rules: feasible beats infeasible regardless of f; feasible by
-    /// f; infeasible by violation.
-    #[test]
-    fn feasibility_rules_order() {
-        let s = |f: f64, v: f64| Sample {
-            y: vec![],
-            x: vec![],
-            f,
-            g: vec![],
-            violation: v,
-        };
-        use std::cmp::Ordering::*;
-        assert_eq!(better(&s(10.0, 0.0), &s(-10.0, 0.1)), Less);
-        assert_eq!(better(&s(1.0, 0.0), &s(2.0, 0.0)), Less);
-        assert_eq!(better(&s(-5.0, 0.3), &s(5.0, 0.2)), Greater);
-    }
-
-    /// Box–Muller normals: sample mean ≈ 0 and variance ≈ 1 (standard
-    /// errors 1/√N and √(2/N) for N = 20 000; 5σ bounds).
-    #[test]
-    fn normal_samples_have_unit_variance() {
-        let mut rng = ChaCha8Rng::seed_from_u64(0);
-        let n = 20_000;
-        let xs: Vec<f64> = (0..n).map(|_| normal(&mut rng)).collect();
-        let mean = xs.iter().sum::<f64>() / n as f64;
-        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n as f64;
-        assert!(mean.abs() < 5.0 / (n as f64).sqrt());
-        assert!((var - 1.0).abs() < 5.0 * (2.0 / n as f64).sqrt());
-    }
-}
+#[path = "cmaes_tests.rs"]
+mod tests;

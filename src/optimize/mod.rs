@@ -15,6 +15,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 pub mod cmaes;
 pub mod driver;
+pub mod kkt;
 pub mod mmfd;
 pub mod qp;
 pub mod testproblems;

@@ -253,6 +253,7 @@ impl BasisBuilder {
             eigenvalues: keep.iter().map(|&j| run.modes.lambda[j]).collect(),
             derivatives,
             rigid,
+            geometric: None,
         })
     }
 

@@ -8,11 +8,11 @@ use super::parts::{
     ParamKind,
 };
 use super::quantity::{Columns, Quantity, Response};
-use super::spec::{Effect, JointSpec, JointType, SceneSpec};
+use super::spec::{DriveSpec, Effect, JointSpec, JointType, SceneSpec};
 use crate::error::{Error, Result};
 use crate::integrate::{Options, SensitivityForm};
 use crate::mbs::math::{axis_angle, frame_from_axis};
-use crate::mbs::model::{Body, Drive, Integral, Joint, JointKind, Model, Param};
+use crate::mbs::model::{Body, Drive, Harmonic, Integral, Joint, JointKind, Model, Param, Piece};
 use crate::mbs::responses::ResponseKind;
 use nalgebra::{Matrix3, Vector3};
 
@@ -59,6 +59,7 @@ impl SceneSpec {
             baumgarte: self.baumgarte,
             quadratic_velocity: self.has(Effect::QuadraticVelocity),
             divergence_limit: Some(self.divergence_limit),
+            geometric_stiffening: self.has(Effect::GeometricStiffening),
             ..Model::default()
         };
         self.add_bodies(&mut model, panels)?;
@@ -150,6 +151,18 @@ impl SceneSpec {
                     Body::new(&key, &b.name, mass, inertia, (com, [1.0, 0.0, 0.0, 0.0]))?
                 }
             };
+            let no_geometric = body
+                .flex
+                .as_ref()
+                .is_some_and(|f| f.basis.geometric.is_none());
+            if self.has(Effect::GeometricStiffening) && no_geometric {
+                return Err(Error::input(
+                    format!("{key}.flexible.kind"),
+                    "panel",
+                    "a `beam` body with `geometric_stiffening` in scene.effects (panels \
+                     have no geometric stiffness yet: remove the effect or use a beam)",
+                ));
+            }
             body.fixed = b.fixed;
             body.v0 = finite3(format!("{key}.velocity"), b.velocity)?;
             body.w0 = body.orientation().transpose()
@@ -276,6 +289,20 @@ impl SceneSpec {
         }
         if let Some(p) = &self.outputs.plot {
             let plotted = parse_quantity(model, flex_names, "outputs.plot", p)?;
+            if !self.outputs.quantities.iter().any(|q| q == p) {
+                return Err(Error::input(
+                    "outputs.plot",
+                    p,
+                    format!(
+                        "one of outputs.quantities ({}): the plot draws a column of history.csv",
+                        if self.outputs.quantities.is_empty() {
+                            "none listed".to_string()
+                        } else {
+                            self.outputs.quantities.join(", ")
+                        }
+                    ),
+                ));
+            }
             if plotted.kind.info().columns != Columns::One {
                 return Err(Error::input(
                     "outputs.plot",
@@ -420,24 +447,62 @@ fn joint_kind(key: &str, j: &JointSpec) -> Result<JointKind> {
             ))
         }
         JointType::Prismatic => JointKind::Prismatic,
-        JointType::Locked => JointKind::Driven(Drive {
-            coefficients: vec![j.angle],
-        }),
-        JointType::Driven => match &j.drive {
-            Some(c) if !c.is_empty() && c.iter().all(|v| v.is_finite()) => {
-                JointKind::Driven(Drive {
-                    coefficients: c.clone(),
-                })
-            }
-            other => {
-                return Err(Error::input(
-                    format!("{key}.drive"),
-                    format!("{other:?}"),
-                    "polynomial coefficients [c0, c1, ..] of θ(t) (rad, s)",
-                ))
-            }
-        },
+        JointType::Locked => JointKind::Driven(Drive::Polynomial(vec![j.angle])),
+        JointType::Driven => {
+            JointKind::Driven(drive_of(&format!("{key}.drive"), j.drive.as_ref())?)
+        }
     })
+}
+
+/// The law of a driven joint's `drive` (`key` = `joints[k].drive`).
+fn drive_of(key: &str, spec: Option<&DriveSpec>) -> Result<Drive> {
+    let law = match spec {
+        None => {
+            return Err(Error::input(
+                key,
+                "(missing)",
+                "a drive: [c0, c1, ..], { pieces = [..] } or { table = [[t, θ], ..] }",
+            ))
+        }
+        Some(DriveSpec::Polynomial(c)) => return Drive::polynomial(key, c.clone()),
+        Some(DriveSpec::Law(law)) => law,
+    };
+    match (&law.pieces, &law.table) {
+        (Some(pieces), None) => Drive::pieces(
+            key,
+            pieces
+                .iter()
+                .map(|p| {
+                    let harmonics = p
+                        .harmonics
+                        .iter()
+                        .map(|h| Harmonic {
+                            amplitude: h.amplitude,
+                            omega: h.omega,
+                            phase: h.phase,
+                        })
+                        .collect();
+                    let piece = Piece {
+                        start: 0.0,
+                        poly: p.poly.clone(),
+                        harmonics,
+                    };
+                    (p.until, piece)
+                })
+                .collect(),
+        ),
+        (None, Some(rows)) => Drive::table(key, rows),
+        (Some(_), Some(_)) => Err(Error::input(
+            format!("{key}.table"),
+            "(given with pieces)",
+            "either pieces or table, not both",
+        )),
+        (None, None) => Err(Error::input(
+            key,
+            "{}",
+            "pieces = [..] or table = [[t, θ], ..]",
+        )),
+    }
 }
 
 /// The unit-free axis of joint `j` (any vector for a kind whose rows read

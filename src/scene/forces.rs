@@ -1,6 +1,7 @@
 //! `[[scene.forces]]` data → [`Force`]s of the model: the Eq. 32
 //! actuator of a revolute joint, spring-dampers between markers or along
-//! a prismatic or cylindrical joint, and loads at a body's centre of mass
+//! a prismatic or cylindrical joint, torsion springs about a revolute
+//! joint, and loads at a body's centre of mass
 //! or at a marker. Each step names its key (`forces[k].<field>`) in
 //! errors; what the scene's effects do not list is validated but not
 //! built.
@@ -146,13 +147,39 @@ impl SceneSpec {
             damping,
             length,
             force,
+            angle,
+            torque,
             ..
         } = f
         else {
             unreachable!("spring_of is called with springs only")
         };
         let values = [*stiffness, *damping];
+        let turning = joint
+            .as_deref()
+            .and_then(|j| model.joint(j))
+            .is_some_and(|j| !model.joints[j].kind.has_slide());
+        // Keys of the other kind of spring are refused, not ignored.
+        let foreign = if turning {
+            [("length", *length), ("force", *force)]
+        } else {
+            [("angle", *angle), ("torque", *torque)]
+        };
+        if let Some((name, Some(v))) = foreign.iter().find(|(_, v)| v.is_some()) {
+            return Err(Error::input(
+                format!("{key}.{name}"),
+                v,
+                if turning {
+                    "no length or force on a torsion spring (angle, torque)"
+                } else {
+                    "angle and torque only on a torsion spring (joint = a revolute joint)"
+                },
+            ));
+        }
         match (joint, marker_i, marker_j) {
+            (Some(j), None, None) if turning => {
+                self.torsion_spring(model, key, j, values, (*angle, *torque))
+            }
             (Some(j), None, None) => self.joint_spring(model, key, j, values, (*length, *force)),
             (None, Some(a), Some(b)) => {
                 if let Some(v) = force {
@@ -176,7 +203,7 @@ impl SceneSpec {
                 ),
                 "(missing)",
                 "marker_i and marker_j (a spring between markers) or joint (a spring \
-                 along a prismatic or cylindrical joint)",
+                 along a prismatic or cylindrical joint, or about a revolute joint)",
             )),
         }
     }
@@ -239,7 +266,7 @@ impl SceneSpec {
         let sliding: Vec<&str> = model
             .joints
             .iter()
-            .filter(|j| j.kind.has_slide())
+            .filter(|j| j.kind.has_slide() || j.kind == JointKind::Revolute)
             .map(|j| j.name.as_str())
             .collect();
         let jt = model
@@ -250,34 +277,59 @@ impl SceneSpec {
                     format!("{key}.joint"),
                     joint,
                     format!(
-                        "the name of a prismatic or cylindrical joint in scene.joints ({}); \
-                         a revolute joint takes type = \"actuator\"",
+                        "the name of a prismatic, cylindrical or revolute joint in \
+                         scene.joints ({})",
                         name_list(&sliding)
                     ),
                 )
             })?;
         let (length, force) = (length.unwrap_or(0.0), force.unwrap_or(0.0));
-        for (name, v, min) in [
-            ("stiffness", stiffness, 0.0),
-            ("damping", damping, 0.0),
-            ("length", length, f64::NEG_INFINITY),
-            ("force", force, f64::NEG_INFINITY),
-        ] {
-            if !(v.is_finite() && v >= min) {
-                let what = if min == 0.0 {
-                    "a finite value ≥ 0"
-                } else {
-                    "a finite value"
-                };
-                return Err(Error::input(format!("{key}.{name}"), v, what));
-            }
-        }
+        check_spring_values(
+            key,
+            [stiffness, damping],
+            [("length", length), ("force", force)],
+        )?;
         Ok(self.has(Effect::Springs).then_some(Force::JointSpring {
             joint: jt,
             stiffness,
             damping: self.damping_if_listed(damping),
             length,
             force,
+        }))
+    }
+
+    /// A torsion spring-damper about a revolute joint (None without the
+    /// `springs` effect): free angle `angle` (rad, default 0), constant
+    /// preload `torque` (N·m, default 0) turning body j positively; the
+    /// damping with the `damping` effect.
+    fn torsion_spring(
+        &self,
+        model: &Model,
+        key: &str,
+        joint: &str,
+        [stiffness, damping]: [f64; 2],
+        (angle, torque): (Option<f64>, Option<f64>),
+    ) -> Result<Option<Force>> {
+        let jt = model.joint(joint).expect("a torsion spring names a joint");
+        if !matches!(model.joints[jt].kind, JointKind::Revolute) {
+            return Err(Error::input(
+                format!("{key}.joint"),
+                joint,
+                "a revolute joint (a driven, locked, fixed or spherical joint has no free angle)",
+            ));
+        }
+        let (angle, torque) = (angle.unwrap_or(0.0), torque.unwrap_or(0.0));
+        check_spring_values(
+            key,
+            [stiffness, damping],
+            [("angle", angle), ("torque", torque)],
+        )?;
+        Ok(self.has(Effect::Springs).then_some(Force::TorsionSpring {
+            joint: jt,
+            stiffness,
+            damping: self.damping_if_listed(damping),
+            angle,
+            torque,
         }))
     }
 
@@ -361,4 +413,25 @@ fn name_list(names: &[&str]) -> String {
         n if n <= 12 => names.join(", "),
         _ => format!("{}, …", names[..12].join(", ")),
     }
+}
+
+/// A joint spring's `stiffness` and `damping` finite and ≥ 0, and its two
+/// free values (free length and preload, or free angle and preload)
+/// finite; the error names `<key>.<name>`.
+fn check_spring_values(key: &str, [k, c]: [f64; 2], free: [(&str, f64); 2]) -> Result<()> {
+    for (name, v) in [("stiffness", k), ("damping", c)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(Error::input(
+                format!("{key}.{name}"),
+                v,
+                "a finite value ≥ 0",
+            ));
+        }
+    }
+    for (name, v) in free {
+        if !v.is_finite() {
+            return Err(Error::input(format!("{key}.{name}"), v, "a finite value"));
+        }
+    }
+    Ok(())
 }

@@ -9,7 +9,7 @@ use serde::Deserialize;
 
 /// What a scene may switch on (`[scene] effects`, written in snake case:
 /// `gravity`, `actuators`, `damping`, `springs`, `loads`, `flexibility`,
-/// `quadratic_velocity`): what is not listed is neither built nor
+/// `quadratic_velocity`, `geometric_stiffening`): what is not listed is neither built nor
 /// evaluated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -28,11 +28,14 @@ pub enum Effect {
     Flexibility,
     /// Quadratic-velocity (gyroscopic and centrifugal) terms.
     QuadraticVelocity,
+    /// Geometric stiffening of flexible bodies by their inertial
+    /// prestress ([`crate::mbs::model::geometric`]).
+    GeometricStiffening,
 }
 
 impl Effect {
     /// Every effect, in the order of the documentation.
-    pub const ALL: [Effect; 7] = [
+    pub const ALL: [Effect; 8] = [
         Effect::Gravity,
         Effect::Actuators,
         Effect::Damping,
@@ -40,6 +43,7 @@ impl Effect {
         Effect::Loads,
         Effect::Flexibility,
         Effect::QuadraticVelocity,
+        Effect::GeometricStiffening,
     ];
 
     /// The name written in study files.
@@ -52,6 +56,7 @@ impl Effect {
             Effect::Loads => "loads",
             Effect::Flexibility => "flexibility",
             Effect::QuadraticVelocity => "quadratic_velocity",
+            Effect::GeometricStiffening => "geometric_stiffening",
         }
     }
 }
@@ -290,9 +295,89 @@ pub struct JointSpec {
     /// held angle of a `locked` joint.
     #[serde(default)]
     pub angle: f64,
-    /// `driven`: polynomial coefficients `[c0, c1, ..]` of `θ(t) = Σ c_k t^k`
-    /// (rad, rad/s, ..).
-    pub drive: Option<Vec<f64>>,
+    /// `driven`: the prescribed angle θ(t) ([`DriveSpec`]): polynomial
+    /// coefficients `[c0, c1, ..]` of `θ(t) = Σ c_k t^k` (rad, rad/s, ..),
+    /// a piecewise law `{ pieces = [..] }` or a table `{ table = [..] }`.
+    pub drive: Option<DriveSpec>,
+}
+
+/// A driven joint's `drive` as written: an array (polynomial
+/// coefficients) or a table with `pieces` or `table`
+/// ([`crate::mbs::model::drive`] for the laws and their derivatives).
+#[derive(Debug, Clone, PartialEq)]
+pub enum DriveSpec {
+    /// `drive = [c0, c1, ..]`: `θ(t) = Σ c_k t^k`.
+    Polynomial(Vec<f64>),
+    /// `drive = { pieces = [..] }` or `drive = { table = [..] }`.
+    Law(DriveLawSpec),
+}
+
+impl<'de> Deserialize<'de> for DriveSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = DriveSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "polynomial coefficients [c0, c1, ..], { pieces = [..] } or \
+                     { table = [[t, θ], ..] }",
+                )
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, a: A) -> Result<DriveSpec, A::Error> {
+                Vec::<f64>::deserialize(SeqAccessDeserializer::new(a)).map(DriveSpec::Polynomial)
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, a: A) -> Result<DriveSpec, A::Error> {
+                DriveLawSpec::deserialize(MapAccessDeserializer::new(a)).map(DriveSpec::Law)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// `drive = { pieces = [..] }` (a piecewise law) or `drive = { table =
+/// [[t, θ], ..] }` (a cubic spline through the rows): exactly one of the
+/// two.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveLawSpec {
+    /// The pieces in time order; each one's time τ starts at 0 where
+    /// the piece starts (the first at t = 0).
+    pub pieces: Option<Vec<PieceSpec>>,
+    /// Rows `[t, θ]` (s, rad), `t` strictly increasing, at least 4: the
+    /// not-a-knot C² cubic spline through them, continued linearly
+    /// outside.
+    pub table: Option<Vec<[f64; 2]>>,
+}
+
+/// One piece of a piecewise drive: `θ = Σ c_k τ^k + Σ a sin(ωτ + φ)` with
+/// `τ` the time since the piece's start.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PieceSpec {
+    /// End time of the piece (s, absolute): required on every piece but
+    /// the last, refused on the last.
+    pub until: Option<f64>,
+    /// Polynomial coefficients `[c0, c1, ..]` in powers of τ (rad, rad/s,
+    /// ..; default none).
+    #[serde(default)]
+    pub poly: Vec<f64>,
+    /// Harmonic terms (default none).
+    #[serde(default)]
+    pub harmonics: Vec<HarmonicSpec>,
+}
+
+/// A harmonic term `amplitude · sin(omega·τ + phase)` of a piece.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HarmonicSpec {
+    /// Amplitude (rad).
+    pub amplitude: f64,
+    /// Angular frequency (rad/s).
+    pub omega: f64,
+    /// Phase at the piece's start (rad, default 0).
+    #[serde(default)]
+    pub phase: f64,
 }
 
 /// A joint's `type` in a study file. Each maps to one
@@ -306,8 +391,8 @@ pub enum JointType {
     Revolute,
     /// A revolute joint held at its initial `angle` (6 equations).
     Locked,
-    /// A revolute joint whose angle follows the polynomial `drive`
-    /// θ(t) = Σ c_k t^k (6 equations).
+    /// A revolute joint whose angle follows the `drive` law θ(t)
+    /// (polynomial, pieces or table; 6 equations).
     Driven,
     /// No relative motion (6 equations).
     Fixed,
@@ -372,9 +457,11 @@ pub enum ForceSpec {
         segments: Vec<SegmentSpec>,
     },
     /// A spring-damper between two markers (`marker_i`, `marker_j`; rest
-    /// `length` default: the initial distance) or along a prismatic or
+    /// `length` default: the initial distance), along a prismatic or
     /// cylindrical `joint` (rest displacement `length`, default 0, and a
-    /// constant actuator `force` along the axis, default 0).
+    /// constant actuator `force` along the axis, default 0), or about a
+    /// revolute `joint` (a torsion spring: free `angle`, default 0, and a
+    /// constant preload `torque`, default 0).
     Spring {
         /// Name for sensitivity parameters (`<name>.stiffness`,
         /// `<name>.damping`).
@@ -383,12 +470,13 @@ pub enum ForceSpec {
         marker_i: Option<String>,
         /// Second marker.
         marker_j: Option<String>,
-        /// A prismatic or cylindrical joint to act along (instead of the
-        /// markers).
+        /// A prismatic or cylindrical joint to act along, or a revolute
+        /// joint to act about (instead of the markers).
         joint: Option<String>,
-        /// Stiffness (N/m).
+        /// Stiffness (N/m; N·m/rad about a revolute joint).
         stiffness: f64,
-        /// Viscous damping (N·s/m, default 0).
+        /// Viscous damping (N·s/m; N·m·s/rad about a revolute joint;
+        /// default 0).
         #[serde(default)]
         damping: f64,
         /// Rest length (m; default: the initial distance of the markers, or
@@ -396,6 +484,12 @@ pub enum ForceSpec {
         length: Option<f64>,
         /// Constant force along a joint's axis (N, default 0).
         force: Option<f64>,
+        /// Free angle θ0 of a torsion spring (rad, default 0): τ = −k(θ −
+        /// θ0) − cθ̇ + torque.
+        angle: Option<f64>,
+        /// Constant preload torque of a torsion spring (N·m, default 0),
+        /// turning body j positively about the axis.
+        torque: Option<f64>,
     },
     /// A force and torque at a body's centre of mass (`body`) or at a
     /// marker (`marker`), in global or body axes (`frame`).

@@ -12,6 +12,7 @@
 
 use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Stats};
+use crate::mbs::post::energy::EnergyMonitor;
 use crate::mbs::responses::{energy_lanes, peak, ResponseKind, ResponseValue};
 use crate::mbs::Projection;
 use crate::mbs::{Energy, Param, Reaction, System, Workspace};
@@ -37,8 +38,9 @@ pub struct Simulation {
     pub stats: Stats,
     /// Largest `|Φ|` over the output times.
     pub max_violation: f64,
-    /// Largest energy change relative to the largest |E| of the run,
-    /// `max |E − E0| / max |E|`, when the scene is conservative.
+    /// Largest energy change relative to a scale that does not vanish,
+    /// `max |E − E0| / max(|E|, T, range of V)` over the run
+    /// ([`EnergyMonitor`]), when the scene is conservative.
     pub energy_error: Option<f64>,
     /// Redundant equations (equations − rank) at the start.
     pub redundant: usize,
@@ -101,10 +103,7 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
     let conservative = sys.conservative();
     let mut rows: Vec<Vec<f64>> = Vec::new();
     let mut max_violation = 0.0f64;
-    // Largest |E − E0| and the largest |E| of the run (its scale: a run
-    // that starts with E0 = 0, e.g. from rest at the potential's zero,
-    // is measured against the energy it reaches, not against 0).
-    let (mut energy_change, mut energy_scale) = (0.0f64, 0.0f64);
+    let mut energy_monitor = EnergyMonitor::new(e0);
     let mut y_end = y0.clone();
     let wants_reactions = scene
         .outputs
@@ -157,9 +156,7 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
         };
         max_violation = max_violation.max(viol);
         if conservative {
-            let e = sys.energy(y, &mut ws);
-            energy_change = energy_change.max((e - e0).abs());
-            energy_scale = energy_scale.max(e.abs()).max(e0.abs());
+            energy_monitor.observe(&sys, y, &mut ws);
         }
         let mut row = output_row(&sys, scene, (t, y), &mut ws, reactions.as_deref(), viol);
         if let Some(prev) = rows.last() {
@@ -216,7 +213,7 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
         projection,
         stats,
         max_violation,
-        energy_error: conservative.then(|| energy_change / energy_scale.max(1e-300)),
+        energy_error: conservative.then(|| energy_monitor.error()),
         sens_headers,
         sens_rows,
         responses,

@@ -38,6 +38,8 @@ pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<Vec<evolve::Re
             restarts,
             feasibility_tolerance,
             tol_fun: plan.section.tol_fun.unwrap_or(1e-12),
+            target: plan.section.target,
+            active: plan.section.active,
         };
         let report = evolve::run(
             problem.as_ref(),

@@ -5,13 +5,18 @@ use crate::error::{Error, Result};
 use crate::explore::config::{map_section, problem};
 use crate::explore::context::Context;
 use crate::explore::evolve::global_schedule;
-use crate::explore::manifest::MapEntry;
+use crate::explore::fingerprint::{self, Fingerprint};
+use crate::explore::manifest::{DriverEntry, MapEntry};
 use crate::explore::map;
+use crate::report::manifest::Manifest;
+use std::collections::BTreeMap;
 use std::path::Path;
 
 /// `plyscape map`: the grid(s), marked with the optima in `optima.csv` and
 /// each evolution's best in `evolution.csv` when those exist in the study's
-/// output directory.
+/// output directory. With `--resume` the cells already in the tables are
+/// kept (after the checks of `check_resume` and [`map::run`]) and only the
+/// missing ones computed.
 pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
     let problem = problem(ctx.study)?;
     let sec = map_section(ctx.study)?;
@@ -54,19 +59,30 @@ pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
         base,
         marks,
     };
-    let slices = map::run(problem.as_ref(), &req, ctx.threads, &dir)?;
     // With more than two variables, the design the slices pass through.
-    let slices_through = (n > 2).then(|| {
+    let slices_through: Option<BTreeMap<String, f64>> = (n > 2).then(|| {
         vars.iter()
             .zip(&req.base)
             .map(|(v, &x)| (v.name.clone(), x))
             .collect()
     });
-    let entry = MapEntry {
+    if ctx.flags.resume {
+        check_resume(ctx, &dir, slices_through.as_ref())?;
+    }
+    let entry = |complete| MapEntry {
+        complete,
         resolution: sec.resolution,
-        slices_through,
+        slices_through: slices_through.clone(),
     };
-    ctx.manifest(&dir, "map", entry)?;
+    ctx.manifest(&dir, "map", entry(false))?;
+    let opts = map::MapOptions {
+        threads: ctx.threads,
+        resume: ctx.flags.resume,
+        quiet: ctx.quiet,
+        checks: sec.resume_checks,
+    };
+    let slices = map::run(problem.as_ref(), &req, &opts, &dir)?;
+    ctx.manifest(&dir, "map", entry(true))?;
     if !ctx.quiet {
         println!(
             "map of {}: {} slice(s) of {}^2 points in {}",
@@ -77,6 +93,40 @@ pub fn run_map(ctx: &Context) -> Result<Vec<map::Slice>> {
         );
     }
     Ok(slices)
+}
+
+/// What `map --resume` checks before it reads the tables back: the
+/// fingerprint of the evaluations ([`Fingerprint::evaluation_only`]: the
+/// solver's settings do not enter a map) recorded by the `map` entry, and
+/// with more than two variables the design the slices pass through (it
+/// follows the best optimum of `optima.csv`). The grid itself is checked
+/// row by row ([`map::run`]).
+fn check_resume(
+    ctx: &Context,
+    dir: &Path,
+    slices_through: Option<&BTreeMap<String, f64>>,
+) -> Result<()> {
+    let now = Fingerprint::of_study(ctx.study).evaluation_only();
+    let table = dir.join("map.csv");
+    fingerprint::check_recorded(ctx.study, dir, &["map"], &now, &table)?;
+    if !dir.join("manifest.json").exists() {
+        return Ok(());
+    }
+    let recorded: Option<DriverEntry<MapEntry>> = Manifest::read(dir)?.entry("map");
+    if let Some(e) = recorded {
+        if e.detail.slices_through.as_ref() != slices_through {
+            return Err(ctx.study.error(
+                "--resume",
+                dir.display(),
+                format!(
+                    "slices through the design they were computed at ({:?}), but they now pass \
+                     through {:?} (the best optimum changed); rerun without --resume",
+                    e.detail.slices_through, slices_through
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `CMA-ES best` for a table of one schedule and `<solver> best`

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::explore::config::{multistart_plan, problem, MultistartPlan};
 use crate::explore::context::Context;
 use crate::explore::manifest::{MultistartCounts, MultistartEntry};
-use crate::explore::{multistart, optimum_report, solvers};
+use crate::explore::{fingerprint, multistart, optimum_report, solvers};
 use crate::optimize::Problem;
 use std::path::{Path, PathBuf};
 
@@ -26,7 +26,11 @@ pub fn multistart_with(
     plan: &MultistartPlan,
 ) -> Result<multistart::Report> {
     let dir = ctx.dir()?;
-    if !ctx.flags.resume {
+    if ctx.flags.resume {
+        // Same evaluations as the rows read back (fingerprint, spot check).
+        let checks = plan.section.resume_checks;
+        fingerprint::check_runs(ctx.study, &dir, problem, checks, ctx.quiet)?;
+    } else {
         keep_earlier_runs(&dir, ctx.flags.force, ctx.quiet)?;
     }
     let started = MultistartEntry {

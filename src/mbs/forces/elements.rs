@@ -2,7 +2,8 @@
 //! rigid bodies, the inertia, elastic and damping forces of flexible
 //! bodies ([`super::flexbody`]), and the force elements of
 //! [`Model::forces`](crate::mbs::Model) (gravity, loads, the Eq. 32
-//! actuator, spring-dampers between markers and along joints), one
+//! actuator, spring-dampers between markers and along joints, torsion
+//! springs on revolute joints), one
 //! function per element. Forces are
 //! accumulated in the velocity layout of the state (`[ṙ, ω', ẇ]` per
 //! body: force in global axes (N), torque in body axes (N·m), modal
@@ -13,7 +14,7 @@
 //! Every value a sensitivity parameter can replace is read through
 //! `pval`, so a dual-number evaluation differentiates it exactly.
 
-use crate::mbs::kinematics::{angle_of, slide_of};
+use crate::mbs::kinematics::{angle_of, slide_of, wrap_angle};
 use crate::mbs::math::{cst, mtv, mv, Scalar};
 use crate::mbs::model::{Force, Load, LoadFrame, Param, PiecewiseLaw};
 use crate::mbs::system::{bump, pval, System, Workspace};
@@ -60,6 +61,13 @@ impl System {
                     length,
                     force,
                 } => self.joint_spring(ws, fi, *joint, [*stiffness, *damping, *length, *force]),
+                Force::TorsionSpring {
+                    joint,
+                    stiffness,
+                    damping,
+                    angle,
+                    torque,
+                } => self.torsion_spring(ws, fi, *joint, [*stiffness, *damping, *angle, *torque]),
             }
         }
     }
@@ -269,6 +277,31 @@ impl System {
         self.apply_force(ws, jt.j, &(-f));
         let d = mj.x - mi.x;
         self.apply_torque(ws, jt.i, &(-zi.cross(&d) * tension));
+    }
+
+    /// Torsion spring-damper `forces[fi]` on revolute joint `joint`
+    /// ([`Force::TorsionSpring`]): torque `τ = −k·wrap(θ − θ0) − c·θ̇ + τ0`
+    /// (N·m) about `z_i` on marker j, the reaction on marker i; `wrap`
+    /// takes the angle difference into (−π, π].
+    fn torsion_spring<T: Scalar>(
+        &self,
+        ws: &mut Workspace<T>,
+        fi: usize,
+        joint: usize,
+        [stiffness, damping, angle, torque]: [f64; 4],
+    ) {
+        bump(&self.counters.springs);
+        let jt = &self.model.joints[joint];
+        let (mi, mj) = (ws.mk[jt.i], ws.mk[jt.j]);
+        let (th, thd) = angle_of(&mi, &mj);
+        let d = wrap_angle(th - cst::<T>(angle));
+        let k = pval(&ws.params, Param::Stiffness(fi), stiffness);
+        let c = pval(&ws.params, Param::Damping(fi), damping);
+        let m = cst::<T>(torque) - k * d - c * thd;
+        let axis: Vector3<T> = mi.frame.column(2).into();
+        let tau = axis * m;
+        self.apply_torque(ws, jt.j, &tau);
+        self.apply_torque(ws, jt.i, &(-tau));
     }
 
     /// Add a global torque on the carrier of marker `m` (and on the modes

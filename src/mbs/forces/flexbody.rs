@@ -36,6 +36,7 @@
 #![allow(clippy::needless_range_loop)] // index-heavy small dense kernels
 
 use crate::mbs::math::{cst, mm, mv, quadratic_form, spd_inverse, sym_times, Scalar};
+use crate::mbs::model::Force;
 use crate::mbs::system::{bump, same_seeds, InvT, System, Workspace, SEED_SPARES};
 use nalgebra::{Matrix3, Vector3};
 
@@ -46,6 +47,13 @@ pub struct FlexEffects {
     pub quadratic: bool,
     /// Modal damping ratio (0 = none).
     pub zeta: f64,
+    /// Geometric stiffening ([`crate::mbs::model::geometric`]): the
+    /// modal geometric stiffness of the inertial prestress, when the
+    /// invariants carry it.
+    pub geometric: bool,
+    /// Gravity (global axes, m/s²) for the prestress of the geometric
+    /// stiffening (`None`: no gravity).
+    pub gravity: Option<Vector3<f64>>,
 }
 
 /// Kinematic state of one flexible body.
@@ -135,6 +143,9 @@ pub fn flex_terms<T: Scalar>(
             put(mass, 6 + i, 6 + j, inv.mww[i * n + j]);
         }
     }
+    if eff.geometric && !inv.kg.is_empty() {
+        geometric_terms(inv, st, eff.gravity, mass, force);
+    }
     // Elastic and damping forces.
     let two = cst::<T>(2.0);
     for j in 0..n {
@@ -185,6 +196,60 @@ pub fn flex_terms<T: Scalar>(
     }
 }
 
+/// The geometric stiffening of a flexible body
+/// ([`crate::mbs::model::geometric`]): with `K_k w` of each unit load
+/// case, the `ω̇` and frame-acceleration cases go into the mass matrix
+/// (`M[w_j, ω_c] += (K_{6+c} w)_j`, `M[w_j, ṙ_c] −= (A Σ_a e_a (K_{9+a}
+/// w)_j)_c`, both symmetric), the `ω_aω_b` and gravity cases into the
+/// modal forces (`Q_j −= Σ_k c_k (K_k w)_j`).
+fn geometric_terms<T: Scalar>(
+    inv: &InvT<T>,
+    st: &FlexState<T>,
+    gravity: Option<Vector3<f64>>,
+    mass: &mut [T],
+    force: &mut [T],
+) {
+    let n = inv.n;
+    let (d, nn) = (6 + n, n * n);
+    let (a, om, w) = (st.a, st.wb, st.w);
+    let kw = |k: usize, j: usize| -> T {
+        let row = &inv.kg[k * nn + j * n..k * nn + j * n + n];
+        row.iter()
+            .zip(w)
+            .fold(T::zero(), |acc, (kij, wi)| acc + *kij * *wi)
+    };
+    let g = gravity.map(|g| mv(&a.transpose(), &g.map(cst::<T>)));
+    let c = [
+        om.x * om.x,
+        om.y * om.y,
+        om.z * om.z,
+        om.x * om.y,
+        om.y * om.z,
+        om.z * om.x,
+    ];
+    for j in 0..n {
+        let kt = Vector3::new(kw(9, j), kw(10, j), kw(11, j));
+        let akt = mv(a, &kt);
+        for col in 0..3 {
+            let r = 6 + j;
+            let v = mass[r * d + 3 + col] + kw(6 + col, j);
+            mass[r * d + 3 + col] = v;
+            mass[(3 + col) * d + r] = v;
+            let v = mass[r * d + col] - akt[col];
+            mass[r * d + col] = v;
+            mass[col * d + r] = v;
+        }
+        let mut q = T::zero();
+        for (k, ck) in c.iter().enumerate() {
+            q += *ck * kw(k, j);
+        }
+        if let Some(g) = &g {
+            q += g.dot(&kt);
+        }
+        force[6 + j] -= q;
+    }
+}
+
 impl System {
     /// The invariants of flexible slot `s` in `T`, lifted again only when
     /// the design seeds differ from those of the current copy and of the
@@ -232,6 +297,11 @@ impl System {
             let eff = FlexEffects {
                 quadratic: self.model.quadratic_velocity && forces,
                 zeta: if forces { zeta } else { 0.0 },
+                geometric: self.model.geometric_stiffening,
+                gravity: self.model.forces.iter().find_map(|f| match f {
+                    Force::Gravity { g } => Some(*g),
+                    _ => None,
+                }),
             };
             if eff.quadratic {
                 bump(&self.counters.quadratic);

@@ -44,6 +44,7 @@
 //! `X`) from the same matrix products
 //! ([`Invariants::with_derivatives`]).
 
+use super::geometric::Geometric;
 use crate::error::{Error, Result};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
@@ -110,6 +111,10 @@ pub struct ModalBasis {
     pub derivatives: Vec<BasisDerivative>,
     /// Rigid-body content of the modes and the modes dropped for it.
     pub rigid: RigidScreen,
+    /// The modal geometric stiffness of the inertial unit load cases
+    /// (geometric stiffening, [`super::geometric`]); `None` when the
+    /// basis's source does not provide it.
+    pub geometric: Option<Geometric>,
 }
 
 impl ModalBasis {
@@ -195,6 +200,9 @@ impl ModalBasis {
                 ));
             }
         }
+        if let Some(g) = &self.geometric {
+            g.validate(key, n, self.derivatives.len())?;
+        }
         Ok(())
     }
 
@@ -236,6 +244,10 @@ impl ModalBasis {
                 content: self.rigid.content.iter().take(n).copied().collect(),
                 ..self.rigid.clone()
             },
+            geometric: self
+                .geometric
+                .as_ref()
+                .map(|g| g.picked(&(0..n).collect::<Vec<_>>())),
         }
     }
 
@@ -300,6 +312,7 @@ impl ModalBasis {
                 dropped,
                 limit,
             },
+            geometric: self.geometric.as_ref().map(|g| g.picked(&keep)),
         })
     }
 
@@ -310,6 +323,7 @@ impl ModalBasis {
         for s in b.nodes.iter_mut() {
             *s -= o;
         }
+        b.geometric = self.geometric.as_ref().map(|g| g.shifted(o));
         b
     }
 
@@ -355,12 +369,21 @@ pub struct Invariants {
     pub mww: Vec<f64>,
     /// Λ (1/s²).
     pub lambda: Vec<f64>,
+    /// The modal geometric stiffness of the unit load cases
+    /// ([`Geometric::cases`], or its derivative); empty when the basis
+    /// has none.
+    pub kg: Vec<f64>,
 }
 
 impl Invariants {
     /// The invariants of `basis`.
     pub fn new(basis: &ModalBasis) -> Invariants {
-        Invariants::of_shapes(basis, &ShapeMatrices::new(basis, &basis.shapes))
+        let mut inv = Invariants::of_shapes(basis, &ShapeMatrices::new(basis, &basis.shapes));
+        inv.kg = basis
+            .geometric
+            .as_ref()
+            .map_or(Vec::new(), |g| g.cases.clone());
+        inv
     }
 
     /// The invariants of `basis` from its arranged shapes `sh`.
@@ -378,17 +401,22 @@ impl Invariants {
     pub fn with_derivatives(basis: &ModalBasis) -> (Invariants, Vec<Invariants>) {
         let n = basis.n_modes;
         let sh = ShapeMatrices::new(basis, &basis.shapes);
-        let value = Invariants::of_shapes(basis, &sh);
+        let mut value = Invariants::of_shapes(basis, &sh);
+        let geometric = basis.geometric.as_ref();
+        value.kg = geometric.map_or(Vec::new(), |g| g.cases.clone());
         let sym =
             |s: Mat<f64>| Mat::<f64>::from_fn(s.nrows(), s.ncols(), |i, j| s[(i, j)] + s[(j, i)]);
         let derivs = basis
             .derivatives
             .iter()
-            .map(|d| {
+            .enumerate()
+            .map(|(v, d)| {
                 let dsh = ShapeMatrices::new(basis, &d.shapes);
                 let (dg, dh) = (sym(dsh.gram(&sh)), sym(dsh.rot_gram(&sh)));
                 let dv = flat_sums(basis, &d.shapes, (&dg, &dh), false);
-                Invariants::from_flat(n, &dv, d.eigenvalues.clone())
+                let mut di = Invariants::from_flat(n, &dv, d.eigenvalues.clone());
+                di.kg = geometric.map_or(Vec::new(), |g| g.derivatives[v].clone());
+                di
             })
             .collect();
         (value, derivs)
@@ -426,6 +454,7 @@ impl Invariants {
             c_rot,
             mww,
             lambda,
+            kg: Vec::new(),
         }
     }
 
@@ -698,6 +727,7 @@ mod tests {
                 },
             }],
             rigid: RigidScreen::default(),
+            geometric: None,
         }
     }
 
@@ -746,6 +776,7 @@ mod tests {
                 shapes: (0..6 * nn * n).map(|i| r(400 + i)).collect(),
             }],
             rigid: RigidScreen::default(),
+            geometric: None,
         }
     }
 

@@ -1,6 +1,7 @@
 //! Force elements as data: gravity, the paper's Eq. 32
 //! spring-damper-actuator with its piecewise-linear law, linear
-//! spring-dampers between markers or along a sliding joint, and constant
+//! spring-dampers between markers or along a sliding joint, torsion
+//! spring-dampers on revolute joints, and constant
 //! or time-tabulated loads (SI units). They are applied by
 //! `crate::mbs::forces`.
 
@@ -23,8 +24,9 @@ pub struct Segment {
     pub anchor: f64,
 }
 
-/// Piecewise-linear law `M(θ)` (Eq. 32 without the damping term). Outside
-/// the union of the segments the nearest boundary segment extends its line.
+/// Piecewise-linear law `M(θ)` (Eq. 32 without the damping term): the
+/// segments tile an interval of `θ`; outside it the nearest boundary
+/// segment extends its line.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PiecewiseLaw {
     /// Segments sorted by `lower`.
@@ -32,8 +34,11 @@ pub struct PiecewiseLaw {
 }
 
 impl PiecewiseLaw {
-    /// Validates (non-empty, `lower < upper`, finite) and sorts.
-    pub fn new(key: &str, mut segments: Vec<Segment>) -> Result<PiecewiseLaw> {
+    /// Validates (non-empty, `lower < upper`, finite; sorted by `lower`,
+    /// each segment's `upper` is the next one's `lower`: no gap, no
+    /// overlap) and sorts. `key` (e.g. `forces[0].segments`) names the
+    /// offending segment in errors, with the bounds of both neighbours.
+    pub fn new(key: &str, segments: Vec<Segment>) -> Result<PiecewiseLaw> {
         if segments.is_empty() {
             return Err(Error::input(key, "[]", "at least one segment"));
         }
@@ -47,7 +52,30 @@ impl PiecewiseLaw {
                 ));
             }
         }
-        segments.sort_by(|a, b| a.lower.total_cmp(&b.lower));
+        // Sorted by lower bound, remembering the written index of each.
+        let mut order: Vec<usize> = (0..segments.len()).collect();
+        order.sort_by(|&a, &b| segments[a].lower.total_cmp(&segments[b].lower));
+        for w in order.windows(2) {
+            let (a, b) = (&segments[w[0]], &segments[w[1]]);
+            if a.upper != b.lower {
+                let what = if a.upper < b.lower {
+                    "a gap"
+                } else {
+                    "an overlap"
+                };
+                return Err(Error::input(
+                    format!("{key}[{}]", w[1]),
+                    format!("({}, {}]", b.lower, b.upper),
+                    format!(
+                        "lower = {} (the upper bound of {key}[{}], ({}, {}]): the segments \
+                         must tile the angle range without gaps or overlaps; here {what} \
+                         between the two",
+                        a.upper, w[0], a.lower, a.upper
+                    ),
+                ));
+            }
+        }
+        let segments = order.into_iter().map(|k| segments[k].clone()).collect();
         Ok(PiecewiseLaw { segments })
     }
 
@@ -128,6 +156,25 @@ pub enum Force {
         length: f64,
         /// Constant actuator force `f` (N), pushing the markers apart along `z_i`.
         force: f64,
+    },
+    /// Torsion spring-damper on a revolute joint: torque on marker j about
+    /// `z_i`, `τ = −k·(θ − θ0) − c·θ̇ + τ0` (N·m), the reaction on marker
+    /// i, with `θ − θ0` taken in (−π, π] (the joint angle is measured
+    /// there: the spring holds within half a turn of `θ0`). Positive `τ`
+    /// turns body j in the positive sense about the axis: the natural sign
+    /// of a spring of potential `½k(θ − θ0)²`.
+    TorsionSpring {
+        /// Index of the revolute joint into
+        /// [`Model::joints`](crate::mbs::Model::joints).
+        joint: usize,
+        /// Stiffness `k` (N·m/rad).
+        stiffness: f64,
+        /// Damping coefficient `c` (N·m·s/rad).
+        damping: f64,
+        /// Free angle `θ0` (rad).
+        angle: f64,
+        /// Constant preload torque `τ0` (N·m), turning body j positively.
+        torque: f64,
     },
     /// Force (N) at the centre of mass and torque (N·m) on a body,
     /// constant or tabulated in time, with components in global or body

@@ -17,32 +17,12 @@
 //! |---|---|---|
 //! | spherical | point | `x_i − x_j = 0` (3) |
 //! | revolute | point, parallel | + `x_i·z_j = 0`, `y_i·z_j = 0` (5) |
-//! | driven | point, parallel, angle | + `θ − f(t) = 0` (6) |
+//! | driven | point, parallel, angle | + `θ − f(t) = 0` (6), `f` a [`Drive`] |
 //! | fixed | point, parallel, twist | revolute + `x_i·y_j = 0` (6) |
 //! | cylindrical | line, parallel | `x_i·d = 0`, `y_i·d = 0` with `d = x_j − x_i`, + `x_i·z_j = 0`, `y_i·z_j = 0` (4) |
 //! | prismatic | line, parallel, twist | cylindrical + `x_i·y_j = 0` (5) |
 
-/// A prescribed relative angle `θ(t) = Σ c_k t^k` (rad, t in s); a locked
-/// revolute joint is the constant polynomial.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Drive {
-    /// Polynomial coefficients `[c_0, c_1, …]` (rad/s^k for `c_k`), in
-    /// increasing powers of `t`.
-    pub coefficients: Vec<f64>,
-}
-
-impl Drive {
-    /// `(θ, θ̇, θ̈)` at time `t`.
-    pub fn eval(&self, t: f64) -> (f64, f64, f64) {
-        let (mut f, mut d, mut dd) = (0.0, 0.0, 0.0);
-        for &c in self.coefficients.iter().rev() {
-            dd = dd * t + d * 2.0;
-            d = d * t + f;
-            f = f * t + c;
-        }
-        (f, d, dd)
-    }
-}
+use super::drive::Drive;
 
 /// A block of constraint rows between two markers: the unit joint kinds
 /// are made of. The rows of a block are named (for labels of reactions
@@ -167,22 +147,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn drive_polynomial_derivatives() {
-        // θ = 1 + 2t + 3t²: closed form derived in this test.
-        let d = Drive {
-            coefficients: vec![1.0, 2.0, 3.0],
-        };
-        let (f, df, ddf) = d.eval(0.5);
-        assert!((f - 2.75).abs() < 1e-15);
-        assert!((df - 5.0).abs() < 1e-15);
-        assert!((ddf - 6.0).abs() < 1e-15);
-    }
-
-    #[test]
     fn flags_follow_from_the_blocks() {
-        let driven = JointKind::Driven(Drive {
-            coefficients: vec![0.0],
-        });
+        let driven = JointKind::Driven(Drive::Polynomial(vec![0.0]));
         let angle = [true, true, false, true, false, false];
         let slide = [false, false, false, true, true, false];
         let kinds = [

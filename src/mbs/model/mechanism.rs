@@ -26,6 +26,10 @@ pub struct Model {
     /// bodies; centrifugal and Coriolis couplings of flexible ones): the
     /// scene's `quadratic_velocity` effect.
     pub quadratic_velocity: bool,
+    /// Geometric stiffening of the flexible bodies by their inertial
+    /// prestress ([`super::geometric`]): the scene's
+    /// `geometric_stiffening` effect.
+    pub geometric_stiffening: bool,
     /// Time integrals carried as extra states (after the velocities), so
     /// that their sensitivities come with the integration
     /// (docs/numerics.md, "Responses and optimization").
@@ -116,9 +120,7 @@ mod tests {
         let kinds = [
             JointKind::Spherical,
             JointKind::Revolute,
-            JointKind::Driven(Drive {
-                coefficients: vec![0.0],
-            }),
+            JointKind::Driven(Drive::Polynomial(vec![0.0])),
             JointKind::Fixed,
             JointKind::Cylindrical,
             JointKind::Prismatic,

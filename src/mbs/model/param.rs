@@ -10,10 +10,10 @@ use super::mechanism::Model;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Param {
     /// Stiffness `k` of the spring-damper `forces[i]` (N/m), between
-    /// markers or along a joint.
+    /// markers or along a joint, or of a torsion spring (N·m/rad).
     Stiffness(usize),
     /// Damping of `forces[i]`: `c` of a spring-damper (N·s/m) or of a
-    /// rotational actuator (N·m·s).
+    /// rotational actuator or torsion spring (N·m·s).
     Damping(usize),
     /// Mass of `bodies[i]` (kg): translational inertia and weight (the
     /// inertia tensor is a separate datum).
@@ -39,12 +39,14 @@ impl Param {
             Param::Mass(b) => model.bodies.get(b).map(|b| b.mass),
             Param::Stiffness(f) => match model.forces.get(f) {
                 Some(Force::SpringDamper { stiffness, .. })
-                | Some(Force::JointSpring { stiffness, .. }) => Some(*stiffness),
+                | Some(Force::JointSpring { stiffness, .. })
+                | Some(Force::TorsionSpring { stiffness, .. }) => Some(*stiffness),
                 _ => None,
             },
             Param::Damping(f) => match model.forces.get(f) {
                 Some(Force::SpringDamper { damping, .. })
                 | Some(Force::JointSpring { damping, .. })
+                | Some(Force::TorsionSpring { damping, .. })
                 | Some(Force::Rotational { damping, .. }) => Some(*damping),
                 _ => None,
             },
@@ -93,14 +95,15 @@ impl Param {
         match *self {
             Param::Mass(b) => model.bodies[b].mass = v,
             Param::Stiffness(f) => match &mut model.forces[f] {
-                Force::SpringDamper { stiffness, .. } | Force::JointSpring { stiffness, .. } => {
-                    *stiffness = v
-                }
+                Force::SpringDamper { stiffness, .. }
+                | Force::JointSpring { stiffness, .. }
+                | Force::TorsionSpring { stiffness, .. } => *stiffness = v,
                 _ => {}
             },
             Param::Damping(f) => match &mut model.forces[f] {
                 Force::SpringDamper { damping, .. }
                 | Force::JointSpring { damping, .. }
+                | Force::TorsionSpring { damping, .. }
                 | Force::Rotational { damping, .. } => *damping = v,
                 _ => {}
             },

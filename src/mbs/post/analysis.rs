@@ -3,9 +3,9 @@
 //! constraint violation.
 
 use crate::error::{Error, Result};
-use crate::mbs::kinematics::{angle_of, slide_of};
+use crate::mbs::kinematics::{angle_of, slide_of, wrap_angle};
 use crate::mbs::math::Scalar;
-use crate::mbs::model::{Energy, Force, JointKind};
+use crate::mbs::model::{Energy, Force};
 use crate::mbs::system::{BodyKin, System, Workspace, RANK_REG, RANK_TOL};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
@@ -170,8 +170,9 @@ impl System {
         ws.rows.iter().fold(0.0f64, |m, r| m.max(r.phi.abs()))
     }
 
-    /// Mechanical energy: kinetic + strain (`½ wᵀΛw`) + gravity potential
-    /// + linear springs between markers and along joints (J).
+    /// Mechanical energy: kinetic + strain (`½ wᵀΛw`) + gravity
+    /// potential + linear springs between markers and along joints +
+    /// torsion springs `½k·wrap(θ − θ0)²` (J).
     pub fn energy(&self, y: &[f64], ws: &mut Workspace<f64>) -> f64 {
         let mut terms = Energy::kinetic_total(&self.model);
         terms.extend(self.moving.iter().map(|&b| Energy::Strain(b)));
@@ -205,6 +206,16 @@ impl System {
                     let jt = &self.model.joints[*joint];
                     let (s, _) = slide_of(&ws.mk[jt.i], &ws.mk[jt.j]);
                     e += 0.5 * stiffness * (s - length).powi(2);
+                }
+                Force::TorsionSpring {
+                    joint,
+                    stiffness,
+                    angle,
+                    ..
+                } => {
+                    let jt = &self.model.joints[*joint];
+                    let (th, _) = angle_of(&ws.mk[jt.i], &ws.mk[jt.j]);
+                    e += 0.5 * stiffness * wrap_angle(th - angle).powi(2);
                 }
                 _ => {}
             }
@@ -269,6 +280,9 @@ impl System {
             Force::Gravity { .. } => true,
             Force::SpringDamper { damping, .. } => *damping == 0.0,
             Force::JointSpring { damping, force, .. } => *damping == 0.0 && *force == 0.0,
+            Force::TorsionSpring {
+                damping, torque, ..
+            } => *damping == 0.0 && *torque == 0.0,
             _ => false,
         });
         let modal_ok = self
@@ -280,7 +294,7 @@ impl System {
             .model
             .joints
             .iter()
-            .all(|j| !matches!(j.kind, JointKind::Driven(ref d) if d.coefficients.len() > 1));
+            .all(|j| j.kind.drive().is_none_or(|d| d.is_constant()));
         forces_ok && joints_ok && modal_ok
     }
 

@@ -1,7 +1,7 @@
 //! After the solve: consistent initial conditions (projection), loads,
 //! violations, reactions, momenta and deflections ([`analysis`]), energy
-//! sums ([`energy`]) and the response functionals with their sensitivity
-//! lanes ([`responses`]).
+//! sums and the energy error of a run ([`energy`]) and the response
+//! functionals with their sensitivity lanes ([`responses`]).
 
 pub mod analysis;
 pub mod energy;

@@ -40,6 +40,10 @@ pub struct InvT<T: Scalar> {
     pub mww: Vec<T>,
     /// Eigenvalues Λ (1/s²), length n.
     pub lambda: Vec<T>,
+    /// The modal geometric stiffness of the unit load cases
+    /// ([`crate::mbs::model::geometric`]), `CASES` blocks of n × n; empty
+    /// when the body has none.
+    pub kg: Vec<T>,
 }
 
 impl<T: Scalar> InvT<T> {
@@ -77,6 +81,7 @@ impl<T: Scalar> InvT<T> {
             c_rot: vec(&|i| &i.c_rot),
             mww: vec(&|i| &i.mww),
             lambda: vec(&|i| &i.lambda),
+            kg: vec(&|i| &i.kg),
         }
     }
 

@@ -46,8 +46,9 @@
 //!    crossing (quadratic in α from `g(0)`, `∇gᵀS` and the trial).
 //! 6. Convergence: `|Δf| < DABOBJ` or `|Δf|/|f| < DELOBJ` for ITRMOP
 //!    consecutive feasible iterations, or the Kuhn–Tucker test
-//!    `|S| <= kt_tolerance · max(|f|, 1)` with the binding constraints within
-//!    CTMIN of their limits.
+//!    `|S| <= kt_tolerance · max(|f|, 1)` (or `max(|∇f|, 1)` with the
+//!    scaled gradient, option `kt_scale`) with the binding constraints
+//!    within CTMIN of their limits.
 //!
 //! Counting follows DOT (and the paper's Table 5): an evaluation with
 //! gradients counts one function call and one gradient call.
@@ -61,7 +62,7 @@ use argmin::core::{
     Problem as ArgminProblem, Solver, State, TerminationReason, TerminationStatus, KV,
 };
 use geometry::{dot, first_root, least_norm, norm};
-pub use options::MmfdOptions;
+pub use options::{KtScale, MmfdOptions};
 
 mod geometry;
 mod options;
@@ -669,7 +670,11 @@ impl Mmfd {
         };
         // Kuhn–Tucker test.
         let on_limits = binding.iter().all(|&j| base.g[j].abs() <= o.ctmin);
-        if norm(&s) <= o.kt_tolerance * base.f.abs().max(1.0) && on_limits {
+        let kt_scale = match o.kt_scale {
+            KtScale::Objective => base.f.abs().max(1.0),
+            KtScale::Gradient => norm(&gf).max(1.0),
+        };
+        if norm(&s) <= o.kt_tolerance * kt_scale && on_limits {
             self.current = Some(base.clone());
             self.termination = Some(Termination::KuhnTucker);
             self.record_stay(problem, &base);

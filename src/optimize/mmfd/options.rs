@@ -1,6 +1,33 @@
-//! [`MmfdOptions`]: the method's parameters, DOT's defaults.
+//! [`MmfdOptions`]: the method's parameters, DOT's defaults, and the
+//! presets the drivers use.
+//!
+//! - [`MmfdOptions::dot`] (= `default()`): DOT's settings, including its
+//!   absolute-change exit DABOBJ = `1e-4 |f(x0)|`, which stops a run whose
+//!   start had a large |f| far from stationarity (on HS 100 from a start
+//!   with f(x0) = 7.7e6: DABOBJ = 772, runs stop up to 374 above f*).
+//! - [`MmfdOptions::standard`]: DOT's settings without that exit, and the
+//!   Kuhn–Tucker test relative to the gradient (as the certificate of
+//!   [`crate::optimize::kkt`] states it) instead of to |f|.
+//! - [`MmfdOptions::polish`] / [`MmfdOptions::polish_for`]: a continuation
+//!   from a run's end at tight tolerances, which stops when the
+//!   certificate's Kuhn–Tucker test passes (or when no further progress
+//!   is possible).
+//!
+//! [`MmfdOptions::with_feasibility`] sets CTMIN to a study's feasibility
+//! tolerance (and the constraint-following tolerance below it).
 
 use crate::error::{Error, Result};
+use crate::optimize::kkt::KktTolerances;
+
+/// What the Kuhn–Tucker test's tolerance is relative to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum KtScale {
+    /// `|S| <= kt_tolerance · max(|f|, 1)` (scaled variables).
+    Objective,
+    /// `|S| <= kt_tolerance · max(|∇f|, 1)` with the scaled gradient: the
+    /// scale of [`crate::optimize::kkt`]'s residual.
+    Gradient,
+}
 
 /// MMFD parameters. Defaults are DOT's where DOT has the parameter
 /// (Vanderplaats R&D, *DOT Users Manual*, parameters RPRM/IPRM).
@@ -39,9 +66,12 @@ pub struct MmfdOptions {
     /// its range, since the variables are range-scaled).
     pub dx2: f64,
     /// Kuhn–Tucker tolerance on the projected gradient in scaled variables,
-    /// relative to `max(|f|, 1)`: 1e-4 (a full-range move then changes f by
-    /// less than 0.01 % to first order).
+    /// relative to `max(|f|, 1)` (see `kt_scale`): 1e-4 (a full-range move
+    /// then changes f by less than 0.01 % to first order).
     pub kt_tolerance: f64,
+    /// What `kt_tolerance` is relative to: `Objective` (default, as
+    /// above) or `Gradient`.
+    pub kt_scale: KtScale,
     /// Function calls allowed per line search (excluding corrections): 6.
     pub max_line_evaluations: usize,
     /// Newton pull-backs onto the binding constraints per trial point: 3.
@@ -66,6 +96,7 @@ impl Default for MmfdOptions {
             dx1: 0.01,
             dx2: 0.2,
             kt_tolerance: 1e-4,
+            kt_scale: KtScale::Objective,
             max_line_evaluations: 6,
             max_corrections: 3,
             follow_tolerance: 3e-5,
@@ -74,6 +105,65 @@ impl Default for MmfdOptions {
 }
 
 impl MmfdOptions {
+    /// DOT's settings (the same as `default()`).
+    pub fn dot() -> MmfdOptions {
+        MmfdOptions::default()
+    }
+
+    /// DOT's settings without the absolute-change exit DABOBJ (which
+    /// depends on |f(x0)|) and with the Kuhn–Tucker test relative to the
+    /// gradient; the relative-change exit DELOBJ = 1e-3 stays, and the
+    /// drivers' polish certifies or continues what it stops.
+    pub fn standard() -> MmfdOptions {
+        MmfdOptions {
+            dabobj: Some(f64::MIN_POSITIVE),
+            kt_scale: KtScale::Gradient,
+            ..MmfdOptions::default()
+        }
+    }
+
+    /// The polish for the default certificate tolerances
+    /// ([`KktTolerances::default`]); see [`MmfdOptions::polish_for`].
+    pub fn polish() -> MmfdOptions {
+        MmfdOptions::polish_for(&KktTolerances::default())
+    }
+
+    /// Options to continue from a run's end until the certificate with
+    /// tolerances `tol` passes: the active set `g_j >= −tol.active` from
+    /// the first iteration (CT = −active, no sharpening), CTMIN the
+    /// feasibility tolerance, the Kuhn–Tucker exit at half the
+    /// certificate's stationarity tolerance relative to the gradient (so
+    /// that the certificate at the end passes), the change exits at
+    /// round-off level (DELOBJ 1e-12 for 3 iterations, no DABOBJ), a first
+    /// step that seeks 1 % of |f| and moves each variable at most 5 % of
+    /// its range per trial, and 200 iterations.
+    pub fn polish_for(tol: &KktTolerances) -> MmfdOptions {
+        MmfdOptions {
+            ct: -tol.active.max(1e-12),
+            ct_reduction: 1.0,
+            delobj: 1e-12,
+            dabobj: Some(f64::MIN_POSITIVE),
+            itrmop: 3,
+            max_iterations: 200,
+            dobj1: 0.01,
+            dx2: 0.05,
+            kt_tolerance: 0.5 * tol.stationarity,
+            kt_scale: KtScale::Gradient,
+            ..MmfdOptions::default()
+        }
+        .with_feasibility(tol.feasibility)
+    }
+
+    /// CTMIN set to the feasibility tolerance `tol` (at least 1e-12, as
+    /// CTMIN must be positive), the constraint-following tolerance to at
+    /// most CTMIN/100, and CT to at most −CTMIN.
+    pub fn with_feasibility(mut self, tol: f64) -> MmfdOptions {
+        self.ctmin = tol.max(1e-12);
+        self.follow_tolerance = self.follow_tolerance.min(self.ctmin / 100.0);
+        self.ct = self.ct.min(-self.ctmin);
+        self
+    }
+
     pub(super) fn validate(&self) -> Result<()> {
         let bad = |k: &str, v: f64, e: &str| Err(Error::input(format!("mmfd.{k}"), v, e));
         if !(self.ct < 0.0 && self.ct.is_finite()) {

@@ -3,5 +3,6 @@ mod compare;
 mod kill;
 mod multistart;
 mod optimum_report;
+mod resume;
 mod scene;
 mod studies;

@@ -659,3 +659,18 @@ fn a_size_that_cannot_fit_is_refused_with_the_estimate() {
         "{e}"
     );
 }
+
+#[test]
+fn geometric_stiffening_on_a_panel_body_is_refused() {
+    // Panels have no geometric stiffness yet (beams do): the effect must
+    // not be accepted and then silently do nothing.
+    let text = panel_scene(30.0).replace(
+        r#"effects = ["flexibility", "quadratic_velocity"]"#,
+        r#"effects = ["flexibility", "quadratic_velocity", "geometric_stiffening"]"#,
+    );
+    let err = load_scene(&study(&text)).unwrap_err().to_string();
+    assert!(
+        err.contains("bodies[1].flexible.kind") && err.contains("geometric_stiffening"),
+        "{err}"
+    );
+}

@@ -129,19 +129,28 @@ fn force_and_response_errors_name_key_value_and_the_expected_values() {
             + body
     };
     let load = |body: &str| BASE.to_string() + "[[scene.forces]]\ntype = \"load\"\n" + body;
+    let actuator = |segments: &str| {
+        BASE.replace(
+            "effects = [\"gravity\"]",
+            "effects = [\"gravity\", \"actuators\"]",
+        ) + "[[scene.forces]]\ntype = \"actuator\"\njoint = \"pin\"\nsegments = ["
+            + segments
+            + "]\n"
+    };
     let cases: Vec<(String, &str, &str, &[&str])> = vec![
-        // A spring along an unknown joint, and along a revolute one.
+        // A spring along an unknown joint, and a rest length on a torsion
+        // spring (about a revolute joint).
         (
             spring("joint = \"slid\"\n"),
             "scene.forces[0].joint",
             "slid",
-            &["prismatic or cylindrical joint", "none in this scene"],
+            &["prismatic, cylindrical or revolute joint", "(pin)"],
         ),
         (
-            spring("joint = \"pin\"\n"),
-            "scene.forces[0].joint",
-            "pin",
-            &["type = \"actuator\""],
+            spring("joint = \"pin\"\nlength = 0.2\n"),
+            "scene.forces[0].length",
+            "0.2",
+            &["no length or force on a torsion spring"],
         ),
         (
             spring("joint = \"pin\"\nmarker_i = \"pin.i\"\nmarker_j = \"pin.j\"\n"),
@@ -185,6 +194,27 @@ fn force_and_response_errors_name_key_value_and_the_expected_values() {
             "scene.responses[0].kind",
             "last",
             &["`integral`, `peak`, `final`"],
+        ),
+        // A plot of an output that is not a column of history.csv.
+        (
+            BASE.replace("quantities = [\"pin.angle\"]", "quantities = [\"pin.angle\"]\nplot = \"pin.rate\""),
+            "scene.outputs.plot",
+            "pin.rate",
+            &["one of outputs.quantities (pin.angle)"],
+        ),
+        // Actuator segments with a gap, and with an overlap (written out
+        // of order: the message names both by their written index).
+        (
+            actuator("{ lower = 0.5, upper = 2.0, value = 1.0 }, { lower = -1.0, upper = 0.4, value = 0.0 }"),
+            "scene.forces[0].segments[0]",
+            "(0.5, 2]",
+            &["lower = 0.4", "forces[0].segments[1], (-1, 0.4]", "a gap"],
+        ),
+        (
+            actuator("{ lower = -1.0, upper = 0.6, value = 0.0 }, { lower = 0.5, upper = 2.0, value = 1.0 }"),
+            "scene.forces[0].segments[1]",
+            "(0.5, 2]",
+            &["lower = 0.6", "forces[0].segments[0], (-1, 0.6]", "an overlap"],
         ),
     ];
     for (text, key, value, expected) in cases {

@@ -1,6 +1,7 @@
 //! Tests of `plyscape::mbs` and the scenes built on it: kernel, joints, loads, flexible bodies, sensitivities, the SAR scenes and the shipped studies.
 mod andrews;
 mod convergence;
+mod drives;
 mod energy;
 mod events;
 mod flex;
@@ -17,4 +18,6 @@ mod sar_holddown;
 mod scene_convergence;
 mod sens;
 mod slider_crank;
+mod stiffening;
 mod studies;
+mod torsion;

@@ -32,6 +32,26 @@ fn rosenbrock_2_and_10_dimensions_to_1e8() {
     }
 }
 
+/// Active CMA-ES (negative weights, Jastrebski & Arnold 2006) solves
+/// Rosenbrock 10-D (f* = 0 at (1, …, 1), Rosenbrock 1960) and the target
+/// stops it there, well inside the budget.
+#[test]
+fn active_cmaes_solves_rosenbrock_10d_and_stops_at_the_target() {
+    let p = tp::rosenbrock(10);
+    let options = CmaesOptions {
+        seed: 3,
+        max_evaluations: 30_000,
+        target: Some(1e-10),
+        active: true,
+        ..CmaesOptions::default()
+    };
+    let o = run(&p, &options);
+    assert_eq!(o.termination, Termination::TargetReached, "{o:?}");
+    assert!(o.f <= 1e-10 && o.feasible);
+    assert!(o.x.iter().all(|&x| (x - 1.0).abs() < 1e-4), "{:?}", o.x);
+    assert!(o.function_calls < 30_000);
+}
+
 /// Seeds 0..10 of `restarts` CMA-ES on Rastrigin in `n` dimensions that
 /// reach the global minimum f* = 0 at the origin within `budget`.
 fn rastrigin_hits(n: usize, budget: usize, restarts: Restarts) -> usize {
