@@ -23,6 +23,8 @@ use crate::scene::{Quantity, Scene};
 use num_dual::Dual64;
 use std::path::{Path, PathBuf};
 
+pub mod spin;
+
 /// Everything a simulation produced.
 #[derive(Debug)]
 pub struct Simulation {
@@ -66,6 +68,9 @@ pub struct Simulation {
     /// The numerical failure that ended the integration early
     /// ([`simulate_partial`]); the rows are those computed before it.
     pub failure: Option<Error>,
+    /// Warnings raised during the run: a flexible body turning fast
+    /// without geometric stiffening ([`spin`]).
+    pub warnings: Vec<String>,
 }
 
 /// The bound on the violation of a dropped constraint row, in units of
@@ -118,7 +123,9 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
     // sensitivities (for integral responses).
     let mut peaks: Vec<Vec<(f64, f64, Vec<f64>)>> = vec![Vec::new(); scene.responses.len()];
     let mut s_end = vec![0.0; n * scene.params.len()];
+    let mut spin = spin::SpinWatch::new(&sys);
     let mut observe = |t: f64, y: &[f64], s: &[f64]| {
+        spin.observe(&sys, t, y);
         let lanes: Vec<(&[f64], Param)> = if s.is_empty() {
             Vec::new()
         } else {
@@ -219,6 +226,7 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
         responses,
         row_events: sys.counters.row_events.get(),
         failure,
+        warnings: spin.warnings,
     };
     Ok((sys, sim))
 }
@@ -745,11 +753,17 @@ pub fn summary(sim: &Simulation) -> String {
         s.jvp_calls,
         s.jacobians,
         s.error_test_failures,
-        s.events,
+        (s.events as u64).saturating_sub(sim.row_events),
         s.restarts,
         s.wall * 1e3,
         s.observer_wall * 1e3
     );
+    if sim.row_events > 0 {
+        text += &format!(
+            "\nredundancy events: {} (dropped constraint rows chosen anew)",
+            sim.row_events
+        );
+    }
     for r in &sim.responses {
         text += &format!(
             "\nresponse {} ({}): {:.6e}{}",
