@@ -23,10 +23,13 @@
 //! at the event state (an event like a segment change: the integrator
 //! restarts there): every row is factored, rows at the regularisation
 //! level are dependent ([`crate::mbs::system::RANK_TOL`]), and of those,
-//! the ones whose violation has reached `τ / 2` stay in the solve (a row
-//! implied by the others cannot drift away from them), as does every row
-//! that has re-entered once (so a run has at most as many such events as
-//! rows). Baumgarte stabilisation then pulls the re-entered row back, so
+//! the ones whose violation has reached `τ / 2` *and* exceeds
+//! [`IMPLIED_RATIO`] times the largest violation of the rows in the solve
+//! stay in the solve (a row implied by the others cannot drift away from
+//! them), as does every row that has re-entered once. A row that reached
+//! its bound but drifts only with the solved rows (a truly redundant row
+//! of an overconstrained linkage at a loose tolerance) stays out, its
+//! bound doubled past its violation, so such a row causes few events. Baumgarte stabilisation then pulls the re-entered row back, so
 //! the largest violation stays at `τ`. While no dropped row drifts, no
 //! root changes sign and the run is unchanged step for step.
 //!
@@ -64,8 +67,9 @@ pub struct RowWatch {
     dropped: Vec<usize>,
     /// Rows that have re-entered the solve: never left out again.
     kept: Vec<bool>,
-    /// The bound `τ` on `|Φ|` of a dropped row (m or rad).
-    bound: f64,
+    /// Per row, the bound on `|Φ_r|` while it is left out (m or rad):
+    /// `τ`, raised for a row found implied at an event.
+    bound: Vec<f64>,
     /// Whether rows are watched (the system's [`System::row_bound`] is set).
     on: bool,
 }
@@ -83,7 +87,7 @@ impl RowWatch {
                 Vec::new()
             },
             kept: vec![false; m],
-            bound: sys.row_bound.unwrap_or(f64::INFINITY),
+            bound: vec![sys.row_bound.unwrap_or(f64::INFINITY); m],
             on,
         }
     }
@@ -119,8 +123,8 @@ impl RowWatch {
         sys.kinematics(y, ws);
         let mut phi = Vec::with_capacity(self.dropped.len());
         sys.row_values(t, ws, &self.dropped, &mut phi);
-        for (gk, p) in g.iter_mut().zip(&phi) {
-            *gk = self.bound - p.abs();
+        for ((gk, p), &r) in g.iter_mut().zip(&phi).zip(&self.dropped) {
+            *gk = self.bound[r] - p.abs();
         }
     }
 
@@ -148,7 +152,7 @@ impl RowWatch {
         sys.kinematics(y, &mut ws);
         let mut phi = Vec::new();
         sys.row_values(t, &ws, &[row], &mut phi);
-        phi[0].abs() >= self.bound * (1.0 - 1e-6)
+        phi[0].abs() >= self.bound[row] * (1.0 - 1e-6)
     }
 
     /// Choose the rows left out anew at `(t, y)` (module doc): the rows
@@ -159,14 +163,21 @@ impl RowWatch {
         let mut ws = Workspace::<f64>::empty();
         ws.drop = Some(vec![false; m]);
         sys.load(t, y, &mut ws);
-        let far: Vec<bool> = ws
-            .rows
-            .iter()
-            .map(|r| r.phi.abs() >= 0.5 * self.bound)
-            .collect();
+        let phi: Vec<f64> = ws.rows.iter().map(|r| r.phi.abs()).collect();
+        // The largest violation of the rows in the solve: a row implied
+        // by them drifts with them, at most a few times as far.
+        let solved = (0..m)
+            .filter(|r| !self.dropped.contains(r))
+            .fold(0.0f64, |a, r| a.max(phi[r]));
+        let mut far = vec![false; m];
         for &r in &self.dropped {
-            if far[r] {
-                self.kept[r] = true;
+            if phi[r] >= 0.5 * self.bound[r] {
+                if phi[r] > IMPLIED_RATIO * solved {
+                    far[r] = true;
+                    self.kept[r] = true;
+                } else {
+                    self.bound[r] = 2.0 * phi[r].max(self.bound[r]);
+                }
             }
         }
         ws.q.clear();
@@ -183,6 +194,11 @@ impl RowWatch {
         crate::mbs::system::bump(&sys.counters.row_events);
     }
 }
+
+/// A dropped row whose violation is at most this many times the largest
+/// violation of the rows in the solve counts as implied by them at an
+/// event (module doc).
+pub const IMPLIED_RATIO: f64 = 10.0;
 
 /// The rows `rows` (ascending) at `(t, y + ε v)`.
 fn dual_rows(sys: &System, t: f64, y: &[f64], v: &[f64], rows: &[usize]) -> Vec<Dual64> {

@@ -107,7 +107,8 @@ pub struct SceneSpec {
     /// switches the guard off).
     #[serde(default = "default_divergence_limit")]
     pub divergence_limit: f64,
-    /// The bodies, `[[scene.bodies]]` (at least one).
+    /// The bodies, `[[scene.bodies]]` (may be empty: a scene in which
+    /// nothing moves is written without integrating).
     pub bodies: Vec<BodySpec>,
     /// The joints, `[[scene.joints]]` (default none).
     #[serde(default)]
