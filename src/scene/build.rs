@@ -93,7 +93,8 @@ impl SceneSpec {
         self.effects.contains(&e)
     }
 
-    /// A valid Baumgarte rate (the effects are checked by serde).
+    /// A valid Baumgarte rate and divergence limit (the effects are
+    /// checked by serde).
     fn check_settings(&self) -> Result<()> {
         if !(self.baumgarte >= 0.0 && self.baumgarte.is_finite()) {
             return Err(Error::input(
@@ -102,7 +103,8 @@ impl SceneSpec {
                 "a finite rate ≥ 0 (1/s)",
             ));
         }
-        if !(self.divergence_limit > 0.0) {
+        // NaN is refused too (it is not > 0).
+        if self.divergence_limit.is_nan() || self.divergence_limit <= 0.0 {
             return Err(Error::input(
                 "divergence_limit",
                 self.divergence_limit,
