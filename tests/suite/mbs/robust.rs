@@ -258,3 +258,22 @@ fn a_fast_turning_body_without_stiffening_warns_once() {
     assert!(t > 5.5 && t < 6.2, "{w}");
     assert!(kane_ws4(true).warnings.is_empty());
 }
+
+#[test]
+fn a_body_welded_to_ground_ends_at_once() {
+    // A body locked by a fixed joint has six coordinates and six
+    // independent rows: no degree of freedom. It is integrated (it is
+    // not `fixed`), and must end in a few steps with the body in place.
+    let sim = run("[scene]\neffects = [\"gravity\"]\n\
+         [[scene.bodies]]\nname = \"b\"\nmass = 1.0\ncom = [0.0, 0.0, 0.0]\n\
+         inertia = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\n\
+         [[scene.joints]]\nname = \"w\"\ntype = \"fixed\"\nbody_i = \"ground\"\nbody_j = \"b\"\n\
+         point = [0.0, 0.0, 0.0]\naxis = [0.0, 0.0, 1.0]\n\
+         [scene.integrator]\nt_end = 1.0\ndt_out = 0.5\n\
+         [scene.outputs]\nquantities = [\"b.position\"]\n");
+    assert_eq!(column(&sim, "t"), [0.0, 0.5, 1.0]);
+    assert!(sim.stats.steps < 20, "{:?}", sim.stats);
+    for z in column(&sim, "b.position_z") {
+        assert!(z.abs() < 1e-12, "{z}");
+    }
+}
