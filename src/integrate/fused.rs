@@ -100,8 +100,8 @@ pub(super) fn integrate_fused<M: OdeModel>(
             n * (1 + np),
         )
         .root(
-            |z: &[f64], _p: &[f64], _t: f64, g: &mut [f64]| {
-                model.roots(&ev.borrow(), &mut work.borrow_mut(), &z[..n], g)
+            |z: &[f64], _p: &[f64], t: f64, g: &mut [f64]| {
+                model.roots(&ev.borrow(), &mut work.borrow_mut(), t, &z[..n], g)
             },
             nroots,
         )

@@ -114,7 +114,7 @@ impl<M: OdeModel> Legs<'_, M> {
                         })?
                         .clone_as_vec(),
                 );
-                let crossing = self.model.classify(&self.events.borrow(), idx, &yr);
+                let crossing = self.model.classify(&self.events.borrow(), idx, tr, &yr);
                 if let Some(crossing) = crossing {
                     let s = if nsens > 0 {
                         solver
@@ -186,7 +186,9 @@ impl<M: OdeModel> Legs<'_, M> {
         Ok((stats, event))
     }
 
-    /// The end of a leg: count it; at an event, switch the piece (the
+    /// The end of a leg: count it; at an event, end the integration with
+    /// an error if the model halts there ([`OdeModel::halt`]: the outputs
+    /// up to the event are already served), else switch the piece (the
     /// sensitivities jump), refreeze the model's pieces, and return the
     /// event when a new leg must start from it.
     pub(super) fn end_leg(
@@ -197,6 +199,12 @@ impl<M: OdeModel> Legs<'_, M> {
     ) -> Result<Option<Event<M::Crossing>>> {
         stats.absorb(&leg.0);
         let Some(mut e) = leg.1 else { return Ok(None) };
+        if let Some((place, detail)) = self
+            .model
+            .halt(&self.events.borrow(), e.crossing, e.t, &e.y)
+        {
+            return Err(Error::numerical_at(place, e.t, detail));
+        }
         stats.events += 1;
         stats.last_event = Some(e.t);
         self.jump(&mut e)?;
@@ -216,7 +224,7 @@ impl<M: OdeModel> Legs<'_, M> {
         let (model, c) = (self.model, e.crossing);
         let mut ev = self.events.borrow_mut();
         if e.s.is_empty() {
-            model.switch(&mut ev, c, &e.y);
+            model.switch(&mut ev, c, e.t, &e.y);
             return Ok(());
         }
         let n = e.y.len();
@@ -224,10 +232,10 @@ impl<M: OdeModel> Legs<'_, M> {
         let (mut fm, mut fp) = (vec![0.0; n], vec![0.0; n]);
         model.freeze(&ev, &mut work);
         model.rhs(&mut work, e.t, &e.y, self.params, &mut fm);
-        model.switch(&mut ev, c, &e.y);
+        model.switch(&mut ev, c, e.t, &e.y);
         model.freeze(&ev, &mut work);
         model.rhs(&mut work, e.t, &e.y, self.params, &mut fp);
-        let den = model.crossing_dir(&ev, c, &e.y, &fm);
+        let den = model.crossing_dir(&ev, c, e.t, &e.y, &fm);
         if den.is_nan() || den.abs() <= 1e-12 {
             return Err(Error::numerical_at(
                 "integrate: segment event",
@@ -240,7 +248,7 @@ impl<M: OdeModel> Legs<'_, M> {
             ));
         }
         for lane in e.s.chunks_mut(n) {
-            let tau = -model.crossing_dir(&ev, c, &e.y, lane) / den;
+            let tau = -model.crossing_dir(&ev, c, e.t, &e.y, lane) / den;
             for k in 0..n {
                 lane[k] += (fm[k] - fp[k]) * tau;
             }

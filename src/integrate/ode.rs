@@ -76,16 +76,35 @@ pub trait OdeModel {
     /// Number of root functions (≥ 1: diffsol needs one; a constant
     /// function where there are none).
     fn nroots(&self, ev: &Self::Events) -> usize;
-    /// Root function values `g(y)` (sign change = a candidate crossing).
-    fn roots(&self, ev: &Self::Events, w: &mut Self::Work, y: &[f64], g: &mut [f64]);
-    /// `g_y v` of every root function.
-    fn roots_dir(&self, ev: &Self::Events, y: &[f64], v: &[f64], g: &mut [f64]);
-    /// Whether the sign change of root `idx` at `y` is a genuine crossing.
-    fn classify(&self, ev: &Self::Events, idx: usize, y: &[f64]) -> Option<Self::Crossing>;
-    /// Switch to the piece after crossing `c` at `y`.
-    fn switch(&self, ev: &mut Self::Events, c: Self::Crossing, y: &[f64]);
-    /// `g_y v` of the switching surface of crossing `c`.
-    fn crossing_dir(&self, ev: &Self::Events, c: Self::Crossing, y: &[f64], v: &[f64]) -> f64;
+    /// Root function values `g(t, y)` (sign change = a candidate crossing).
+    fn roots(&self, ev: &Self::Events, w: &mut Self::Work, t: f64, y: &[f64], g: &mut [f64]);
+    /// `g_y v` of every root function at `(t, y)`.
+    fn roots_dir(&self, ev: &Self::Events, t: f64, y: &[f64], v: &[f64], g: &mut [f64]);
+    /// Whether the sign change of root `idx` at `(t, y)` is a genuine crossing.
+    fn classify(&self, ev: &Self::Events, idx: usize, t: f64, y: &[f64]) -> Option<Self::Crossing>;
+    /// Why the integration must end at crossing `c` at `(t, y)` instead of
+    /// switching (a guard of the model, e.g. a divergence bound), as
+    /// `(place, detail)` of the numerical error; `None` (the default): go on.
+    fn halt(
+        &self,
+        _ev: &Self::Events,
+        _c: Self::Crossing,
+        _t: f64,
+        _y: &[f64],
+    ) -> Option<(String, String)> {
+        None
+    }
+    /// Switch to the piece after crossing `c` at `(t, y)`.
+    fn switch(&self, ev: &mut Self::Events, c: Self::Crossing, t: f64, y: &[f64]);
+    /// `g_y v` of the switching surface of crossing `c` at `(t, y)`.
+    fn crossing_dir(
+        &self,
+        ev: &Self::Events,
+        c: Self::Crossing,
+        t: f64,
+        y: &[f64],
+        v: &[f64],
+    ) -> f64;
     /// What switched, for messages (e.g. `actuator forces[3]`).
     fn crossing_label(&self, ev: &Self::Events, c: Self::Crossing) -> String;
 }

@@ -50,8 +50,8 @@ pub fn integrate<M: OdeModel>(
             n,
         )
         .root(
-            |x: &[f64], _p: &[f64], _t: f64, g: &mut [f64]| {
-                model.roots(&ev.borrow(), &mut work.borrow_mut(), x, g)
+            |x: &[f64], _p: &[f64], t: f64, g: &mut [f64]| {
+                model.roots(&ev.borrow(), &mut work.borrow_mut(), t, x, g)
             },
             nroots,
         )

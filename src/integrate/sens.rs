@@ -91,11 +91,11 @@ pub fn integrate_sens<M: OdeModel>(
             n,
         )
         .root_sens_implicit(
-            |x: &[f64], _p: &[f64], _t: f64, g: &mut [f64]| {
-                model.roots(&ev.borrow(), &mut work.borrow_mut(), x, g)
+            |x: &[f64], _p: &[f64], t: f64, g: &mut [f64]| {
+                model.roots(&ev.borrow(), &mut work.borrow_mut(), t, x, g)
             },
-            |x: &[f64], _p: &[f64], _t: f64, v: &[f64], g: &mut [f64]| {
-                model.roots_dir(&ev.borrow(), x, v, g)
+            |x: &[f64], _p: &[f64], t: f64, v: &[f64], g: &mut [f64]| {
+                model.roots_dir(&ev.borrow(), t, x, v, g)
             },
             // The switching surfaces do not depend on the parameters.
             |_x: &[f64], _p: &[f64], _t: f64, _v: &[f64], g: &mut [f64]| g.fill(0.0),

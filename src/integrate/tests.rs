@@ -44,19 +44,19 @@ impl OdeModel for Ramp {
     fn nroots(&self, _ev: &usize) -> usize {
         1
     }
-    fn roots(&self, ev: &usize, _w: &mut usize, y: &[f64], g: &mut [f64]) {
+    fn roots(&self, ev: &usize, _w: &mut usize, _t: f64, y: &[f64], g: &mut [f64]) {
         g[0] = if *ev == 0 { y[0] - 1.0 } else { -1.0 };
     }
-    fn roots_dir(&self, ev: &usize, _y: &[f64], v: &[f64], g: &mut [f64]) {
+    fn roots_dir(&self, ev: &usize, _t: f64, _y: &[f64], v: &[f64], g: &mut [f64]) {
         g[0] = if *ev == 0 { v[0] } else { 0.0 };
     }
-    fn classify(&self, ev: &usize, _idx: usize, y: &[f64]) -> Option<usize> {
+    fn classify(&self, ev: &usize, _idx: usize, _t: f64, y: &[f64]) -> Option<usize> {
         (*ev == 0 && (y[0] - 1.0).abs() < 1e-8).then_some(1)
     }
-    fn switch(&self, ev: &mut usize, c: usize, _y: &[f64]) {
+    fn switch(&self, ev: &mut usize, c: usize, _t: f64, _y: &[f64]) {
         *ev = c;
     }
-    fn crossing_dir(&self, _ev: &usize, _c: usize, _y: &[f64], v: &[f64]) -> f64 {
+    fn crossing_dir(&self, _ev: &usize, _c: usize, _t: f64, _y: &[f64], v: &[f64]) -> f64 {
         v[0]
     }
     fn crossing_label(&self, _ev: &usize, _c: usize) -> String {

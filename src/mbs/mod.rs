@@ -16,9 +16,11 @@
 //! ## Layers
 //! Top-down; every file imports only layers below it (methods of
 //! [`System`] are added by the layers above [`system`]):
-//! - [`ode`], [`segments`]: the system as an [`crate::integrate::OdeModel`]
-//!   (plain, directional and multi-lane right-hand sides) and the Eq. 32
-//!   segment changes as its events.
+//! - [`ode`], [`segments`], [`watch`]: the system as an
+//!   [`crate::integrate::OdeModel`] (plain, directional and multi-lane
+//!   right-hand sides) and its events: the Eq. 32 segment changes, the
+//!   dropped constraint rows chosen anew when one drifts, and the
+//!   divergence guard of the flexible bodies.
 //! - [`post`]: projection onto the constraints, loads, reactions, momenta,
 //!   deflections, energy sums, responses and their sensitivity lanes.
 //! - [`dynamics`]: the right-hand side `ẏ = f(t, y)` and the energy
@@ -102,6 +104,7 @@ pub mod ode;
 pub mod post;
 pub mod segments;
 pub mod system;
+pub mod watch;
 
 pub use math::DualN;
 pub use model::{

@@ -204,33 +204,42 @@ impl OdeModel for System {
         w.d1.ws.segments = segs.clone();
         w.d2.ws.segments = segs.clone();
         w.d4.ws.segments = segs;
+        let drop = ev.dropped();
+        w.ws.drop = drop.clone();
+        w.d1.ws.drop = drop.clone();
+        w.d2.ws.drop = drop.clone();
+        w.d4.ws.drop = drop;
     }
 
     fn nroots(&self, ev: &Events) -> usize {
         ev.nroots()
     }
 
-    fn roots(&self, ev: &Events, w: &mut SystemWork, y: &[f64], g: &mut [f64]) {
-        ev.roots(self, y, &mut w.kin, g)
+    fn roots(&self, ev: &Events, w: &mut SystemWork, t: f64, y: &[f64], g: &mut [f64]) {
+        ev.roots(self, (t, y), (&mut w.kin, &mut w.ws), g)
     }
 
-    fn roots_dir(&self, ev: &Events, y: &[f64], v: &[f64], g: &mut [f64]) {
-        ev.roots_jvp(self, y, v, g)
+    fn roots_dir(&self, ev: &Events, t: f64, y: &[f64], v: &[f64], g: &mut [f64]) {
+        ev.roots_jvp(self, t, y, v, g)
     }
 
-    fn classify(&self, ev: &Events, idx: usize, y: &[f64]) -> Option<Crossing> {
-        ev.classify(self, idx, y)
+    fn classify(&self, ev: &Events, idx: usize, t: f64, y: &[f64]) -> Option<Crossing> {
+        ev.classify(self, idx, t, y)
     }
 
-    fn switch(&self, ev: &mut Events, c: Crossing, y: &[f64]) {
-        ev.switch(self, c, y)
+    fn halt(&self, ev: &Events, c: Crossing, _t: f64, y: &[f64]) -> Option<(String, String)> {
+        ev.halt(self, c, y)
     }
 
-    fn crossing_dir(&self, ev: &Events, c: Crossing, y: &[f64], v: &[f64]) -> f64 {
-        ev.crossing_dir(self, c, y, v)
+    fn switch(&self, ev: &mut Events, c: Crossing, t: f64, y: &[f64]) {
+        ev.switch(self, c, t, y)
+    }
+
+    fn crossing_dir(&self, ev: &Events, c: Crossing, t: f64, y: &[f64], v: &[f64]) -> f64 {
+        ev.crossing_dir(self, c, t, y, v)
     }
 
     fn crossing_label(&self, ev: &Events, c: Crossing) -> String {
-        format!("actuator forces[{}]", ev.force_of(c))
+        ev.label(self, c)
     }
 }

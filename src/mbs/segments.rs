@@ -47,7 +47,8 @@
 //! evaluation of θ at `y + ε v`.
 
 use crate::mbs::model::{Force, PiecewiseLaw};
-use crate::mbs::system::{BodyKin, System};
+use crate::mbs::system::{BodyKin, System, Workspace};
+use crate::mbs::watch::{Guard, RowWatch};
 use num_dual::Dual64;
 
 /// One actuator law whose segment can change.
@@ -108,7 +109,10 @@ fn switch_of(force: usize, joint: usize, law: &PiecewiseLaw) -> Switch {
 }
 
 /// The event state of a system: the switching actuators and the interval
-/// each one is frozen in.
+/// each one is frozen in, the dropped constraint rows watched for drift
+/// and the divergence guard ([`crate::mbs::watch`]). Root functions are
+/// laid out in that order: two per switch (when segment events are
+/// enabled), one per dropped row, one per guarded body.
 #[derive(Debug, Clone)]
 pub struct Events {
     switches: Vec<Switch>,
@@ -123,15 +127,34 @@ pub struct Events {
     shift: Vec<[f64; 2]>,
     nforces: usize,
     /// Whether segment changes are events (otherwise the laws are
-    /// evaluated by value and no root function is active).
+    /// evaluated by value and no root function of a segment is active).
     pub enabled: bool,
+    /// The dropped constraint rows, watched for drift.
+    rows: RowWatch,
+    /// The divergence guard of the flexible bodies.
+    guard: Guard,
 }
 
-/// An accepted segment change.
+/// An accepted event.
 #[derive(Debug, Clone, Copy)]
-pub struct Crossing {
-    switch: usize,
-    to: usize,
+pub enum Crossing {
+    /// Switch `switch` enters interval `to` (a segment change).
+    Segment {
+        /// The switch (index into the switching actuators).
+        switch: usize,
+        /// Its new interval.
+        to: usize,
+    },
+    /// Dropped constraint row `row` reached its bound: rows chosen anew.
+    Row {
+        /// The row (index into the model's constraint rows).
+        row: usize,
+    },
+    /// Guarded body `k` passed the divergence bound: the run ends.
+    Diverged {
+        /// Index of the body among the guarded ones.
+        k: usize,
+    },
 }
 
 impl Events {
@@ -159,6 +182,23 @@ impl Events {
             shift,
             nforces: sys.model.forces.len(),
             enabled,
+            rows: RowWatch::new(sys),
+            guard: Guard::new(sys),
+        }
+    }
+
+    /// The constraint rows left out of the solve now, for
+    /// [`Workspace::drop`] (`None`: the system's set).
+    pub fn dropped(&self) -> Option<Vec<bool>> {
+        self.rows.mask()
+    }
+
+    /// Number of segment root functions.
+    fn nseg(&self) -> usize {
+        if self.active() {
+            2 * self.switches.len()
+        } else {
+            0
         }
     }
 
@@ -167,14 +207,11 @@ impl Events {
         self.enabled && !self.switches.is_empty()
     }
 
-    /// Number of root functions handed to diffsol (two per switch; one
-    /// constant function when there are none, as diffsol needs ≥ 1).
+    /// Number of root functions handed to diffsol (two per switch, one
+    /// per dropped row, one per guarded body; one constant function when
+    /// there are none, as diffsol needs ≥ 1).
     pub fn nroots(&self) -> usize {
-        if self.active() {
-            2 * self.switches.len()
-        } else {
-            1
-        }
+        (self.nseg() + self.rows.nroots() + self.guard.nroots()).max(1)
     }
 
     /// Freeze every switch in the interval of its current θ at `y`.
@@ -225,12 +262,28 @@ impl Events {
         out
     }
 
-    /// Root functions at `y`: `θ_k − b_{i−1}` (> 0 inside) and `θ_k − b_i`
-    /// (≤ 0 inside) for switch `k` in interval `i`; a constant ±1 where
-    /// the interval is unbounded. `kin` is scratch.
-    pub fn roots(&self, sys: &System, y: &[f64], kin: &mut Vec<BodyKin<f64>>, g: &mut [f64]) {
+    /// Root functions at `(t, y)`: the segments' (below), then the
+    /// dropped rows' and the guard's ([`crate::mbs::watch`]); a constant 1
+    /// when there are none. `kin` and `ws` are scratch.
+    pub fn roots(
+        &self,
+        sys: &System,
+        (t, y): (f64, &[f64]),
+        (kin, ws): (&mut Vec<BodyKin<f64>>, &mut Workspace<f64>),
+        g: &mut [f64],
+    ) {
+        g.fill(1.0);
+        let (ns, nr) = (self.nseg(), self.rows.nroots());
+        self.rows.roots(sys, t, y, ws, &mut g[ns..ns + nr]);
+        self.guard.roots(y, &mut g[ns + nr..]);
+        self.segment_roots(sys, y, kin, g);
+    }
+
+    /// Segment root functions at `y`: `θ_k − b_{i−1}` (> 0 inside) and
+    /// `θ_k − b_i` (≤ 0 inside) for switch `k` in interval `i`; a constant
+    /// ±1 where the interval is unbounded.
+    fn segment_roots(&self, sys: &System, y: &[f64], kin: &mut Vec<BodyKin<f64>>, g: &mut [f64]) {
         if !self.active() {
-            g.fill(1.0);
             return;
         }
         sys.body_kin(y, &[], kin);
@@ -249,10 +302,14 @@ impl Events {
         }
     }
 
-    /// `g_y v` of every root function (exact, one dual evaluation of the
-    /// joint angles at `y + ε v`).
-    pub fn roots_jvp(&self, sys: &System, y: &[f64], v: &[f64], out: &mut [f64]) {
+    /// `g_y v` of every root function at `(t, y)` (exact, one dual
+    /// evaluation of the joint angles, and of the dropped rows, at
+    /// `y + ε v`).
+    pub fn roots_jvp(&self, sys: &System, t: f64, y: &[f64], v: &[f64], out: &mut [f64]) {
         out.fill(0.0);
+        let (ns, nr) = (self.nseg(), self.rows.nroots());
+        self.rows.roots_dir(sys, t, y, v, &mut out[ns..ns + nr]);
+        self.guard.roots_dir(y, v, &mut out[ns + nr..]);
         if !self.active() {
             return;
         }
@@ -274,7 +331,24 @@ impl Events {
     /// exit from the current segment: θ within `1e-8 (1 + |b|)` rad of the
     /// breakpoint (not a 2π wrap of the angle) and θ̇ pointing out of the
     /// interval (not the re-crossing of the breakpoint just passed).
-    pub fn classify(&self, sys: &System, idx: usize, y: &[f64]) -> Option<Crossing> {
+    ///
+    /// A dropped row's root is genuine when its violation has reached the
+    /// bound, a guarded body's when its deflection bound has passed the
+    /// limit.
+    pub fn classify(&self, sys: &System, idx: usize, t: f64, y: &[f64]) -> Option<Crossing> {
+        let (ns, nr) = (self.nseg(), self.rows.nroots());
+        if idx >= ns + nr {
+            let k = idx - ns - nr;
+            return (k < self.guard.nroots() && self.guard.passed(k, y))
+                .then_some(Crossing::Diverged { k });
+        }
+        if idx >= ns {
+            let row = self.rows.row(idx - ns);
+            return self
+                .rows
+                .reached(sys, row, t, y)
+                .then_some(Crossing::Row { row });
+        }
         if !self.active() || idx >= 2 * self.switches.len() {
             return None;
         }
@@ -293,11 +367,11 @@ impl Events {
             return None;
         }
         match (upper, thd) {
-            (true, d) if d > 0.0 => Some(Crossing {
+            (true, d) if d > 0.0 => Some(Crossing::Segment {
                 switch: k,
                 to: i + 1,
             }),
-            (false, d) if d < 0.0 => Some(Crossing {
+            (false, d) if d < 0.0 => Some(Crossing::Segment {
                 switch: k,
                 to: i - 1,
             }),
@@ -305,26 +379,64 @@ impl Events {
         }
     }
 
-    /// Switch to the segment after crossing `c` at the state `y`.
-    pub fn switch(&mut self, sys: &System, c: Crossing, y: &[f64]) {
-        let mut kin = Vec::new();
-        sys.body_kin(y, &[], &mut kin);
-        self.mode[c.switch] = c.to;
-        self.set_shift(sys, c.switch, &kin);
+    /// Switch to the segment after crossing `c` at `(t, y)`, or choose
+    /// the dropped rows anew; a divergence changes nothing (the run ends,
+    /// [`Events::halt`]).
+    pub fn switch(&mut self, sys: &System, c: Crossing, t: f64, y: &[f64]) {
+        match c {
+            Crossing::Segment { switch, to } => {
+                let mut kin = Vec::new();
+                sys.body_kin(y, &[], &mut kin);
+                self.mode[switch] = to;
+                self.set_shift(sys, switch, &kin);
+            }
+            Crossing::Row { .. } => self.rows.rechoose(sys, t, y),
+            Crossing::Diverged { .. } => {}
+        }
     }
 
-    /// `g_y v` of the root function of crossing `c` (θ of its joint at
-    /// `y + ε v`).
-    pub fn crossing_dir(&self, sys: &System, c: Crossing, y: &[f64], v: &[f64]) -> f64 {
-        let yd: Vec<Dual64> = y.iter().zip(v).map(|(&a, &b)| Dual64::new(a, b)).collect();
-        let mut kin = Vec::new();
-        sys.body_kin(&yd, &[], &mut kin);
-        sys.joint_angle(&kin, self.switches[c.switch].joint).0.eps
+    /// `(place, message)` of the error that ends the run at crossing `c`
+    /// at `y`: a guarded body passed the divergence bound.
+    pub fn halt(&self, sys: &System, c: Crossing, y: &[f64]) -> Option<(String, String)> {
+        match c {
+            Crossing::Diverged { k } => Some((
+                "simulate: divergence guard".to_string(),
+                self.guard.message(sys, k, y),
+            )),
+            _ => None,
+        }
     }
 
-    /// The force index of crossing `c`'s actuator (for messages).
-    pub fn force_of(&self, c: Crossing) -> usize {
-        self.switches[c.switch].force
+    /// `g_y v` of the root function of crossing `c` at `(t, y)` (θ of its
+    /// joint, or the row, at `y + ε v`).
+    pub fn crossing_dir(&self, sys: &System, c: Crossing, t: f64, y: &[f64], v: &[f64]) -> f64 {
+        match c {
+            Crossing::Segment { switch, .. } => {
+                let yd: Vec<Dual64> = y.iter().zip(v).map(|(&a, &b)| Dual64::new(a, b)).collect();
+                let mut kin = Vec::new();
+                sys.body_kin(&yd, &[], &mut kin);
+                sys.joint_angle(&kin, self.switches[switch].joint).0.eps
+            }
+            Crossing::Row { row } => self.rows.crossing_dir(sys, row, t, y, v),
+            Crossing::Diverged { .. } => 0.0,
+        }
+    }
+
+    /// What crossing `c` is, for messages: `actuator forces[3]` (its
+    /// actuator's force index), `redundant row pin.x`, `divergence guard`.
+    pub fn label(&self, sys: &System, c: Crossing) -> String {
+        match c {
+            Crossing::Segment { switch, .. } => {
+                format!("actuator forces[{}]", self.switches[switch].force)
+            }
+            Crossing::Row { row } => format!(
+                "redundant row {}",
+                sys.model
+                    .row_label(row)
+                    .unwrap_or_else(|| format!("row {row}"))
+            ),
+            Crossing::Diverged { .. } => "divergence guard".into(),
+        }
     }
 }
 

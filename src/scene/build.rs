@@ -58,6 +58,7 @@ impl SceneSpec {
         let mut model = Model {
             baumgarte: self.baumgarte,
             quadratic_velocity: self.has(Effect::QuadraticVelocity),
+            divergence_limit: Some(self.divergence_limit),
             geometric_stiffening: self.has(Effect::GeometricStiffening),
             ..Model::default()
         };
@@ -92,13 +93,22 @@ impl SceneSpec {
         self.effects.contains(&e)
     }
 
-    /// A valid Baumgarte rate (the effects are checked by serde).
+    /// A valid Baumgarte rate and divergence limit (the effects are
+    /// checked by serde).
     fn check_settings(&self) -> Result<()> {
         if !(self.baumgarte >= 0.0 && self.baumgarte.is_finite()) {
             return Err(Error::input(
                 "baumgarte",
                 self.baumgarte,
                 "a finite rate ≥ 0 (1/s)",
+            ));
+        }
+        // NaN is refused too (it is not > 0).
+        if self.divergence_limit.is_nan() || self.divergence_limit <= 0.0 {
+            return Err(Error::input(
+                "divergence_limit",
+                self.divergence_limit,
+                "a factor > 0 of the body size (inf: no divergence guard)",
             ));
         }
         Ok(())

@@ -101,7 +101,14 @@ pub struct SceneSpec {
     /// default 10).
     #[serde(default = "default_baumgarte")]
     pub baumgarte: f64,
-    /// The bodies, `[[scene.bodies]]` (at least one).
+    /// Divergence guard: a run ends (with its outputs so far) when a
+    /// flexible body's modal deflection bound exceeds this factor times
+    /// the body's size (`crate::mbs::watch`; > 0, default 0.2, `inf`
+    /// switches the guard off).
+    #[serde(default = "default_divergence_limit")]
+    pub divergence_limit: f64,
+    /// The bodies, `[[scene.bodies]]` (may be empty: a scene in which
+    /// nothing moves is written without integrating).
     pub bodies: Vec<BodySpec>,
     /// The joints, `[[scene.joints]]` (default none).
     #[serde(default)]
@@ -165,6 +172,10 @@ fn default_gravity() -> [f64; 3] {
 /// the mechanisms' dynamics of interest yet far from making them stiff.
 fn default_baumgarte() -> f64 {
     10.0
+}
+
+fn default_divergence_limit() -> f64 {
+    0.2
 }
 
 /// One `[[scene.bodies]]` entry: a rigid body, or a flexible one with a

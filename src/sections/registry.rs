@@ -223,10 +223,24 @@ pub fn run_scene(cfg: &RunConfig) -> Result<()> {
     use crate::simulate;
     let t0 = std::time::Instant::now();
     let scene = crate::scene::load_scene(&cfg.study)?;
-    let (_, sim) = simulate::simulate(&scene).map_err(cfg.study.locate("scene"))?;
+    // A numerical failure keeps the rows computed before it: they are
+    // written, the failure goes into stats.csv and the manifest, and the
+    // run then ends with the failure (exit code 3).
+    let (_, mut sim) = simulate::simulate_partial(&scene).map_err(cfg.study.locate("scene"))?;
+    for w in &sim.warnings {
+        eprintln!("{w}");
+    }
     let dir = cfg.study.output_dir(&cfg.out)?;
     let files = simulate::write_results(&scene, &sim, &dir)?;
     let mut entry = serde_json::Map::new();
+    if let Some(e) = &sim.failure {
+        entry.insert("status".into(), "failed".into());
+        entry.insert("failure".into(), e.to_string().into());
+        entry.insert("rows_written".into(), sim.rows.len().into());
+    }
+    if !sim.warnings.is_empty() {
+        entry.insert("warnings".into(), sim.warnings.clone().into());
+    }
     entry.insert("wall_seconds".into(), t0.elapsed().as_secs_f64().into());
     // The integration's own wall-clock times live here, not in stats.csv
     // (which holds only reproducible numbers; see simulate::write_results).
@@ -241,6 +255,14 @@ pub fn run_scene(cfg: &RunConfig) -> Result<()> {
             .into(),
     );
     crate::report::record_command(&dir, &cfg.study, 1, "simulate", entry, None)?;
+    if let Some(e) = sim.failure.take() {
+        if !cfg.quiet {
+            for f in &files {
+                println!("wrote {} (up to the failure)", f.display());
+            }
+        }
+        return Err(e);
+    }
     let (rigid_lines, warnings) = simulate::rigid_summary(&scene);
     for w in &warnings {
         eprintln!("{w}");

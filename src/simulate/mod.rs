@@ -1,6 +1,14 @@
 //! `plyscape simulate`: make a built scene's initial state consistent,
 //! integrate, and write `history.csv` (time + outputs, SI units in the
 //! header), `stats.csv` and an SVG of one output.
+//!
+//! A numerical failure during the integration (a step size underflow, a
+//! non-finite output, the divergence guard of `crate::mbs::watch`)
+//! keeps the rows computed before it: [`simulate_partial`] returns them
+//! with the failure in [`Simulation::failure`], [`write_results`] writes
+//! them with the failure in `stats.csv`. A scene in which nothing moves
+//! (no body, or every body fixed) is not integrated: its constant state
+//! is written at the output times.
 
 use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Stats};
@@ -14,6 +22,8 @@ use crate::scene::quantity::QuantityKind;
 use crate::scene::{Quantity, Scene};
 use num_dual::Dual64;
 use std::path::{Path, PathBuf};
+
+pub mod spin;
 
 /// Everything a simulation produced.
 #[derive(Debug)]
@@ -49,16 +59,46 @@ pub struct Simulation {
     pub sens_headers: Vec<String>,
     /// One row per output time: `[t, ∂outputs/∂p_1.., ∂outputs/∂p_2..]`.
     pub sens_rows: Vec<Vec<f64>>,
-    /// The scene's response functionals with their sensitivities.
+    /// The scene's response functionals with their sensitivities (none
+    /// after a failure).
     pub responses: Vec<ResponseValue>,
+    /// Redundancy events: times the dropped constraint rows were chosen
+    /// anew because one of them drifted ([`crate::mbs::watch`]).
+    pub row_events: u64,
+    /// The numerical failure that ended the integration early
+    /// ([`simulate_partial`]); the rows are those computed before it.
+    pub failure: Option<Error>,
+    /// Warnings raised during the run: a flexible body turning fast
+    /// without geometric stiffening ([`spin`]).
+    pub warnings: Vec<String>,
 }
 
-/// Simulate a built scene (no files written).
+/// The bound on the violation of a dropped constraint row, in units of
+/// the integrator's absolute tolerance ([`crate::mbs::watch`]).
+pub const ROW_BOUND_ATOL: f64 = 10.0;
+
+/// Simulate a built scene (no files written); a numerical failure during
+/// the integration is an error (the rows so far are dropped; see
+/// [`simulate_partial`] to keep them).
 pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
+    let (sys, mut sim) = simulate_partial(scene)?;
+    match sim.failure.take() {
+        Some(e) => Err(e),
+        None => Ok((sys, sim)),
+    }
+}
+
+/// Simulate a built scene (no files written), keeping the output rows
+/// (and sensitivity rows) computed before a numerical failure of the
+/// integration: the failure is [`Simulation::failure`] and the responses
+/// are empty. Errors before the integration (an inconsistent initial
+/// state) are returned as errors.
+pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
     let mut sys = System::new(scene.model.clone());
     let mut y0 = sys.initial_state();
     let projection = sys.project(scene.options.t0, &mut y0)?;
     sys.drop_rows(&projection.dependent);
+    sys.watch_rows(ROW_BOUND_ATOL * scene.options.atol);
     let mut headers = vec!["t [s]".to_string()];
     for (label, q) in &scene.outputs {
         headers.extend(q.headers(label));
@@ -83,7 +123,9 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
     // sensitivities (for integral responses).
     let mut peaks: Vec<Vec<(f64, f64, Vec<f64>)>> = vec![Vec::new(); scene.responses.len()];
     let mut s_end = vec![0.0; n * scene.params.len()];
+    let mut spin = spin::SpinWatch::new(&sys);
     let mut observe = |t: f64, y: &[f64], s: &[f64]| {
+        spin.observe(&sys, t, y);
         let lanes: Vec<(&[f64], Param)> = if s.is_empty() {
             Vec::new()
         } else {
@@ -138,13 +180,32 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         y_end.copy_from_slice(y);
         Ok(())
     };
-    let stats = if scene.params.is_empty() {
-        integrate(&sys, &y0, &scene.options, |t, y| observe(t, y, &[]))?
+    let run = if sys.nb() == 0 {
+        // Nothing moves: the state (integrals of zero energies included)
+        // is constant; an integrator would not start on it.
+        scene.options.validate().and_then(|_| {
+            let s0 = vec![0.0; n * scene.params.len()];
+            for &t in &scene.options.times {
+                observe(t, &y0, &s0)?;
+            }
+            Ok(Stats::default())
+        })
+    } else if scene.params.is_empty() {
+        integrate(&sys, &y0, &scene.options, |t, y| observe(t, y, &[]))
     } else {
         let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
-        integrate_sens(&sys, &y0, &scene.options, &params, &mut observe)?
+        integrate_sens(&sys, &y0, &scene.options, &params, &mut observe)
     };
-    let responses = collect_responses(scene, &sys, &peaks, &y_end, &s_end)?;
+    let (stats, failure) = match run {
+        Ok(stats) => (stats, None),
+        Err(e @ Error::Numerical { .. }) => (Stats::default(), Some(e)),
+        Err(e) => return Err(e),
+    };
+    let responses = if failure.is_none() {
+        collect_responses(scene, &sys, &peaks, &y_end, &s_end)?
+    } else {
+        Vec::new()
+    };
     let sim = Simulation {
         headers,
         rows,
@@ -163,6 +224,9 @@ pub fn simulate(scene: &Scene) -> Result<(System, Simulation)> {
         sens_headers,
         sens_rows,
         responses,
+        row_events: sys.counters.row_events.get(),
+        failure,
+        warnings: spin.warnings,
     };
     Ok((sys, sim))
 }
@@ -439,7 +503,10 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
         ("nonlinear_iterations", s.nonlinear_iterations.to_string()),
         ("nonlinear_failures", s.nonlinear_failures.to_string()),
         ("events", scene.options.events.to_string()),
-        ("segment_events", s.events.to_string()),
+        (
+            "segment_events",
+            (s.events as u64).saturating_sub(sim.row_events).to_string(),
+        ),
         ("restarts", s.restarts.to_string()),
         ("equations", sim.equations.to_string()),
         ("redundant_equations", sim.redundant.to_string()),
@@ -460,10 +527,19 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
                 .map_or("n/a".into(), |e| format!("{e:.3e}")),
         ),
     ];
-    let rows: Vec<Vec<String>> = records
+    let failed = sim.failure.is_some();
+    let mut rows: Vec<Vec<String>> = records
         .into_iter()
-        .map(|(k, v)| vec![k.to_string(), v, stat_unit(k).to_string()])
+        .map(|(k, v)| {
+            let v = if failed && INTEGRATOR_COUNTERS.contains(&k) {
+                "n/a".into()
+            } else {
+                v
+            };
+            vec![k.to_string(), v, stat_unit(k).to_string()]
+        })
         .collect();
+    rows.extend(event_and_failure_rows(sim));
     write_table(&stats_path, &["quantity", "value", "unit"], &rows)?;
     let mut written = vec![hist, stats_path];
     if !sim.sens_rows.is_empty() {
@@ -513,6 +589,51 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
     }
     Ok(written)
 }
+
+/// The rows of `stats.csv` that only some runs have: `redundancy_events`
+/// (when the dropped rows were chosen anew) and, after a failure,
+/// `status` = `failed` with `failure_time`, `failure_place` and
+/// `failure_message`; the integrator's counters are then not known (the
+/// failed integration returns none) and read `n/a`.
+fn event_and_failure_rows(sim: &Simulation) -> Vec<Vec<String>> {
+    let mut out = Vec::new();
+    if sim.row_events > 0 {
+        out.push(vec![
+            "redundancy_events".into(),
+            sim.row_events.to_string(),
+            "-".into(),
+        ]);
+    }
+    if let Some(Error::Numerical {
+        place,
+        time,
+        detail,
+    }) = &sim.failure
+    {
+        out.push(vec!["status".into(), "failed".into(), "-".into()]);
+        out.push(vec![
+            "failure_time".into(),
+            time.map_or("n/a".into(), |t| format!("{t:.6e}")),
+            "s".into(),
+        ]);
+        out.push(vec!["failure_place".into(), place.clone(), "-".into()]);
+        out.push(vec!["failure_message".into(), detail.clone(), "-".into()]);
+    }
+    out
+}
+
+/// The integrator's counters in `stats.csv` (`n/a` after a failure).
+const INTEGRATOR_COUNTERS: [&str; 9] = [
+    "steps",
+    "rhs_calls",
+    "jvp_calls",
+    "jacobians",
+    "error_test_failures",
+    "nonlinear_iterations",
+    "nonlinear_failures",
+    "segment_events",
+    "restarts",
+];
 
 /// The unit of a `stats.csv` quantity (`-`: a count, a name or a ratio).
 fn stat_unit(quantity: &str) -> &'static str {
@@ -632,11 +753,17 @@ pub fn summary(sim: &Simulation) -> String {
         s.jvp_calls,
         s.jacobians,
         s.error_test_failures,
-        s.events,
+        (s.events as u64).saturating_sub(sim.row_events),
         s.restarts,
         s.wall * 1e3,
         s.observer_wall * 1e3
     );
+    if sim.row_events > 0 {
+        text += &format!(
+            "\nredundancy events: {} (dropped constraint rows chosen anew)",
+            sim.row_events
+        );
+    }
     for r in &sim.responses {
         text += &format!(
             "\nresponse {} ({}): {:.6e}{}",

@@ -6,7 +6,7 @@
 
 use super::rows::joint_rows;
 use crate::mbs::math::{cst, mtv, Scalar};
-use crate::mbs::system::{System, Workspace};
+use crate::mbs::system::{Row, System, Workspace};
 use nalgebra::Vector3;
 
 impl System {
@@ -62,5 +62,35 @@ impl System {
             row.gamma -= cst::<T>(2.0) * a * phidot + a * a * row.phi;
         }
         ws.rows = rows;
+    }
+
+    /// The values `Φ` of the constraint rows `rows` (ascending indices)
+    /// at time `t` into `out` (`out[k]` of `rows[k]`), from the marker
+    /// kinematics in `ws.mk` (after [`System::kinematics`]): only the
+    /// joints holding those rows are evaluated, without the assembly.
+    pub fn row_values<T: Scalar>(
+        &self,
+        t: f64,
+        ws: &Workspace<T>,
+        rows: &[usize],
+        out: &mut Vec<T>,
+    ) {
+        out.clear();
+        let mut scratch: Vec<Row<T>> = Vec::new();
+        let mut first = 0;
+        let mut next = rows.iter().peekable();
+        for joint in &self.model.joints {
+            let n = joint.kind.equations();
+            if next.peek().is_some_and(|&&r| r < first + n) {
+                scratch.clear();
+                let markers = (&ws.mk[joint.i], &ws.mk[joint.j]);
+                joint_rows(&joint.kind, markers, t, &mut scratch);
+                while let Some(&&r) = next.peek().filter(|&&&r| r < first + n) {
+                    out.push(scratch[r - first].phi);
+                    next.next();
+                }
+            }
+            first += n;
+        }
     }
 }

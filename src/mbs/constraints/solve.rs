@@ -174,8 +174,15 @@ impl System {
                 }
             }
         }
+        sol.dropped.clear();
+        match &ws.drop {
+            Some(d) => sol
+                .dropped
+                .extend((0..m).map(|r| d.get(r).copied().unwrap_or(false))),
+            None => sol.dropped.extend((0..m).map(|r| self.dropped(r))),
+        }
         let mut ndrop = 0;
-        for (r, _) in self.drop.iter().enumerate().take(m).filter(|(_, d)| **d) {
+        for (r, _) in sol.dropped.iter().enumerate().filter(|(_, d)| **d) {
             ndrop += 1;
             let p = inv[r];
             for c in 0..p {
@@ -324,7 +331,7 @@ impl System {
                 sol.dacc[l * nv + o..l * nv + o + d].copy_from_slice(&sol.u);
             }
             for r in 0..m {
-                if self.dropped(r) {
+                if sol.dropped[r] {
                     rhs[r] = 0.0;
                 } else {
                     rhs[r] -= RANK_REG * dd[r] * sol.lam[r];

@@ -37,6 +37,10 @@ pub struct Model {
     /// Groups of `(body, design variable)` that [`Param::Tied`](crate::mbs::Param::Tied) lanes move
     /// together.
     pub ties: Vec<Vec<(usize, usize)>>,
+    /// Divergence guard: an integration ends when a flexible body's
+    /// modal deflection bound exceeds this factor times the body's size
+    /// (`crate::mbs::watch`); `None` (or infinite): no guard.
+    pub divergence_limit: Option<f64>,
 }
 
 /// `∫ scale · Σ terms dt` over energy terms (strain and kinetic energies

@@ -24,6 +24,10 @@ pub(crate) fn bump(c: &Cell<u64>) {
 /// Evaluation counters (what is not built is never evaluated).
 #[derive(Debug, Default)]
 pub struct Counters {
+    /// Redundancy events: constraint rows chosen anew during an
+    /// integration because a dropped row's violation reached its bound
+    /// ([`crate::mbs::watch`]).
+    pub row_events: Cell<u64>,
     /// Right-hand-side evaluations ([`System::rhs`](crate::mbs::System::rhs)).
     pub rhs: Cell<u64>,
     /// Gravity force evaluations.
@@ -60,6 +64,10 @@ pub struct System {
     /// Constraint rows left out of the solve (their multipliers are zero):
     /// equations found redundant at the projected initial state.
     pub(crate) drop: Vec<bool>,
+    /// Bound on the violation of a dropped row before the rows are chosen
+    /// anew during an integration ([`crate::mbs::watch`], m or rad);
+    /// `None`: dropped rows are not watched.
+    pub row_bound: Option<f64>,
     /// Evaluation counters, bumped through `&self`.
     pub counters: Counters,
 }
@@ -96,6 +104,7 @@ impl System {
             npos,
             nvel,
             drop: Vec::new(),
+            row_bound: None,
             counters: Counters::default(),
         }
     }
@@ -115,6 +124,18 @@ impl System {
             }
             self.drop[r] = true;
         }
+    }
+
+    /// Watch the dropped rows during integrations: when one's violation
+    /// reaches `bound` (m or rad), the rows are chosen anew
+    /// ([`crate::mbs::watch`]).
+    pub fn watch_rows(&mut self, bound: f64) {
+        self.row_bound = Some(bound);
+    }
+
+    /// Number of constraint equations (rows) of the model's joints.
+    pub fn equations(&self) -> usize {
+        self.model.joints.iter().map(|j| j.kind.equations()).sum()
     }
 
     /// Whether constraint row `r` is left out of the solve.

@@ -133,6 +133,10 @@ pub struct Workspace<T: Scalar> {
     /// right-hand side is smooth. Empty (or an out-of-range entry): the
     /// segment is picked by the value of θ.
     pub segments: Vec<usize>,
+    /// The constraint rows left out of the solve while the integrator has
+    /// chosen them anew ([`crate::mbs::watch`]): `drop[r]` for row `r`.
+    /// `None`: the system's set ([`System::dropped`](crate::mbs::System::dropped)).
+    pub drop: Option<Vec<bool>>,
     /// Per marker: whether its node rotation is computed
     /// ([`System::node_rotations`](crate::mbs::System::node_rotations)).
     pub(crate) rotations: Vec<bool>,
@@ -177,6 +181,9 @@ pub struct SolveScratch {
     pub(crate) dd: Vec<f64>,
     pub(crate) lane_lam: Vec<f64>,
     pub(crate) mp: Vec<f64>,
+    /// Per row: whether it is left out of the solve (the workspace's set
+    /// or the system's), for the tangent.
+    pub(crate) dropped: Vec<bool>,
 }
 
 /// Translational and rotational mode-shape rows of a node (n columns each).
@@ -269,6 +276,7 @@ impl<T: Scalar> Workspace<T> {
             rank: 0,
             params: Vec::new(),
             segments: Vec::new(),
+            drop: None,
             rotations: Vec::new(),
         }
     }

@@ -11,6 +11,7 @@ mod kernel;
 mod loads;
 mod mechanisms;
 mod prismatic;
+mod robust;
 mod sar;
 mod sar_clamp;
 mod sar_flex;
