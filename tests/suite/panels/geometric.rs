@@ -90,6 +90,7 @@ fn a_spinning_clamped_strip_stiffens_like_a_beam() {
     let s_beam = hub.geometric.as_ref().unwrap().get(WZ2, 0, 0);
     for j in 0..2 {
         let s = g.get(WZ2, j, j);
+        println!("mode {j}: panel S = {s}, beam S = {s_beam} (on axis {s0})");
         assert!(
             (s - s_beam).abs() < 0.03 * s_beam,
             "mode {j}: panel S = {s}, beam S = {s_beam}"
