@@ -309,6 +309,52 @@ impl Triangle {
         }
     }
 
+    /// Membrane resultants `N = A ε + B κ` = (N_xx, N_yy, N_xy) \[N/m\]
+    /// of the element displacement `q` (element DOF order) with the
+    /// laminate's `a`, `b` (constant over the element: CST membrane,
+    /// constant curvature).
+    pub fn membrane_resultants(
+        &self,
+        g: &CompactOps,
+        a: &nalgebra::Matrix3<f64>,
+        b: &nalgebra::Matrix3<f64>,
+        q: &Vec18,
+    ) -> [f64; 3] {
+        let um = SVector::<f64, 6>::from_fn(|j, _| q[MEMBRANE_DOF[j]]);
+        let ub = SVector::<f64, 6>::from_fn(|j, _| q[BENDING_DOF[j]]);
+        let n = a * (g.gm * um) + b * (g.gb * ub);
+        [n[0], n[1], n[2]]
+    }
+
+    /// Slope `(w,x, w,y)` of the linear deflection with node values `w`.
+    pub fn slope(&self, w: [f64; 3]) -> [f64; 2] {
+        let mut s = [0.0; 2];
+        for (g, wi) in self.grad.iter().zip(w) {
+            s[0] += g[0] * wi;
+            s[1] += g[1] * wi;
+        }
+        s
+    }
+
+    /// Geometric (initial-stress) stiffness of the membrane prestress
+    /// `n` = (N_xx, N_yy, N_xy) \[N/m\]: `K_G = ∫ [w,x w,y]ᵀ N [w,x w,y] dA`
+    /// with `N = [[N_xx, N_xy], [N_xy, N_yy]]`, on the w DOFs only (the
+    /// von Kármán plate term; the in-plane terms `u,α N u,β` are left
+    /// out, as for the axial term of a beam). Exact for the linear `w`:
+    /// `K_G,ij = A ∇N_iᵀ N ∇N_j`.
+    pub fn geometric_stiffness(&self, n: [f64; 3]) -> Mat18 {
+        let mut k = Mat18::zeros();
+        for i in 0..3 {
+            let [ax, ay] = self.grad[i];
+            let (nx, ny) = (n[0] * ax + n[2] * ay, n[2] * ax + n[1] * ay);
+            for j in 0..3 {
+                let [bx, by] = self.grad[j];
+                k[(6 * i + 2, 6 * j + 2)] = self.area * (nx * bx + ny * by);
+            }
+        }
+        k
+    }
+
     /// HRZ lumped mass (module doc): `mass_area` = Σρt \[kg/m²\],
     /// `rotary_area` = Σρ∫z² \[kg\]. Diagonal, element DOF order.
     pub fn lumped_mass(&self, mass_area: f64, rotary_area: f64) -> [f64; 18] {

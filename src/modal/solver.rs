@@ -129,6 +129,88 @@ impl ModalSolver {
         })
     }
 
+    /// Static solve `K U = B` in place for the `n × r` block `rhs` with the
+    /// current stiffness (loads in, displacements out).
+    ///
+    /// `rigid` empty: `K` must be positive definite (a supported
+    /// structure); one `LLᵀ` of `K`. Otherwise `rigid` holds the
+    /// M-orthonormal rigid-body modes `R` of a free structure and the
+    /// solve is by *inertia relief*: the loads are first made
+    /// self-equilibrated, `B ← (I − M R Rᵀ) B` (the rigid-body
+    /// acceleration they would cause is taken off), and `U` is the
+    /// solution M-orthogonal to `R`, found by the fixed point
+    /// `(K − σM) U_{m+1} = B + σ M U_m` (σ = `shift` < 0, `K − σM`
+    /// positive definite), each iterate projected by `I − R RᵀM`. On the
+    /// elastic modes the error contracts by `|σ|/(λ_j − σ)` per step.
+    /// Returns the number of iterations (1 for a supported structure).
+    /// Errors: a failed factorization or no convergence in 200 steps →
+    /// [`Error::Numerical`].
+    pub fn solve_static(
+        &self,
+        mut rhs: faer::MatMut<'_, f64>,
+        rigid: &[Vec<f64>],
+        shift: f64,
+    ) -> Result<usize> {
+        let (n, r) = (rhs.nrows(), rhs.ncols());
+        if rigid.is_empty() {
+            self.pencil.factor_llt(0.0)?.solve_in_place(rhs);
+            return Ok(1);
+        }
+        let mass = self.pencil.mass();
+        // x ← x − R (Rᵀ M x) (displacements) or b ← b − M R (Rᵀ b) (loads).
+        let project = |m: &mut faer::MatMut<'_, f64>, loads: bool| {
+            for c in 0..m.ncols() {
+                for q in rigid {
+                    let a: f64 = if loads {
+                        (0..n).map(|i| q[i] * m[(i, c)]).sum()
+                    } else {
+                        (0..n).map(|i| q[i] * mass[i] * m[(i, c)]).sum()
+                    };
+                    for i in 0..n {
+                        m[(i, c)] -= a * if loads { mass[i] * q[i] } else { q[i] };
+                    }
+                }
+            }
+        };
+        project(&mut rhs, true);
+        let b = rhs.to_owned();
+        let mut factor = self.pencil.factor_llt(shift)?;
+        let mut u = Mat::<f64>::zeros(n, r);
+        let mut last = f64::INFINITY;
+        for it in 1..=200 {
+            let mut next =
+                Mat::<f64>::from_fn(n, r, |i, c| b[(i, c)] + shift * mass[i] * u[(i, c)]);
+            factor.solve_in_place(next.as_mut());
+            project(&mut next.as_mut(), false);
+            let (mut change, mut size) = (0.0f64, 0.0f64);
+            for c in 0..r {
+                for i in 0..n {
+                    change = change.max((next[(i, c)] - u[(i, c)]).abs());
+                    size = size.max(next[(i, c)].abs());
+                }
+            }
+            u = next;
+            if !(change.is_finite() && size.is_finite()) {
+                break;
+            }
+            // Converged, or stalled at the rounding floor of the solves.
+            if change <= 1e-13 * size || size == 0.0 || (change >= last && change <= 1e-10 * size) {
+                rhs.copy_from(&u);
+                return Ok(it);
+            }
+            last = change;
+        }
+        Err(Error::numerical(
+            "modal::solve_static",
+            format!(
+                "inertia-relief iteration with shift {shift:e} did not converge in 200 steps \
+                 (a free structure with a rigid motion not among the {} given, or an \
+                 eigenvalue near the shift)",
+                rigid.len()
+            ),
+        ))
+    }
+
     /// Eigenvalue (and, in the updated-mode approach, eigenvector)
     /// derivatives of `modes` for each design variable; see [`derivatives`].
     /// Where `K` and the `K'ᵥ` split into independent blocks (e.g. the

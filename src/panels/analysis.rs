@@ -68,9 +68,9 @@ pub fn layup_label(panel: &Panel) -> String {
 /// (if asked) the derivatives. This is the shape an optimization loop uses.
 pub struct PanelAnalysis {
     pub(super) panel: Panel,
-    model: crate::fe::PanelModel,
+    pub(super) model: crate::fe::PanelModel,
     pub(super) sys: PanelSystem,
-    solver: ModalSolver,
+    pub(super) solver: ModalSolver,
     want: Option<ModeUpdate>,
     mirrors: [Option<Vec<usize>>; 2],
     /// The rigid frame of the last run, keyed by the laminate's mass and

@@ -145,6 +145,7 @@ use nalgebra::Vector3;
 pub struct BasisBuilder {
     analysis: PanelAnalysis,
     update: Option<ModeUpdate>,
+    geometric: bool,
 }
 
 /// Lumped node masses of a panel: translational (kg) and rotary
@@ -162,7 +163,17 @@ impl BasisBuilder {
         Ok(BasisBuilder {
             analysis: PanelAnalysis::new(panel, derivatives)?,
             update: derivatives,
+            geometric: false,
         })
+    }
+
+    /// Compute (or not) the modal geometric stiffness of the inertial
+    /// unit load cases ([`super::geometric`]) with every later basis, and
+    /// its ply-angle derivatives when the builder computes mode
+    /// derivatives: what the scene effect `geometric_stiffening` needs.
+    /// Off by default (12 static solves and, per design variable, 12 more).
+    pub fn set_geometric(&mut self, on: bool) {
+        self.geometric = on;
     }
 
     /// The basis of the panel with lay-up `laminate` (same ply count as the
@@ -208,6 +219,24 @@ impl BasisBuilder {
             out
         };
         let shapes = expand(x);
+        let geometric = if self.geometric {
+            let dmodes: Vec<Option<&faer::Mat<f64>>> = run
+                .derivatives
+                .iter()
+                .map(|d| match self.update {
+                    Some(ModeUpdate::Updated) => d.dmodes.as_ref(),
+                    _ => None,
+                })
+                .collect();
+            Some(super::geometric::modal_geometric(
+                &self.analysis,
+                laminate,
+                x,
+                &dmodes,
+            )?)
+        } else {
+            None
+        };
         let mut derivatives = Vec::with_capacity(run.derivatives.len());
         for (d, name) in run.derivatives.iter().zip(&run.variables) {
             let dshapes = match (self.update, &d.dmodes) {
@@ -253,7 +282,7 @@ impl BasisBuilder {
             eigenvalues: keep.iter().map(|&j| run.modes.lambda[j]).collect(),
             derivatives,
             rigid,
-            geometric: None,
+            geometric,
         })
     }
 
@@ -316,15 +345,35 @@ pub fn panel_basis(
         .map_err(|e| in_panel(e, &panel.name))
 }
 
+/// [`panel_basis`] with the modal geometric stiffness of the inertial
+/// unit load cases ([`BasisBuilder::set_geometric`]) when `geometric`.
+pub fn panel_basis_geometric(
+    panel: &Panel,
+    n_modes: usize,
+    derivatives: Option<ModeUpdate>,
+    geometric: bool,
+) -> Result<ModalBasis> {
+    if n_modes == 0 {
+        return Err(Error::input("n_modes", 0, "at least 1 mode"));
+    }
+    let mut builder = BasisBuilder::new(panel, derivatives)?;
+    builder.set_geometric(geometric);
+    builder
+        .basis(&panel.laminate, n_modes)
+        .map_err(|e| in_panel(e, &panel.name))
+}
+
 /// [`panel_basis`] for the panel named `name` in the study's `[[panels]]`
-/// section. Errors name the study file: an unknown name is an input error
-/// on key `panels.name` listing the names available; errors of the panel
-/// entry carry `panels[i]`.
+/// section (with the geometric stiffness when `geometric`). Errors name
+/// the study file: an unknown name is an input error on key `panels.name`
+/// listing the names available; errors of the panel entry carry
+/// `panels[i]`.
 pub fn basis_for_study(
     study: &Study,
     name: &str,
     n_modes: usize,
     derivatives: Option<ModeUpdate>,
+    geometric: bool,
 ) -> Result<ModalBasis> {
     if n_modes == 0 {
         return Err(Error::input("n_modes", 0, "at least 1 mode"));
@@ -333,7 +382,7 @@ pub fn basis_for_study(
     let Some(i) = panels.iter().position(|p| p.name == name) else {
         return Err(unknown_panel(study, name, &panels));
     };
-    panel_basis(&panels[i], n_modes, derivatives)
+    panel_basis_geometric(&panels[i], n_modes, derivatives, geometric)
         .map_err(|e| e.in_file(&study.path, &format!("panels[{i}]")))
 }
 

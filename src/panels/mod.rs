@@ -6,11 +6,12 @@
 
 pub mod analysis;
 pub mod basis;
+mod geometric;
 pub mod rigid;
 
 pub use analysis::{
     analyse_panel, dfreq_hz_per_deg, in_panel, layup_label, PanelAnalysis, PanelModes,
     FREE_FREE_SHIFT,
 };
-pub use basis::{basis_for_study, panel_basis, unknown_panel, BasisBuilder};
+pub use basis::{basis_for_study, panel_basis, panel_basis_geometric, unknown_panel, BasisBuilder};
 pub use rigid::RigidFrame;

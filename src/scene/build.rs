@@ -42,7 +42,7 @@ impl SceneSpec {
     /// key below `scene` (e.g. `joints[2].body_i`); callers attach the
     /// file with `Error::in_file`.
     pub fn build(&self) -> Result<Scene> {
-        self.build_with(&|name, _, _| {
+        self.build_with(&|name, _, _, _| {
             Err(Error::input(
                 "flexible.panel",
                 name,
@@ -135,7 +135,16 @@ impl SceneSpec {
                             "a moving body (a fixed body cannot be flexible)",
                         ));
                     }
-                    flexible_body(&key, &b.name, f, self.has(Effect::Damping), panels)?
+                    flexible_body(
+                        &key,
+                        &b.name,
+                        f,
+                        (
+                            self.has(Effect::Damping),
+                            self.has(Effect::GeometricStiffening),
+                        ),
+                        panels,
+                    )?
                 }
                 _ => {
                     let need = |what: &str| {
@@ -153,18 +162,6 @@ impl SceneSpec {
                     Body::new(&key, &b.name, mass, inertia, (com, [1.0, 0.0, 0.0, 0.0]))?
                 }
             };
-            let no_geometric = body
-                .flex
-                .as_ref()
-                .is_some_and(|f| f.basis.geometric.is_none());
-            if self.has(Effect::GeometricStiffening) && no_geometric {
-                return Err(Error::input(
-                    format!("{key}.flexible.kind"),
-                    "panel",
-                    "a `beam` body with `geometric_stiffening` in scene.effects (panels \
-                     have no geometric stiffness yet: remove the effect or use a beam)",
-                ));
-            }
             body.fixed = b.fixed;
             body.v0 = finite3(format!("{key}.velocity"), b.velocity)?;
             body.w0 = body.orientation().transpose()

@@ -50,8 +50,8 @@ pub struct BuildProfile {
 pub fn load_scene(study: &Study) -> Result<Scene> {
     let mut spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
     spec.prune_derivatives();
-    let panels = |name: &str, modes: usize, update: Option<ModeUpdate>| {
-        crate::panels::basis_for_study(study, name, modes, update)
+    let panels = |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: bool| {
+        crate::panels::basis_for_study(study, name, modes, update, geometric)
     };
     spec.build_with(&panels).map_err(study.locate("scene"))
 }
@@ -187,9 +187,9 @@ impl ScenePlan {
         }
         spec.prune_derivatives();
         let profile = Cell::new(BuildProfile::default());
-        let bases = |name: &str, modes: usize, update: Option<ModeUpdate>| {
+        let bases = |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: bool| {
             let t = Instant::now();
-            let basis = self.basis(name, modes, update, laminates);
+            let basis = self.basis(name, modes, (update, geometric), laminates);
             let mut p = profile.get();
             p.bases += 1;
             p.derivative_bases += usize::from(update.is_some());
@@ -206,12 +206,12 @@ impl ScenePlan {
     }
 
     /// The basis of panel `name` with lay-up `laminates[i]`, from a pooled
-    /// builder.
+    /// builder; with its geometric stiffness when `geometric`.
     fn basis(
         &self,
         name: &str,
         modes: usize,
-        update: Option<ModeUpdate>,
+        (update, geometric): (Option<ModeUpdate>, bool),
         laminates: &[Laminate],
     ) -> Result<ModalBasis> {
         if modes == 0 {
@@ -240,6 +240,7 @@ impl ScenePlan {
                 builder: BasisBuilder::new(&self.panels[i], update).map_err(located)?,
             },
         };
+        prepared.builder.set_geometric(geometric);
         let basis = prepared
             .builder
             .basis(&laminates[i], modes)

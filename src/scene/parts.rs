@@ -14,8 +14,10 @@ use crate::modal::ModeUpdate;
 use nalgebra::{Matrix3, Vector3};
 
 /// Builds the modal basis of a `kind = "panel"` body: `(panel name,
-/// modes, derivatives)` → basis; errors name the study's keys.
-pub type PanelBases<'a> = &'a dyn Fn(&str, usize, Option<ModeUpdate>) -> Result<ModalBasis>;
+/// modes, derivatives, geometric)` → basis, with the modal geometric
+/// stiffness of the inertial load cases when `geometric` (the scene's
+/// `geometric_stiffening`); errors name the study's keys.
+pub type PanelBases<'a> = &'a dyn Fn(&str, usize, Option<ModeUpdate>, bool) -> Result<ModalBasis>;
 
 fn vec3(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
@@ -312,12 +314,12 @@ pub(super) fn load_table(key: &str, rows: &[[f64; 7]]) -> Result<Vec<(f64, [f64;
 }
 
 /// A flexible body from its `flexible` table: basis, invariants, frame
-/// placement.
+/// placement; `geometric`: panel bases with their geometric stiffness.
 pub(super) fn flexible_body(
     key: &str,
     name: &str,
     f: &FlexSpec,
-    damping: bool,
+    (damping, geometric): (bool, bool),
     panels: PanelBases,
 ) -> Result<Body> {
     let fk = format!("{key}.flexible");
@@ -351,7 +353,7 @@ pub(super) fn flexible_body(
                     "a rigid-body content share in (0, 1] (1 keeps every mode)",
                 ));
             }
-            panels(panel, f.modes, f.derivatives)
+            panels(panel, f.modes, f.derivatives, geometric)
                 .map_err(|e| match e {
                     // The mode count is this body's key, not the panel's.
                     Error::Input { key, expected, .. } if key.ends_with("n_modes") => {

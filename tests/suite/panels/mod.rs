@@ -1,3 +1,4 @@
 //! Tests of `plyscape::panels`: modal bases and panel modes.
 mod basis;
+mod geometric;
 mod modes;
