@@ -40,14 +40,34 @@
 //!    early if they diverge). The pull-back of the last trial, scaled by
 //!    `(α/α_last)²`, predicts the next one (the curvature of the limits).
 //!    First trial length: on the first iteration the one that changes f by
-//!    `dobj1`·|f| on the linear model, but at least a `dx1` move; later the
-//!    Nocedal–Wright estimates `α_prev f'_prev/f'` and `2|Δf_prev|/|f'|`
-//!    capped by `dobj2`·|f|, or the previous α when following constraints;
-//!    always at most a `dx2` move of any variable and inside the bounds. A
-//!    quadratic through `f(0)`, `f'(0)` and the trial (later three points)
-//!    gives the next length (extrapolating up to 4×, interpolating down to
-//!    0.01×); a constraint that becomes violated is interpolated to its zero
-//!    crossing (quadratic in α from `g(0)`, `∇gᵀS` and the trial).
+//!    `dobj1`·|f| on the linear model, but at least a `dx1` move; later
+//!    the minimizer of the quadratic model with the secant curvature of
+//!    the Lagrangian along the last step, `α = −f'(0)/(κ|S|²)` with
+//!    `κ = sᵀy/sᵀs`, `s` the scaled step between the last two gradient
+//!    evaluations and `y` the change of `∇f + Σ λ_j ∇g_j` over it (λ the
+//!    binding multipliers of the direction), capped by `dobj2`·|f|; when
+//!    `κ <= 0` the Nocedal–Wright estimates `α_prev f'_prev/f'` and
+//!    `2|Δf_prev|/|f'|` capped by `dobj2`·|f|, or the previous α when
+//!    following constraints; always at most a `dx2` move of any variable
+//!    and inside the bounds.
+//!    Phase A shortens the trial until it is feasible and decreases f
+//!    (Armijo: `f(α) < φ(0) + 10⁻⁴ α f'(0)`): a quadratic through `φ(0)`,
+//!    `f'(0)` and the trial (down to 0.01×), or a violated constraint's
+//!    zero crossing (quadratic in α from `g(0)`, `∇gᵀS` and the trial).
+//!    Phase B fits `q(α) = φ(0) + f'(0) α + c α²` through the accepted
+//!    trial (three points after a rejected one) and stops without a
+//!    further call when the trial already realizes 90 % of the fit's
+//!    decrease, `(α/α* − 1)² <= 0.1` for the fit's minimizer α*. Otherwise
+//!    it evaluates α* (capped at 4× the trial, the bounds and constraint
+//!    crossings; longer extrapolations continue) *with gradients*, as an
+//!    SQP code evaluates its step: accepted (feasible, lower f, the
+//!    followed constraints met without a correction), that evaluation is
+//!    the next iteration's, so the step costs no extra call; otherwise it
+//!    is an ordinary trial. It is evaluated without gradients when the
+//!    fit's f would end the run by a change exit (no iteration would use
+//!    the gradients). This, DOT's idea of not evaluating what a fit
+//!    predicts well, takes about one function call per gradient call in
+//!    the search.
 //! 6. Convergence: `|Δf| < DABOBJ` or `|Δf|/|f| < DELOBJ` for ITRMOP
 //!    consecutive feasible iterations, or the Kuhn–Tucker test
 //!    `|S| <= kt_tolerance · max(|f|, 1)` (or `max(|∇f|, 1)` with the
@@ -65,11 +85,13 @@ use crate::error::{Error, Result};
 use argmin::core::{
     Problem as ArgminProblem, Solver, State, TerminationReason, TerminationStatus, KV,
 };
-use geometry::{dot, first_root, least_norm, norm};
+use geometry::{dot, least_norm, norm};
 pub use options::{KtScale, MmfdOptions};
+use search::Search;
 
 mod geometry;
 mod options;
+mod search;
 
 /// A design with its (function-only or full) evaluation.
 #[derive(Debug, Clone)]
@@ -100,6 +122,9 @@ pub struct Mmfd {
     fr_count: usize,
     /// Previous accepted step length and its slope, for the next first trial.
     prev_step: Option<(f64, f64)>,
+    /// The last gradient evaluation's design and scaled gradients of f
+    /// and the constraints: the secant curvature of the next iteration.
+    secant: Option<(Vec<f64>, Vec<f64>, Vec<Vec<f64>>)>,
     /// |Δf| of the last iteration (quadratic first-trial estimate
     /// `α = 2|Δf|/|f'(0)|`, Nocedal & Wright eq. 3.60).
     last_change: f64,
@@ -150,21 +175,6 @@ fn counts(problem: &Ap<'_>) -> (usize, usize) {
         .unwrap_or((0, 0))
 }
 
-/// What the line search works with in one iteration.
-struct Search<'s> {
-    base: &'s Point,
-    /// Scaled gradients of f and of all constraints at the base.
-    gf: &'s [f64],
-    gg: &'s [Vec<f64>],
-    s: &'s [f64],
-    c0: &'s [f64],
-    binding: &'s [usize],
-    /// Last trial's α and its pull-back beyond `c₀` (scaled): the curvature
-    /// of the followed constraints, reused as `(α/α_last)²` times that
-    /// pull-back to predict the next trial's (second-order prediction).
-    learned: std::cell::RefCell<Option<(f64, Vec<f64>)>>,
-}
-
 impl Mmfd {
     /// A solver starting from `x0` (wrapped/clamped into the box).
     pub fn new(problem: &dyn Problem, x0: &[f64], options: MmfdOptions) -> Result<Self> {
@@ -198,6 +208,7 @@ impl Mmfd {
             fr_prev: None,
             fr_count: 0,
             prev_step: None,
+            secant: None,
             last_change: f64::INFINITY,
             abs_count: 0,
             rel_count: 0,
@@ -231,221 +242,14 @@ impl Mmfd {
             .collect()
     }
 
-    /// Evaluate the trial `x + c₀ + αS` with constraint following.
-    fn trial(&self, problem: &mut Ap<'_>, sr: &Search<'_>, alpha: f64) -> Result<Point> {
-        let lin: Vec<f64> = sr.c0.iter().zip(sr.s).map(|(c, s)| c + alpha * s).collect();
-        let mut z = lin.clone();
-        if let Some((a_last, pull)) = sr.learned.borrow().as_ref() {
-            let k = (alpha / a_last).powi(2);
-            for (zi, p) in z.iter_mut().zip(pull) {
-                *zi += k * p;
-            }
-        }
-        let mut x = self.moved(problem, &sr.base.x, &z);
-        let mut ev = evaluate(problem, &x, false)?;
-        let follow_tol = self.options.follow_tolerance;
-        let mut last_r = f64::INFINITY;
-        for _ in 0..self.options.max_corrections {
-            if sr.binding.is_empty() {
-                break;
-            }
-            let r: Vec<f64> = sr.binding.iter().map(|&j| ev.g[j]).collect();
-            let r_max = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            // Converged, or diverging (the step is too long for the frozen
-            // gradients: the line search will shorten it).
-            if r_max <= follow_tol || r_max >= last_r {
-                break;
-            }
-            last_r = r_max;
-            let cols: Vec<&[f64]> = sr.binding.iter().map(|&j| sr.gg[j].as_slice()).collect();
-            let Some(dz) = least_norm(&cols, &r) else {
-                break;
-            };
-            for (zi, d) in z.iter_mut().zip(&dz) {
-                *zi += d;
-            }
-            x = self.moved(problem, &sr.base.x, &z);
-            ev = evaluate(problem, &x, false)?;
-        }
-        if !sr.binding.is_empty() && alpha > 0.0 {
-            let pull = z.iter().zip(&lin).map(|(a, b)| a - b).collect();
-            *sr.learned.borrow_mut() = Some((alpha, pull));
-        }
-        Ok(Point {
-            x,
-            f: ev.f,
-            g: ev.g,
-        })
-    }
-
-    /// Largest α keeping `y + c₀ + αS` inside the bounds of the non-periodic
-    /// variables.
-    fn alpha_max(&self, problem: &Ap<'_>, sr: &Search<'_>) -> f64 {
-        let vars = variables(problem);
-        let snorm = sr.s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let mut amax = f64::INFINITY;
-        for (i, v) in vars.iter().enumerate() {
-            if v.period.is_some() || sr.s[i].abs() <= 1e-9 * snorm {
-                continue;
-            }
-            let y = (sr.base.x[i] - v.lower) / self.range[i] + sr.c0[i];
-            let room = if sr.s[i] > 0.0 { 1.0 - y } else { y };
-            amax = amax.min(room.max(0.0) / sr.s[i].abs());
-        }
-        amax
-    }
-
-    /// Predicted α where a constraint not followed crosses zero, from
-    /// `g(0)`, `∇gᵀS` and the value at the trial `at`.
-    fn crossing(&self, sr: &Search<'_>, at: &Point, alpha: f64) -> f64 {
-        let mut best = f64::INFINITY;
-        for (j, gt) in at.g.iter().enumerate() {
-            if sr.binding.contains(&j) {
-                continue;
-            }
-            let g0 = sr.base.g[j] + dot(&sr.gg[j], sr.c0);
-            let s = dot(&sr.gg[j], sr.s);
-            if s <= 0.0 && *gt <= 0.0 {
-                continue;
-            }
-            let a = (gt - g0 - s * alpha) / (alpha * alpha);
-            if let Some(r) = first_root(a, s, g0) {
-                best = best.min(r);
-            } else if *gt > 0.0 {
-                // Linear interpolation between the base and the trial.
-                let r = alpha * (0.0 - g0) / (gt - g0);
-                if r > 0.0 {
-                    best = best.min(r);
-                }
-            }
-        }
-        best
-    }
-
-    /// The line search of step 5. Returns the accepted point and α, or None
-    /// when no feasible point with a decrease of f was found.
-    fn line_search(&self, problem: &mut Ap<'_>, sr: &Search<'_>) -> Result<Option<(Point, f64)>> {
+    /// Whether an iteration from `old` to a feasible design with f =
+    /// `f_new` would end the run by a change exit (then its point is not
+    /// evaluated with gradients: no iteration would use them).
+    fn would_stop(&self, old: &Point, f_new: f64) -> bool {
         let o = &self.options;
-        let ok = |p: &Point| p.max_g() <= o.ctmin;
-        let phi0 = sr.base.f + dot(sr.gf, sr.c0);
-        let d0 = dot(sr.gf, sr.s);
-        let snorm = sr.s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        // Pure pull onto the binding limits (S = 0).
-        if snorm == 0.0 || d0 >= 0.0 {
-            if norm(sr.c0) == 0.0 {
-                return Ok(None);
-            }
-            let t = self.trial(problem, sr, 0.0)?;
-            return Ok((ok(&t) && t.f < sr.base.f.max(phi0)).then_some((t, 0.0)));
-        }
-        let amax = self.alpha_max(problem, sr);
-        let fscale = sr.base.f.abs().max(self.dabobj);
-        let mut alpha = match self.prev_step {
-            None => (o.dobj1 * fscale / d0.abs()).max(o.dx1 / snorm),
-            // Following curved limits, f'(0) = −|S|² shrinks quadratically
-            // near the optimum while the best α stays about the same.
-            Some((a, _)) if !sr.binding.is_empty() => a,
-            Some((a, dprev)) => (a * dprev / d0)
-                .min(o.dobj2 * fscale / d0.abs())
-                .min(2.02 * self.last_change.max(1e-300) / d0.abs()),
-        };
-        alpha = alpha.min(o.dx2 / snorm).min(amax);
-
-        if !(alpha > 0.0 && alpha.is_finite()) {
-            return Ok(None);
-        }
-        // Reference for a decrease: f at the base, or the predicted f on the
-        // binding limits when reaching them costs (base slightly violated).
-        let f_ref = sr.base.f.max(phi0);
-        let mut best: Option<(Point, f64)> = None;
-        let mut evals = 0;
-        // Phase A: a feasible trial with a decrease.
-        while evals < o.max_line_evaluations {
-            let t = self.trial(problem, sr, alpha)?;
-            evals += 1;
-            if !ok(&t) {
-                let r = self.crossing(sr, &t, alpha);
-                // A followed constraint the corrections could not reach
-                // (r infinite): the step was too long for the curvature.
-                alpha = if r.is_finite() {
-                    r.clamp(0.05 * alpha, 0.9 * alpha)
-                } else {
-                    0.25 * alpha
-                };
-                continue;
-            }
-            if t.f < f_ref + 1e-4 * alpha * d0 {
-                best = Some((t, alpha));
-                break;
-            }
-            let c = (t.f - phi0 - d0 * alpha) / (alpha * alpha);
-            let a_q = if c > 0.0 {
-                -d0 / (2.0 * c)
-            } else {
-                0.1 * alpha
-            };
-            alpha = a_q.clamp(0.01 * alpha, 0.5 * alpha);
-        }
-        let Some((mut bp, mut ba)) = best else {
-            return Ok(None);
-        };
-        // Phase B: interpolate / extrapolate from the accepted trial.
-        let mut lo: Option<(f64, f64)> = None; // a second point for 3-point fits
-        while evals < o.max_line_evaluations {
-            let (a_star, capped) = match lo {
-                Some((a2, f2)) => {
-                    // Quadratic through (0, φ0), (ba, f_b), (a2, f2).
-                    let (x1, y1, x2, y2) = (ba, bp.f - phi0, a2, f2 - phi0);
-                    let den = x1 * x2 * (x1 - x2);
-                    let c = (y1 * x2 - y2 * x1) / den;
-                    let b = (y2 * x1 * x1 - y1 * x2 * x2) / den;
-                    if c > 0.0 {
-                        (-b / (2.0 * c), false)
-                    } else {
-                        break;
-                    }
-                }
-                None => {
-                    let c = (bp.f - phi0 - d0 * ba) / (ba * ba);
-                    if c > 0.0 {
-                        let a = -d0 / (2.0 * c);
-                        if a > 4.0 * ba {
-                            (4.0 * ba, true)
-                        } else {
-                            (a, false)
-                        }
-                    } else {
-                        (4.0 * ba, true)
-                    }
-                }
-            };
-            let limit = amax.min(self.crossing(sr, &bp, ba));
-            let a_new = a_star.min(limit);
-            if a_new.is_nan() || a_new <= 0.0 || (a_new - ba).abs() <= 0.05 * ba {
-                break;
-            }
-            let t = self.trial(problem, sr, a_new)?;
-            evals += 1;
-            if ok(&t) && t.f < bp.f {
-                let prev = (ba, bp.f);
-                bp = t;
-                ba = a_new;
-                if capped && a_new < limit {
-                    lo = None;
-                    continue;
-                }
-                lo = Some(prev);
-                if a_new >= limit {
-                    break;
-                }
-            } else {
-                if lo.is_some() || !ok(&t) {
-                    break;
-                }
-                lo = Some((a_new, t.f));
-            }
-        }
-        Ok(Some((bp, ba)))
+        let df = (f_new - old.f).abs();
+        (self.abs_count + 1 >= o.itrmop && df < self.dabobj)
+            || (self.rel_count + 1 >= o.itrmop && df < o.delobj * old.f.abs().max(1e-300))
     }
 
     /// Record the iteration and update the convergence counters.
@@ -655,7 +459,7 @@ impl Mmfd {
             }
         }
         // Steps 3–4: direction.
-        let (s, binding) = if active.is_empty() && side_rows.is_empty() {
+        let (s, binding, mult) = if active.is_empty() && side_rows.is_empty() {
             let mut s: Vec<f64> = gf.iter().map(|v| -v).collect();
             if let Some((gprev, sprev)) = &self.fr_prev {
                 if self.fr_count < n {
@@ -672,7 +476,7 @@ impl Mmfd {
                 }
             }
             self.fr_prev = Some((gf.clone(), s.clone()));
-            (s, vec![])
+            (s, vec![], vec![])
         } else {
             self.fr_prev = None;
             self.fr_count = 0;
@@ -693,6 +497,12 @@ impl Mmfd {
                 })
                 .map(|(_, &j)| j)
                 .collect();
+            let mult: Vec<f64> = active
+                .iter()
+                .enumerate()
+                .filter(|(_, j)| binding.contains(j))
+                .map(|(k, _)| sol.lambda[k])
+                .collect();
             let mut s = sol.s;
             // Remove round-off components pointing out of an active bound.
             for &(i, sign) in &side_vars {
@@ -700,8 +510,27 @@ impl Mmfd {
                     s[i] = 0.0;
                 }
             }
-            (s, binding)
+            (s, binding, mult)
         };
+        // Secant curvature of the Lagrangian (the binding multipliers of
+        // this direction) along the step from the last gradient evaluation.
+        let curvature = self.secant.take().and_then(|(xp, gfp, ggp)| {
+            let st: Vec<f64> = vars
+                .iter()
+                .enumerate()
+                .map(|(i, v)| v.difference(base.x[i], xp[i]) / self.range[i])
+                .collect();
+            let mut y: Vec<f64> = gf.iter().zip(&gfp).map(|(a, b)| a - b).collect();
+            for (&j, l) in binding.iter().zip(&mult) {
+                for (yi, (a, b)) in y.iter_mut().zip(gg[j].iter().zip(&ggp[j])) {
+                    *yi += l * (a - b);
+                }
+            }
+            let ss = dot(&st, &st);
+            let k = dot(&st, &y) / ss;
+            (ss > 0.0 && k > 0.0 && k.is_finite()).then_some(k)
+        });
+        self.secant = Some((base.x.clone(), gf.clone(), gg.clone()));
         // Kuhn–Tucker test.
         let on_limits = binding.iter().all(|&j| base.g[j].abs() <= o.ctmin);
         let kt_scale = match o.kt_scale {
@@ -729,11 +558,13 @@ impl Mmfd {
             s: &s,
             c0: &c0,
             binding: &binding,
+            curvature,
             learned: std::cell::RefCell::new(None),
         };
         match self.line_search(problem, &sr)? {
-            Some((p, alpha)) => {
+            Some((p, alpha, ev)) => {
                 self.failed_searches = 0;
+                self.start_evaluation = ev;
                 if alpha > 0.0 {
                     self.prev_step = Some((alpha, d0));
                 }
