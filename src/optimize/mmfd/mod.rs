@@ -93,6 +93,9 @@ mod geometry;
 mod options;
 mod search;
 
+/// A design with its scaled gradients of f and of the constraints.
+type Secant = (Vec<f64>, Vec<f64>, Vec<Vec<f64>>);
+
 /// A design with its (function-only or full) evaluation.
 #[derive(Debug, Clone)]
 struct Point {
@@ -124,7 +127,7 @@ pub struct Mmfd {
     prev_step: Option<(f64, f64)>,
     /// The last gradient evaluation's design and scaled gradients of f
     /// and the constraints: the secant curvature of the next iteration.
-    secant: Option<(Vec<f64>, Vec<f64>, Vec<Vec<f64>>)>,
+    secant: Option<Secant>,
     /// |Δf| of the last iteration (quadratic first-trial estimate
     /// `α = 2|Δf|/|f'(0)|`, Nocedal & Wright eq. 3.60).
     last_change: f64,

@@ -141,6 +141,7 @@ fn check_derivatives(support: Support) {
             let err = (g.derivatives[v][e] - fd).abs() / scale;
             worst = worst.max(err);
         }
+        println!("{support:?} variable {v}: worst error {worst:e} of the largest entry");
         assert!(
             worst < 1e-6,
             "{support:?} variable {v}: error {worst:e} of the largest entry"
