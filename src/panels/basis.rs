@@ -168,7 +168,7 @@ impl BasisBuilder {
     }
 
     /// Compute (or not) the modal geometric stiffness of the inertial
-    /// unit load cases ([`super::geometric`]) with every later basis, and
+    /// unit load cases (`panels::geometric`) with every later basis, and
     /// its ply-angle derivatives when the builder computes mode
     /// derivatives: what the scene effect `geometric_stiffening` needs.
     /// Off by default (12 static solves and, per design variable, 12 more).
