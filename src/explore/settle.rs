@@ -270,30 +270,8 @@ pub fn strictly_feasible(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optimize::testproblems::Analytic;
-    use crate::optimize::{Termination, Variable};
-
-    /// min x on [−3, 3] subject to g = 0.5 + x² − x⁴/4 <= 0: feasible for
-    /// x² >= 2 + √6 (|x| >= 2.10938), so a local optimum on the constraint
-    /// at x* = +2.10938 (λ = 1/|g'(x*)| = 0.19354, g' = 2x − x³) and the
-    /// global one on the bound −3; the violation has a local minimum
-    /// g = 0.5 > 0 at x = 0 (closed form, derived here).
-    fn islands() -> Analytic {
-        fn k(x: &[f64]) -> (f64, Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
-            let x = x[0];
-            let g = 0.5 + x * x - 0.25 * x.powi(4);
-            (x, vec![g], vec![1.0], vec![vec![2.0 * x - x.powi(3)]])
-        }
-        Analytic {
-            name: "islands".into(),
-            variables: vec![Variable::bounded("x", -3.0, 3.0).unwrap()],
-            n_constraints: 1,
-            kernel: k,
-            x0: vec![0.3],
-            optima: vec![vec![-3.0]],
-            f_opt: -3.0,
-        }
-    }
+    use crate::optimize::testproblems::islands;
+    use crate::optimize::Termination;
 
     const X_STAR: f64 = 2.109_381_364_946_409_5; // sqrt(2 + sqrt(6))
 

@@ -184,27 +184,7 @@ pub fn table(problem: &dyn Problem, checks: &[Check], tolerance: f64) -> Vec<Vec
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optimize::testproblems::Analytic;
-    use crate::optimize::Variable;
-
-    /// g = 0.5 + x² − x⁴/4 on [−3, 3]: feasible for |x| >= 2.10938, a
-    /// local minimum of the violation (g = 0.5) at x = 0 (closed form).
-    fn islands() -> Analytic {
-        fn k(x: &[f64]) -> (f64, Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
-            let x = x[0];
-            let g = 0.5 + x * x - 0.25 * x.powi(4);
-            (x, vec![g], vec![1.0], vec![vec![2.0 * x - x.powi(3)]])
-        }
-        Analytic {
-            name: "islands".into(),
-            variables: vec![Variable::bounded("x", -3.0, 3.0).unwrap()],
-            n_constraints: 1,
-            kernel: k,
-            x0: vec![0.3],
-            optima: vec![vec![-3.0]],
-            f_opt: -3.0,
-        }
-    }
+    use crate::optimize::testproblems::islands;
 
     #[test]
     fn pure_descent_on_the_violation_finds_its_basin() {

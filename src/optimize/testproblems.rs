@@ -426,6 +426,29 @@ fn rastrigin_kernel(x: &[f64]) -> (f64, Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
     (f, vec![], gf, vec![])
 }
 
+/// `min x` on `[−3, 3]` subject to `g = 0.5 + x² − x⁴/4 <= 0` (closed
+/// form, derived here): feasible for `x² >= 2 + √6` (`|x| >= 2.10938`), so
+/// a local optimum on the constraint at `x* = +2.10938` (multiplier
+/// `λ = 1/|g'(x*)| = 0.19354`, `g' = 2x − x³`) and the global one on the
+/// bound −3; the violation has a local minimum `g = 0.5 > 0` at `x = 0`,
+/// which no descent on the violation leaves. A test of infeasible ends.
+pub fn islands() -> Analytic {
+    fn k(x: &[f64]) -> (f64, Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+        let x = x[0];
+        let g = 0.5 + x * x - 0.25 * x.powi(4);
+        (x, vec![g], vec![1.0], vec![vec![2.0 * x - x.powi(3)]])
+    }
+    Analytic {
+        name: "islands".into(),
+        variables: boxed(&[(-3.0, 3.0)]),
+        n_constraints: 1,
+        kernel: k,
+        x0: vec![0.3],
+        optima: vec![vec![-3.0]],
+        f_opt: -3.0,
+    }
+}
+
 /// The n-dimensional Rastrigin function `10 n + Σ x_i² − 10 cos 2πx_i` on
 /// `[−5.12, 5.12]ⁿ`; global minimum `f* = 0` at the origin among ~11ⁿ local
 /// minima (Rastrigin 1974).

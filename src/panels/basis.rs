@@ -337,12 +337,7 @@ pub fn panel_basis(
     n_modes: usize,
     derivatives: Option<ModeUpdate>,
 ) -> Result<ModalBasis> {
-    if n_modes == 0 {
-        return Err(Error::input("n_modes", 0, "at least 1 mode"));
-    }
-    BasisBuilder::new(panel, derivatives)?
-        .basis(&panel.laminate, n_modes)
-        .map_err(|e| in_panel(e, &panel.name))
+    panel_basis_geometric(panel, n_modes, derivatives, false)
 }
 
 /// [`panel_basis`] with the modal geometric stiffness of the inertial

@@ -13,9 +13,11 @@ use plyscape::panels::basis::RIGID_CONTENT_LIMIT;
 use plyscape::panels::{basis_for_study, panel_basis};
 use plyscape::study::Study;
 
+/// Ply thickness of the test laminates \[m\].
 const PLY_T: f64 = 0.5e-3;
 
-fn laminate(angles_deg: &[f64]) -> Laminate {
+/// IM6/SC1081 plies of `PLY_T` at the given angles \[deg\].
+pub(super) fn laminate(angles_deg: &[f64]) -> Laminate {
     Laminate::new(
         angles_deg
             .iter()

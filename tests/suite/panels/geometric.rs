@@ -4,31 +4,17 @@
 //! coefficient, and the exact ply-angle derivatives against central
 //! differences (supported and free–free panels).
 
+use super::basis::laminate;
 use plyscape::beams::Beam;
 use plyscape::fe::{Mesh, MeshParams, Panel, Support};
-use plyscape::laminate::{DesignMap, Laminate, Orthotropic, Ply};
+use plyscape::laminate::{DesignMap, Laminate};
 use plyscape::mbs::model::geometric::CASES;
 use plyscape::mbs::ModalBasis;
 use plyscape::modal::ModeUpdate;
 use plyscape::panels::panel_basis_geometric;
 
-const PLY_T: f64 = 0.5e-3;
 /// Unit load case ω_z² (module doc table of `mbs::model::geometric`).
 const WZ2: usize = 2;
-
-fn laminate(angles_deg: &[f64]) -> Laminate {
-    Laminate::new(
-        angles_deg
-            .iter()
-            .map(|a| Ply {
-                material: Orthotropic::im6_sc1081(),
-                thickness: PLY_T,
-                angle: a.to_radians(),
-            })
-            .collect(),
-    )
-    .unwrap()
-}
 
 fn panel(length: f64, width: f64, divisions: usize, lam: Laminate, support: Support) -> Panel {
     Panel {
