@@ -8,7 +8,9 @@
 //! `plyscape::optimize::testproblems` defines them (published optima and
 //! sources there), and the paper's SAR ply-angle problem
 //! (studies/sar_optimize.toml, full model, a few seconds per run) from
-//! 55°/−55°, whose reference f is the committed study's optimum. Settings:
+//! 55°/−55°, whose reference f is the best design known (IPOP-CMA-ES's
+//! strictly feasible best in results/sar_explore/comparison.csv).
+//! Settings:
 //! - `defaults`: [`MmfdOptions::default`] (DOT's defaults);
 //! - `defaults+continued`: the `defaults` run, then MMFD again from its end
 //!   point with tight change tolerances (DELOBJ 1e-12, DABOBJ 1e-14, CTMIN
@@ -24,7 +26,9 @@
 //! with `defaults`.
 //!
 //! Columns: problem, setting, n, m, iterations, function and gradient
-//! calls (DOT's counting: a call with gradients counts one of each),
+//! calls (DOT's counting, `plyscape::optimize::Counted`: a call with
+//! gradients counts a gradient call, plus a function call unless it is
+//! at the design evaluated just before),
 //! function calls per gradient call, final f, the published f*, the
 //! relative error `|f − f*| / max(1, |f*|)`, the largest constraint value
 //! (normalised `g_j <= 0`), why the (last) run stopped, and the class of
@@ -130,14 +134,15 @@ fn main() {
         csv.push_str(&row(&c, "defaults+polish", &q, added(cd, &q)));
     }
     // The paper's problem (studies/sar_optimize.toml) from 55°/−55°; f* is
-    // the optimum of the committed study run before issue 23's line
-    // search (results/sar_optimize/runs.csv, start 0), not a published one.
+    // the best design known, not a published value: IPOP-CMA-ES's best,
+    // made strictly feasible by the polish, in the 64-start comparison
+    // (results/sar_explore/comparison.csv, row `cmaes,strict`).
     let study = Study::load("studies/sar_optimize.toml").expect("studies/sar_optimize.toml");
     let sar = explore::problem(&study).expect("the SAR problem builds");
     let c = Case {
         name: "sar_55_-55".into(),
         problem: sar.as_ref(),
-        f_star: 0.9089485349000455,
+        f_star: 0.9089481415152655,
     };
     let d = run(&c, &[55.0, -55.0], &MmfdOptions::default());
     let cd = (d.iterations, d.function_calls, d.gradient_calls);

@@ -94,16 +94,23 @@ fn no_worse(b: &LocalOutcome, a: &LocalOutcome, tol: f64) -> bool {
 }
 
 /// The certificate at `o`'s design, recorded to `observer` as a check of
-/// the run's last iteration (one evaluation with gradients, counted after
-/// `calls`; its active set `g_j >= −active` as the record's CT).
+/// the run's last iteration (one evaluation with gradients through
+/// `counted`, whose calls are added to `calls`; its active set
+/// `g_j >= −active` as the record's CT). Returns the certificate and the
+/// calls after it.
 fn certify_recorded(
-    problem: &dyn Problem,
+    counted: &Counted<'_>,
     o: &LocalOutcome,
     calls: (usize, usize),
     tol: &KktTolerances,
     observer: &mut dyn Observer,
-) -> Result<Certificate> {
-    let (ev, c) = kkt::certify_at(problem, &o.x, tol)?;
+) -> Result<(Certificate, (usize, usize))> {
+    let before = (counted.function_calls(), counted.gradient_calls());
+    let (ev, c) = kkt::certify_at(counted, &o.x, tol)?;
+    let calls = (
+        calls.0 + counted.function_calls() - before.0,
+        calls.1 + counted.gradient_calls() - before.1,
+    );
     observer.observe(&IterRecord {
         iteration: o.iterations,
         x: o.x.clone(),
@@ -112,10 +119,10 @@ fn certify_recorded(
         max_g: ev.max_g(),
         ct: Some(-tol.active),
         step: 0.0,
-        function_calls: calls.0 + 1,
-        gradient_calls: calls.1 + 1,
+        function_calls: calls.0,
+        gradient_calls: calls.1,
     });
-    Ok(c)
+    Ok((c, calls))
 }
 
 /// Settle the solver's `outcome` (see the module doc). Each certificate is
@@ -129,8 +136,13 @@ pub fn settle(
     observer: &mut dyn Observer,
 ) -> Settled {
     let tol = &policy.tolerances;
+    // One counter for the certificates and the polish: it starts from the
+    // caller's last design when the caller counts (`Counted`), so that a
+    // certificate at the design the solver has just evaluated counts as
+    // the caller's counter counts it.
+    let counted = Counted::new(problem);
     let calls = (outcome.function_calls, outcome.gradient_calls);
-    let first = match certify_recorded(problem, &outcome, calls, tol, observer) {
+    let (first, calls) = match certify_recorded(&counted, &outcome, calls, tol, observer) {
         Ok(c) => c,
         Err(e) => {
             return Settled {
@@ -140,7 +152,6 @@ pub fn settle(
             }
         }
     };
-    let calls = (calls.0 + 1, calls.1 + 1);
     // No polish from an infeasible end where descent on the violation
     // cannot go on: a stationary point of the violation, or an end where
     // the solver's own restoration found no decrease or stalled (a kink of
@@ -160,7 +171,7 @@ pub fn settle(
             polish: String::new(),
         };
     }
-    let counted = Counted::new(problem);
+    let before = (counted.function_calls(), counted.gradient_calls());
     let mut continued = Continued {
         inner: observer,
         iterations: outcome.iterations,
@@ -184,22 +195,22 @@ pub fn settle(
             ..p.clone()
         };
         let at = (o.function_calls, o.gradient_calls);
-        let c = certify_recorded(&counted, &o, at, tol, observer)?;
-        Ok((p.termination, o, c))
+        let (c, after) = certify_recorded(&counted, &o, at, tol, observer)?;
+        Ok((p.termination, o, c, after))
     });
     let (polish, c) = match polished {
-        Ok((t, o, c)) if no_worse(&o, &outcome, tol.feasibility) => {
+        Ok((t, o, c, after)) if no_worse(&o, &outcome, tol.feasibility) => {
             return Settled {
                 polish: t.to_string(),
                 outcome: LocalOutcome {
-                    function_calls: o.function_calls + 1,
-                    gradient_calls: o.gradient_calls + 1,
+                    function_calls: after.0,
+                    gradient_calls: after.1,
                     ..o
                 },
                 certificate: Some(c),
             }
         }
-        Ok((t, o, _)) => (
+        Ok((t, o, _, _)) => (
             format!("kept: the polish ended worse ({t}, f = {})", o.f),
             o.iterations,
         ),
@@ -209,8 +220,8 @@ pub fn settle(
     // polish's iterations, so that the history ends at the result.
     let end = LocalOutcome {
         iterations: c,
-        function_calls: calls.0 + counted.function_calls(),
-        gradient_calls: calls.1 + counted.gradient_calls(),
+        function_calls: calls.0 + counted.function_calls() - before.0,
+        gradient_calls: calls.1 + counted.gradient_calls() - before.1,
         ..outcome
     };
     observer.observe(&IterRecord {

@@ -148,15 +148,28 @@ pub trait Problem: Sync {
     fn variable_label(&self, i: usize) -> String {
         format!("{} [-]", self.variables()[i].name)
     }
+    /// The design of the last evaluation, when the problem keeps it (a
+    /// [`Counted`] does): a counter wrapped around this one starts from it,
+    /// so that nested counters count alike.
+    fn last_evaluated(&self) -> Option<Vec<f64>> {
+        None
+    }
 }
 
-/// Counts every evaluation of the wrapped problem. A call with gradients
-/// counts as one function call and one gradient call (DOT's convention,
-/// which the paper's Table 5 uses).
+/// Counts every evaluation of the wrapped problem, as DOT (the paper's
+/// Table 5) and scipy's optimizers count: a function call is an
+/// evaluation of f and g at a design not evaluated just before; a call
+/// with gradients counts one gradient call, plus one function call unless
+/// it is at the design of the evaluation just before (DOT asks for the
+/// gradients of the design its line search has accepted, whose f and g it
+/// already has; without its `speculative` option it evaluates no gradient
+/// during the line search).
 pub struct Counted<'a> {
     inner: &'a dyn Problem,
     function_calls: AtomicUsize,
     gradient_calls: AtomicUsize,
+    /// The design of the last evaluation.
+    last: std::sync::Mutex<Option<Vec<f64>>>,
 }
 
 impl<'a> Counted<'a> {
@@ -166,6 +179,7 @@ impl<'a> Counted<'a> {
             inner,
             function_calls: AtomicUsize::new(0),
             gradient_calls: AtomicUsize::new(0),
+            last: std::sync::Mutex::new(inner.last_evaluated()),
         }
     }
     /// Function evaluations so far.
@@ -186,7 +200,17 @@ impl Problem for Counted<'_> {
         self.inner.n_constraints()
     }
     fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
-        self.function_calls.fetch_add(1, Ordering::Relaxed);
+        let known = match self.last.lock() {
+            Ok(mut last) => {
+                let known = last.as_deref() == Some(x);
+                *last = Some(x.to_vec());
+                known
+            }
+            Err(_) => false,
+        };
+        if !(gradients && known) {
+            self.function_calls.fetch_add(1, Ordering::Relaxed);
+        }
         if gradients {
             self.gradient_calls.fetch_add(1, Ordering::Relaxed);
         }
@@ -200,6 +224,9 @@ impl Problem for Counted<'_> {
     }
     fn variable_label(&self, i: usize) -> String {
         self.inner.variable_label(i)
+    }
+    fn last_evaluated(&self) -> Option<Vec<f64>> {
+        self.last.lock().ok().and_then(|l| l.clone())
     }
 }
 
@@ -397,5 +424,26 @@ mod tests {
         assert_eq!(b.wrap(3.0), 1.0);
         assert_eq!(b.difference(0.5, -0.5), 1.0);
         assert!(Variable::bounded("x", 1.0, -1.0).is_err());
+    }
+
+    /// DOT's and scipy's counting: gradients at the design evaluated just
+    /// before add a gradient call only; anywhere else a function call too.
+    #[test]
+    fn gradients_of_the_last_design_count_no_function_call() {
+        let p = testproblems::hs21();
+        let c = Counted::new(&p);
+        c.evaluate(&[2.0, 1.0], false).unwrap();
+        c.evaluate(&[2.0, 1.0], true).unwrap();
+        assert_eq!((c.function_calls(), c.gradient_calls()), (1, 1));
+        c.evaluate(&[3.0, 1.0], true).unwrap();
+        assert_eq!((c.function_calls(), c.gradient_calls()), (2, 2));
+        c.evaluate(&[2.0, 0.0], false).unwrap();
+        c.evaluate(&[3.0, 1.0], true).unwrap();
+        assert_eq!((c.function_calls(), c.gradient_calls()), (4, 3));
+        // A counter around this one knows its last design.
+        let inner = Counted::new(&c);
+        inner.evaluate(&[3.0, 1.0], true).unwrap();
+        assert_eq!((inner.function_calls(), inner.gradient_calls()), (0, 1));
+        assert_eq!((c.function_calls(), c.gradient_calls()), (4, 4));
     }
 }

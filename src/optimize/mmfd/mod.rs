@@ -41,12 +41,14 @@
 //!    `(α/α_last)²`, predicts the next one (the curvature of the limits).
 //!    First trial length: on the first iteration the one that changes f by
 //!    `dobj1`·|f| on the linear model, but at least a `dx1` move; later
-//!    the minimizer of the quadratic model with the secant curvature of
-//!    the Lagrangian along the last step, `α = −f'(0)/(κ|S|²)` with
-//!    `κ = sᵀy/sᵀs`, `s` the scaled step between the last two gradient
-//!    evaluations and `y` the change of `∇f + Σ λ_j ∇g_j` over it (λ the
-//!    binding multipliers of the direction), capped by `dobj2`·|f|; when
-//!    `κ <= 0` the Nocedal–Wright estimates `α_prev f'_prev/f'` and
+//!    the minimizer of the quadratic model with the curvature of the
+//!    Lagrangian along `S`, `α = −f'(0)/(SᵀHS)`: `H` is a damped BFGS
+//!    model (`geometry::Bfgs`) started as `κI` with the secant curvature
+//!    `κ = sᵀy/sᵀs` of the first pair and updated with every later pair
+//!    (`s` the scaled step between two gradient evaluations, `y` the
+//!    change of `∇f + Σ λ_j ∇g_j` over it, λ the binding multipliers of
+//!    the direction), capped by `dobj2`·|f|; without a model the
+//!    Nocedal–Wright estimates `α_prev f'_prev/f'` and
 //!    `2|Δf_prev|/|f'|` capped by `dobj2`·|f|, or the previous α when
 //!    following constraints; always at most a `dx2` move of any variable
 //!    and inside the bounds.
@@ -62,20 +64,24 @@
 //!    crossings; longer extrapolations continue) *with gradients*, as an
 //!    SQP code evaluates its step: accepted (feasible, lower f, the
 //!    followed constraints met without a correction), that evaluation is
-//!    the next iteration's, so the step costs no extra call; otherwise it
-//!    is an ordinary trial. It is evaluated without gradients when the
-//!    fit's f would end the run by a change exit (no iteration would use
-//!    the gradients). This, DOT's idea of not evaluating what a fit
-//!    predicts well, takes about one function call per gradient call in
-//!    the search.
+//!    the next iteration's; otherwise it is an ordinary trial. It is
+//!    evaluated without gradients when the fit's f would end the run by a
+//!    change exit (no iteration would use the gradients), and when the
+//!    followed constraints needed a correction in this search (curved
+//!    limits: the step will be corrected, and gradients at the uncorrected
+//!    point would be wasted). This, DOT's idea of not evaluating what a
+//!    fit predicts well, takes about one function call per gradient call
+//!    in the search.
 //! 6. Convergence: `|Δf| < DABOBJ` or `|Δf|/|f| < DELOBJ` for ITRMOP
 //!    consecutive feasible iterations, or the Kuhn–Tucker test
 //!    `|S| <= kt_tolerance · max(|f|, 1)` (or `max(|∇f|, 1)` with the
 //!    scaled gradient, option `kt_scale`) with the binding constraints
 //!    within CTMIN of their limits.
 //!
-//! Counting follows DOT (and the paper's Table 5): an evaluation with
-//! gradients counts one function call and one gradient call.
+//! Counting follows DOT (and the paper's Table 5) and scipy, see
+//! [`Counted`]: an evaluation with gradients counts one gradient call,
+//! plus one function call unless it is at the design evaluated just before
+//! (the accepted point of a line search).
 
 use super::driver::{self, OptState, Recorded};
 use super::{
@@ -128,6 +134,8 @@ pub struct Mmfd {
     /// The last gradient evaluation's design and scaled gradients of f
     /// and the constraints: the secant curvature of the next iteration.
     secant: Option<Secant>,
+    /// Damped BFGS model of the Lagrangian's curvature (scaled).
+    curvature: geometry::Bfgs,
     /// |Δf| of the last iteration (quadratic first-trial estimate
     /// `α = 2|Δf|/|f'(0)|`, Nocedal & Wright eq. 3.60).
     last_change: f64,
@@ -212,6 +220,7 @@ impl Mmfd {
             fr_count: 0,
             prev_step: None,
             secant: None,
+            curvature: geometry::Bfgs::default(),
             last_change: f64::INFINITY,
             abs_count: 0,
             rel_count: 0,
@@ -517,7 +526,7 @@ impl Mmfd {
         };
         // Secant curvature of the Lagrangian (the binding multipliers of
         // this direction) along the step from the last gradient evaluation.
-        let curvature = self.secant.take().and_then(|(xp, gfp, ggp)| {
+        if let Some((xp, gfp, ggp)) = self.secant.take() {
             let st: Vec<f64> = vars
                 .iter()
                 .enumerate()
@@ -529,10 +538,9 @@ impl Mmfd {
                     *yi += l * (a - b);
                 }
             }
-            let ss = dot(&st, &st);
-            let k = dot(&st, &y) / ss;
-            (ss > 0.0 && k > 0.0 && k.is_finite()).then_some(k)
-        });
+            self.curvature.update(&st, &y);
+        }
+        let curvature = self.curvature.along(&s);
         self.secant = Some((base.x.clone(), gf.clone(), gg.clone()));
         // Kuhn–Tucker test.
         let on_limits = binding.iter().all(|&j| base.g[j].abs() <= o.ctmin);

@@ -25,13 +25,28 @@ pub(super) struct Search<'s> {
     pub(super) s: &'s [f64],
     pub(super) c0: &'s [f64],
     pub(super) binding: &'s [usize],
-    /// Secant curvature `κ = sᵀy / sᵀs` of the Lagrangian along the last
-    /// step (scaled), when positive: the first trial `−f'(0)/(κ|S|²)`.
+    /// Curvature `κ = SᵀHS/|S|²` of the Lagrangian's BFGS model along
+    /// `S` (scaled), when positive: the first trial `−f'(0)/(κ|S|²)`.
     pub(super) curvature: Option<f64>,
     /// Last trial's α and its pull-back beyond `c₀` (scaled): the curvature
     /// of the followed constraints, reused as `(α/α_last)²` times that
     /// pull-back to predict the next trial's (second-order prediction).
     pub(super) learned: std::cell::RefCell<Option<(f64, Vec<f64>)>>,
+}
+
+impl Search<'_> {
+    /// Whether the followed constraints have needed no correction in this
+    /// search (none followed, or the last trial met them as it was): then
+    /// a fitted step is likely accepted as evaluated, and evaluating it
+    /// with gradients saves the next iteration's evaluation. Where the
+    /// limits are curved the step will be corrected, and gradients at the
+    /// uncorrected point would be wasted.
+    fn straight(&self) -> bool {
+        self.learned
+            .borrow()
+            .as_ref()
+            .is_none_or(|(_, pull)| pull.iter().all(|p| *p == 0.0))
+    }
 }
 
 impl Mmfd {
@@ -265,7 +280,10 @@ impl Mmfd {
             // A step that ends the search is evaluated with gradients, which
             // the next iteration reuses when the step is accepted.
             let predicted = phi0 + b * a_new + c * a_new * a_new;
-            let last = full && (!capped || a_new >= limit) && !self.would_stop(sr.base, predicted);
+            let last = full
+                && (!capped || a_new >= limit)
+                && sr.straight()
+                && !self.would_stop(sr.base, predicted);
             let (t, ev) = self.trial_with(problem, sr, a_new, last)?;
             evals += 1;
             full &= !last;

@@ -96,11 +96,11 @@ fn hs21_bound_active() {
     assert_eq!(o.active_constraints, 0);
     assert!((o.x[0] - 2.0).abs() < 1e-12 && o.x[1].abs() < 1e-6);
     assert_eq!(o.termination, Termination::KuhnTucker);
-    assert_eq!(counts(&o), (1, 4, 2));
+    assert_eq!(counts(&o), (1, 3, 2));
     // Infeasible start: 10·3 − 30 − 10 < 0 violates the constraint.
     assert!(p.evaluate(&[3.0, 30.0], false).unwrap().g[0] > 0.0);
     let o = solve(&p, &[3.0, 30.0], &d);
-    assert_eq!(counts(&o), (4, 16, 5));
+    assert_eq!(counts(&o), (4, 14, 5));
 }
 
 #[test]
@@ -109,10 +109,10 @@ fn hs35_feasible_and_infeasible_starts() {
     let d = MmfdOptions::default();
     let o = solve(&p, &p.x0, &d);
     assert_eq!(o.active_constraints, 1);
-    assert_eq!(counts(&o), (7, 15, 7));
+    assert_eq!(counts(&o), (7, 12, 7));
     assert!(p.evaluate(&[2.0; 3], false).unwrap().g[0] > 0.0);
     let o = solve(&p, &[2.0; 3], &d);
-    assert_eq!(counts(&o), (6, 13, 6));
+    assert_eq!(counts(&o), (6, 9, 6));
 }
 
 #[test]
@@ -126,10 +126,10 @@ fn hs43_curved_constraints_are_followed() {
     for (xi, oi) in o.x.iter().zip(&p.optima[0]) {
         assert!((xi - oi).abs() < 5e-3, "{:?}", o.x);
     }
-    assert_eq!(counts(&o), (5, 24, 5));
+    assert_eq!(counts(&o), (5, 20, 5));
     assert!(p.evaluate(&[2.0; 4], false).unwrap().g[0] > 0.0);
     let o = solve(&p, &[2.0; 4], &d);
-    assert_eq!(counts(&o), (10, 58, 13));
+    assert_eq!(counts(&o), (9, 37, 9));
 }
 
 #[test]
@@ -138,10 +138,10 @@ fn hs76_linear_constraints_and_bound() {
     let d = MmfdOptions::default();
     let o = solve(&p, &p.x0, &d);
     assert_eq!(o.active_side_constraints, 1); // x3 = 0
-    assert_eq!(counts(&o), (6, 15, 6));
+    assert_eq!(counts(&o), (7, 12, 7));
     assert!(p.evaluate(&[2.0; 4], false).unwrap().g[0] > 0.0);
     let o = solve(&p, &[2.0; 4], &d);
-    assert_eq!(counts(&o), (9, 21, 9));
+    assert_eq!(counts(&o), (8, 14, 8));
 }
 
 #[test]
@@ -157,11 +157,11 @@ fn hs100_seven_variables() {
     };
     let o = solve(&p, &p.x0, &d);
     assert_eq!(o.active_constraints, 2);
-    assert_eq!(counts(&o), (20, 85, 26));
+    assert_eq!(counts(&o), (17, 58, 19));
     let x_bad = [3.0, 3.0, 0.0, 5.0, 0.0, 1.0, 1.0];
     assert!(p.evaluate(&x_bad, false).unwrap().g[0] > 0.0);
     let o = solve(&p, &x_bad, &d);
-    assert_eq!(counts(&o), (23, 86, 26));
+    assert_eq!(counts(&o), (15, 48, 16));
 }
 
 #[test]
@@ -171,11 +171,11 @@ fn disc_constraint_following() {
     let d = MmfdOptions::default();
     let o = solve(&p, &p.x0, &d);
     assert_eq!(o.active_constraints, 1);
-    assert_eq!(counts(&o), (5, 25, 8));
+    assert_eq!(counts(&o), (6, 29, 7));
     // Infeasible start outside the disc: restoration first.
     let o = solve(&p, &[1.5, 1.5], &d);
     assert_eq!(o.termination, Termination::KuhnTucker);
-    assert_eq!(counts(&o), (5, 14, 7));
+    assert_eq!(counts(&o), (5, 11, 7));
 }
 
 #[test]
@@ -195,7 +195,7 @@ fn periodic_variables_wrap_across_the_seam() {
     for r in &h.0 {
         assert!(r.x.iter().all(|&t| (-90.0..90.0).contains(&t)));
     }
-    assert_eq!(counts(&o), (4, 11, 4));
+    assert_eq!(counts(&o), (4, 10, 4));
 }
 
 #[test]
@@ -369,11 +369,12 @@ fn each_record_reaches_the_observer_when_it_is_made() {
 }
 
 /// The line search's frugality on the Hock–Schittkowski problems of
-/// `benches/mmfd_peers.rs` with DOT's defaults (issue 23): 98 function
-/// calls in all where the previous line search took 110
-/// (results/mmfd_peers/line_search_before.csv), a median of at most 2.5
-/// function calls per gradient call (3.17 before), and every optimum to
-/// 2.2e-4 relative in f (the published optima are cited in
+/// `benches/mmfd_peers.rs` with DOT's defaults (issue 23): at most 79
+/// function calls in all (110 with the first line search,
+/// results/mmfd_peers/line_search_before.csv, counted then with a call
+/// for every evaluation), a median of at most 2 function calls per
+/// gradient call (the issue's target; 3.17 before), and every optimum to
+/// 3.1e-4 relative in f (the published optima are cited in
 /// `plyscape::optimize::testproblems`).
 #[test]
 fn hs_function_calls_with_the_fitted_step() {
@@ -383,9 +384,10 @@ fn hs_function_calls_with_the_fitted_step() {
     for p in [tp::hs21(), tp::hs35(), tp::hs43(), tp::hs76(), tp::hs100()] {
         let o = mmfd::minimize(&p, &p.x0, &d, &mut History::default()).unwrap();
         let rel = (o.f - p.f_opt).abs() / p.f_opt.abs().max(1.0);
-        // DOT's change exits stop HS 100 in its flat valley at 2e-4
-        // (2.0e-4 before, see hs100_seven_variables).
-        assert!(rel <= 2.2e-4, "{}: rel {rel:.3e}", p.name());
+        // DOT's change exits (DELOBJ 1e-3) stop HS 100 in its flat
+        // valley at 3.1e-4 (2.0e-4 with the first line search); the polish
+        // takes it to 2e-9 (results/mmfd_peers).
+        assert!(rel <= 3.1e-4, "{}: rel {rel:.3e}", p.name());
         println!(
             "{}: {} f, {} g, rel {rel:.3e}",
             p.name(),
@@ -396,18 +398,20 @@ fn hs_function_calls_with_the_fitted_step() {
         ratios.push(o.function_calls as f64 / o.gradient_calls as f64);
     }
     ratios.sort_by(f64::total_cmp);
-    assert!(total <= 98, "{total} function calls");
-    assert!(ratios[2] <= 2.5, "median {} ({ratios:?})", ratios[2]);
+    assert!(total <= 79, "{total} function calls");
+    assert!(ratios[2] <= 2.0, "median {} ({ratios:?})", ratios[2]);
 }
 
 /// The paper's problem (studies/sar_optimize.toml, full model) from its
-/// start 55°/−55° with DOT's defaults, as the study's first MMFD run: at
-/// most 19 function and 6 gradient calls (24 f + 5 g before issue 23's
-/// line search), and the optimum of the committed run
-/// (results/sar_optimize/runs.csv, start 0: 50.94972913717°/−48.90972213317°,
-/// f = 0.9089485349) to 0.01° and 1e-6 in f. About 2 s in release.
+/// start 55°/−55° with DOT's defaults, as the study's first MMFD run:
+/// at most 16 function and 5 gradient calls (issue 23's target; 24 f + 5 g
+/// with the first line search, 12 f + 5 g measured), and the best design
+/// known, found independently by IPOP-CMA-ES and made strictly feasible
+/// by the polish (results/sar_explore/comparison.csv, row `cmaes,strict`:
+/// 50.95189259307°/−48.92301018699°, f = 0.9089481415), to 0.01° and 1e-6
+/// in f. About 2 s in release.
 #[test]
-fn sar_from_55_minus_55_in_19_function_and_6_gradient_calls() {
+fn sar_from_55_minus_55_in_16_function_and_5_gradient_calls() {
     let study = plyscape::study::Study::load("studies/sar_optimize.toml").unwrap();
     let p = plyscape::explore::problem(&study).unwrap();
     let o = mmfd::minimize(
@@ -421,11 +425,11 @@ fn sar_from_55_minus_55_in_19_function_and_6_gradient_calls() {
         "SAR: {:?} f = {:.10} g = {:?}, {} f + {} g, {}",
         o.x, o.f, o.g, o.function_calls, o.gradient_calls, o.termination
     );
-    assert!(o.function_calls <= 19 && o.gradient_calls <= 6, "{o:?}");
+    assert!(o.function_calls <= 16 && o.gradient_calls <= 5, "{o:?}");
     assert!(
-        (o.x[0] - 50.94972913717).abs() < 0.01 && (o.x[1] + 48.90972213317).abs() < 0.01,
+        (o.x[0] - 50.95189259307).abs() < 0.01 && (o.x[1] + 48.92301018699).abs() < 0.01,
         "{o:?}"
     );
-    assert!((o.f - 0.9089485349).abs() < 1e-6, "{o:?}");
+    assert!((o.f - 0.9089481415).abs() < 1e-6, "{o:?}");
     assert!(o.g[0] <= MmfdOptions::default().ctmin, "{o:?}");
 }
