@@ -69,8 +69,10 @@ use std::path::Path;
 /// that moves the value of an evaluation (physics, integration, objective
 /// or constraint formulas) or the end of a run, so that `--resume` refuses
 /// tables computed before it. 2: every run's end certified and polished,
-/// MMFD's CTMIN the study's feasibility tolerance (default 1e-6).
-pub const EVALUATION_VERSION: u32 = 2;
+/// MMFD's CTMIN the study's feasibility tolerance (default 1e-6). 3:
+/// MMFD's first trial from a BFGS curvature model; a peak whose largest
+/// sample is at an end of the run located by the end samples' parabola.
+pub const EVALUATION_VERSION: u32 = 3;
 
 /// Relative tolerance of the spot check (see the module doc).
 pub const RECHECK_RTOL: f64 = 1e-9;

@@ -59,6 +59,7 @@ impl SceneSpec {
             baumgarte: self.baumgarte,
             quadratic_velocity: self.has(Effect::QuadraticVelocity),
             divergence_limit: Some(self.divergence_limit),
+            spin_warning_fraction: Some(self.spin_warning_fraction),
             geometric_stiffening: self.has(Effect::GeometricStiffening),
             ..Model::default()
         };
@@ -109,6 +110,13 @@ impl SceneSpec {
                 "divergence_limit",
                 self.divergence_limit,
                 "a factor > 0 of the body size (inf: no divergence guard)",
+            ));
+        }
+        if self.spin_warning_fraction.is_nan() || self.spin_warning_fraction <= 0.0 {
+            return Err(Error::input(
+                "spin_warning_fraction",
+                self.spin_warning_fraction,
+                "a fraction > 0 of the first modal frequency (inf: no warning)",
             ));
         }
         Ok(())

@@ -107,6 +107,13 @@ pub struct SceneSpec {
     /// switches the guard off).
     #[serde(default = "default_divergence_limit")]
     pub divergence_limit: f64,
+    /// Fast-rotation warning: a flexible body without the
+    /// `geometric_stiffening` effect warns once when its frame turns
+    /// faster than this fraction of its first modal frequency
+    /// (`crate::simulate::spin`; > 0, default 0.3, `inf` switches the
+    /// warning off).
+    #[serde(default = "default_spin_warning_fraction")]
+    pub spin_warning_fraction: f64,
     /// The bodies, `[[scene.bodies]]` (may be empty: a scene in which
     /// nothing moves is written without integrating).
     pub bodies: Vec<BodySpec>,
@@ -176,6 +183,10 @@ fn default_baumgarte() -> f64 {
 
 fn default_divergence_limit() -> f64 {
     0.2
+}
+
+fn default_spin_warning_fraction() -> f64 {
+    crate::simulate::spin::SPIN_FRACTION
 }
 
 /// One `[[scene.bodies]]` entry: a rigid body, or a flexible one with a

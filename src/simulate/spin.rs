@@ -10,8 +10,8 @@
 //!
 //! So each flexible body of a scene *without* the `geometric_stiffening`
 //! effect is watched at the output times: the first time the magnitude of
-//! its frame's angular velocity `|ω|` (rad/s) exceeds
-//! [`SPIN_FRACTION`]` · ω_1`, with `ω_1 = √λ_1` the lowest nonzero
+//! its frame's angular velocity `|ω|` (rad/s) exceeds `c · ω_1`, with
+//! `c` the scene's `spin_warning_fraction` (default [`SPIN_FRACTION`]) and `ω_1 = √λ_1` the lowest nonzero
 //! eigenvalue of its modal basis (the first bending frequency of the
 //! basis as built: free or constrained, in rad/s), one warning names the
 //! body, the time, `|ω|` and `ω_1`. A body warns once per run; scenes
@@ -20,8 +20,9 @@
 use crate::mbs::system::BodyKin;
 use crate::mbs::System;
 
-/// The fraction of a flexible body's first frequency above which its
-/// frame's angular speed draws the fast-rotation warning (module doc).
+/// The default fraction of a flexible body's first frequency above which
+/// its frame's angular speed draws the fast-rotation warning (module doc;
+/// the scene's `spin_warning_fraction`).
 pub const SPIN_FRACTION: f64 = 0.3;
 
 /// One flexible body under watch.
@@ -39,6 +40,8 @@ struct Spinning {
 #[derive(Debug, Clone)]
 pub struct SpinWatch {
     bodies: Vec<Spinning>,
+    /// The fraction `c` of the module doc.
+    fraction: f64,
     kin: Vec<BodyKin<f64>>,
     /// The warnings so far, in the order they were raised.
     pub warnings: Vec<String>,
@@ -72,14 +75,15 @@ impl SpinWatch {
         }
         SpinWatch {
             bodies,
+            fraction: sys.model.spin_warning_fraction.unwrap_or(SPIN_FRACTION),
             kin: Vec::new(),
             warnings: Vec::new(),
         }
     }
 
-    /// Check the state `y` at time `t`; a body turning faster than
-    /// [`SPIN_FRACTION`] of its first frequency for the first time adds
-    /// its warning.
+    /// Check the state `y` at time `t`; a body turning faster than the
+    /// fraction of its first frequency for the first time adds its
+    /// warning.
     pub fn observe(&mut self, sys: &System, t: f64, y: &[f64]) {
         if self.bodies.iter().all(|b| b.warned) {
             return;
@@ -87,14 +91,14 @@ impl SpinWatch {
         sys.body_kin(y, &[], &mut self.kin);
         for b in self.bodies.iter_mut().filter(|b| !b.warned) {
             let w = self.kin[b.slot].w.norm();
-            if w > SPIN_FRACTION * b.omega1 {
+            if w > self.fraction * b.omega1 {
                 b.warned = true;
                 self.warnings.push(format!(
                     "warning: body `{}` turns at |ω| = {w:.4} rad/s at t = {t:.4} s, above \
-                     {SPIN_FRACTION} × its first modal frequency {:.4} rad/s, without the \
+                     {} × its first modal frequency {:.4} rad/s, without the \
                      `geometric_stiffening` effect: its deflections are not reliable \
                      (add \"geometric_stiffening\" to [scene] effects)",
-                    sys.model.bodies[sys.moving[b.slot]].name, b.omega1
+                    sys.model.bodies[sys.moving[b.slot]].name, self.fraction, b.omega1
                 ));
             }
         }

@@ -41,6 +41,11 @@ pub struct Model {
     /// modal deflection bound exceeds this factor times the body's size
     /// (`crate::mbs::watch`); `None` (or infinite): no guard.
     pub divergence_limit: Option<f64>,
+    /// Fast-rotation warning: a flexible body without geometric
+    /// stiffening warns when its frame turns faster than this fraction
+    /// of its first modal frequency (`crate::simulate::spin`); `None`:
+    /// the default 0.3.
+    pub spin_warning_fraction: Option<f64>,
 }
 
 /// `∫ scale · Σ terms dt` over energy terms (strain and kinetic energies

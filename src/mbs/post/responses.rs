@@ -15,9 +15,17 @@
 //!   of the parabola through it and its two neighbours (error `O(Δt³)` in
 //!   the value for an output interval `Δt` well below the oscillation
 //!   period; the study's `dt_out` controls it). The sensitivities are
-//!   interpolated to `t*` by the same three-point rule. A peak at the first
-//!   or last output time is taken there (a boundary maximum, whose time
-//!   does not move with the parameters).
+//!   interpolated to `t*` by the same three-point rule. When the largest
+//!   sample is the first or the last, the parabola through the three end
+//!   samples is used the same way: its vertex when it is concave (the
+//!   maximum lies between the end sample and its neighbour), else the end
+//!   sample itself (a boundary maximum, whose time does not move with the
+//!   parameters). The located peak is then continuous when the largest
+//!   sample moves to or from an end: the same three samples give the peak
+//!   on both sides. (Taking the end sample whenever it was the largest
+//!   made the peak jump by the parabola's bump there, a step in the
+//!   constraint that no optimizer can cross and no Kuhn–Tucker test can
+//!   certify.)
 //! - **Final values** are the sum at the end time, with the derivative
 //!   `dE/dp = ∂E/∂y · s(t_end) + ∂E/∂p` ([`energy_lanes`]).
 
@@ -111,13 +119,16 @@ pub fn energy_lanes(
 /// `None` for an empty series.
 pub fn peak(series: &[(f64, f64, Vec<f64>)]) -> Option<(f64, f64, Vec<f64>)> {
     let k = (0..series.len()).max_by(|&a, &b| series[a].1.total_cmp(&series[b].1))?;
-    if k == 0 || k + 1 == series.len() {
+    if series.len() < 3 {
         let (t, v, g) = &series[k];
         return Some((*t, *v, g.clone()));
     }
-    let (t0, v0, g0) = &series[k - 1];
-    let (t1, v1, g1) = &series[k];
-    let (t2, v2, g2) = &series[k + 1];
+    // The three samples around the largest, the three end samples when
+    // it is an end.
+    let c = k.clamp(1, series.len() - 2);
+    let (t0, v0, g0) = &series[c - 1];
+    let (t1, v1, g1) = &series[c];
+    let (t2, v2, g2) = &series[c + 1];
     // Lagrange basis on (t0, t1, t2), evaluated at the vertex.
     let l = |t: f64| {
         [
@@ -135,7 +146,7 @@ pub fn peak(series: &[(f64, f64, Vec<f64>)]) -> Option<(f64, f64, Vec<f64>)> {
     let ts = if a < 0.0 {
         (-b / (2.0 * a)).clamp(*t0, *t2)
     } else {
-        *t1
+        series[k].0
     };
     let w = l(ts);
     let value = w[0] * v0 + w[1] * v1 + w[2] * v2;
@@ -163,11 +174,47 @@ mod tests {
         assert!((t - 0.537).abs() < 1e-12);
         assert!((v - 3.0).abs() < 1e-12);
         assert!((g[0] - 0.537).abs() < 1e-12);
-        // A maximum at the end stays there.
+        // A maximum at the end of a series that rises without a maximum
+        // (linear: no concave parabola) stays there.
         let rising: Vec<(f64, f64, Vec<f64>)> =
             (0..5).map(|k| (k as f64, k as f64, vec![1.0])).collect();
         assert_eq!(peak(&rising).unwrap().0, 4.0);
         assert!(peak(&[]).is_none());
+        // The vertex between the last two samples (0.96 in 0.9..1.0) is
+        // found exactly, with its gradient, although the last sample is
+        // the largest; the same at the start (vertex 0.03).
+        for (vertex, end) in [(0.96, 1.0), (0.03, 0.0)] {
+            let s: Vec<(f64, f64, Vec<f64>)> = (0..11)
+                .map(|k| {
+                    let t = k as f64 * 0.1;
+                    (t, 3.0 - 2.0 * (t - vertex).powi(2), vec![t])
+                })
+                .collect();
+            let (t, v, g) = peak(&s).unwrap();
+            assert!(s.iter().all(|x| x.1 <= s[(end * 10.0) as usize].1));
+            assert!((t - vertex).abs() < 1e-12 && (v - 3.0).abs() < 1e-12);
+            assert!((g[0] - vertex).abs() < 1e-12);
+        }
+    }
+
+    /// The located peak is continuous as the largest sample moves to the
+    /// last one: U(t) = 1 − (t − c)² sampled at 0, 0.1, …, 1 for a vertex c
+    /// sweeping across 0.95, where the largest sample changes from 0.9 to
+    /// 1.0. Before, the peak dropped from ≈1 to U(1.0) = 1 − 0.05² there.
+    #[test]
+    fn peak_is_continuous_when_the_largest_sample_reaches_the_end() {
+        let at = |c: f64| {
+            let s: Vec<(f64, f64, Vec<f64>)> = (0..11)
+                .map(|k| {
+                    let t = k as f64 * 0.1;
+                    (t, 1.0 - (t - c).powi(2), vec![])
+                })
+                .collect();
+            peak(&s).unwrap().1
+        };
+        let (below, above) = (at(0.95 - 1e-9), at(0.95 + 1e-9));
+        assert!((below - above).abs() < 1e-12, "{below} {above}");
+        assert!((above - 1.0).abs() < 1e-12);
     }
 
     #[test]

@@ -43,7 +43,10 @@ fn a_changed_evaluation_is_refused_with_what_changed_and_more_starts_resume() {
         serde_json::from_str(&std::fs::read_to_string(out.join("r/manifest.json")).unwrap())
             .unwrap();
     let fp = &m["commands"]["multistart"]["fingerprint"];
-    assert_eq!(fp["evaluation_version"], 2);
+    assert_eq!(
+        fp["evaluation_version"],
+        plyscape::explore::fingerprint::EVALUATION_VERSION
+    );
     assert_eq!(fp["parts"]["solver"].as_str().unwrap().len(), 16);
 
     // The solver's settings changed: refused, exit code 2, the key named.
@@ -111,7 +114,13 @@ fn a_changed_evaluation_is_refused_with_what_changed_and_more_starts_resume() {
     let text = std::fs::read_to_string(&path).unwrap();
     std::fs::write(
         &path,
-        text.replace("\"evaluation_version\": 2", "\"evaluation_version\": 0"),
+        text.replace(
+            &format!(
+                "\"evaluation_version\": {}",
+                plyscape::explore::fingerprint::EVALUATION_VERSION
+            ),
+            "\"evaluation_version\": 0",
+        ),
     )
     .unwrap();
     let e = explore::run_multistart(&ctx(&s, &out, 1, RESUME))

@@ -259,6 +259,41 @@ fn a_fast_turning_body_without_stiffening_warns_once() {
     assert!(kane_ws4(true).warnings.is_empty());
 }
 
+/// The scene's `spin_warning_fraction` moves the threshold: at 0.5 × 3.80
+/// = 1.90 rad/s the hub reaches it later in the spin-up (Ω(t) above, at
+/// 7.1 s), at `inf` never; a fraction ≤ 0 is refused naming the key.
+#[test]
+fn the_spin_warning_fraction_is_a_scene_key() {
+    let base = shipped_text("kane_spinup_ws4.toml")
+        .replace("t_end = 25.0", "t_end = 8.0")
+        .replace(", \"geometric_stiffening\"]", "]");
+    let with = |value: &str| {
+        base.replacen(
+            "[scene]",
+            &format!("[scene]\nspin_warning_fraction = {value}"),
+            1,
+        )
+    };
+    let sim = run(&with("0.5"));
+    assert_eq!(sim.warnings.len(), 1, "{:?}", sim.warnings);
+    let w = &sim.warnings[0];
+    assert!(w.contains("0.5 ×"), "{w}");
+    let t: f64 = w
+        .split("at t = ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(t > 6.8 && t < 7.4, "{w}");
+    assert!(run(&with("inf")).warnings.is_empty());
+    let e = crate::common::scenes::scene_spec(&with("0.0"))
+        .build()
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("spin_warning_fraction"), "{e}");
+}
+
 #[test]
 fn a_body_welded_to_ground_ends_at_once() {
     // A body locked by a fixed joint has six coordinates and six
