@@ -74,6 +74,7 @@ pub mod config;
 pub mod context;
 pub mod evolve;
 pub mod fingerprint;
+pub mod front;
 pub mod manifest;
 pub mod map;
 pub mod merge;
