@@ -4,10 +4,14 @@
 //! ([`super::settle`]).
 //!
 //! 1. **Anchors** (one per objective `i`, in parallel): minimize `f_i` from
-//!    the problem's start design; then, lexicographically, minimize the sum
+//!    the problem's start design and `anchor_starts − 1` seeded uniform
+//!    random designs, and keep the best end (certified first, then lowest
+//!    `f_i`); then, lexicographically, minimize the sum
 //!    of the other objectives subject to `f_i <= f_i* + τ·max(1, |f_i*|)`
-//!    with `τ = 1e-4` (both [`EpsilonConstraint`] problems from the start
-//!    design). The anchors give the ideal point `z_j = min_i f_j(a_i)`
+//!    with `τ = 1e-4` (both [`EpsilonConstraint`] problems), from the first
+//!    run's end, and once more from the start design when that run does not
+//!    end certified (e.g. an end on ZDT1's `x1 = 0`, where `∂f2/∂x1` is
+//!    unbounded); both runs are counted. The anchors give the ideal point `z_j = min_i f_j(a_i)`
 //!    and the payoff-table nadir `N_j = max_i f_j(a_i)`; the ranges are
 //!    `s_j = N_j − z_j` (1 where that vanishes).
 //! 2. **Subproblems** (in parallel): the augmented reference-point
@@ -18,8 +22,11 @@
 //!    between the anchors, whose ends are the anchors); for three the
 //!    lattice with the most points `≤ K`, edges included, so that the
 //!    front's corners beyond the anchors' triangle are reached. Each starts
-//!    from the problem's start design with `t` at its smallest feasible
-//!    value, `t ∈ [−m − 1, max(t0, 0) + 1]`.
+//!    from the anchors' designs weighted by `λ` (wrapped into the box; the
+//!    problem's start design when an anchor is not certified) with `t` at
+//!    its smallest feasible value, `t ∈ [−m − 1, max(t0, 0) + 1]`, and
+//!    once more from the start design when that run does not end
+//!    certified (both counted).
 //! 3. **The front**: the ends certified `converged` (feasible, Kuhn–Tucker)
 //!    of the lexicographic anchors and the subproblems, evaluated once more
 //!    for their objectives, and of those the non-dominated ones (equal
@@ -39,6 +46,8 @@ use crate::optimize::multiobjective::{
     non_dominated, EpsilonConstraint, MultiProblem, Tchebycheff,
 };
 use crate::optimize::{NoObserver, Observer, Problem};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -58,6 +67,11 @@ pub struct GradientSettings {
     pub mmfd: MmfdOptions,
     /// Certificate and polish of every end.
     pub end: EndPolicy,
+    /// Starts of each anchor's first run: the start design, then uniform
+    /// random designs (>= 1).
+    pub anchor_starts: usize,
+    /// Seed of those random starts.
+    pub seed: u64,
 }
 
 /// One settled end of the gradient side.
@@ -68,8 +82,11 @@ pub struct SubproblemEnd {
     pub label: String,
     /// The run (its design includes `t` for a subproblem).
     pub run: RunRecord,
-    /// The objectives at the end's design (minimized orientation), when
-    /// it is certified.
+    /// The end is certified `converged` (feasible, Kuhn–Tucker).
+    pub certified: bool,
+    /// The objectives at the end's design (minimized orientation), for a
+    /// certified end that enters the front (the lexicographic anchors and
+    /// the subproblems).
     pub f: Option<Vec<f64>>,
 }
 
@@ -96,7 +113,7 @@ pub struct GradientFront {
 impl GradientFront {
     /// How many ends are certified `converged`.
     pub fn certified(&self) -> usize {
-        self.ends.iter().filter(|e| e.f.is_some()).count()
+        self.ends.iter().filter(|e| e.certified).count()
     }
 }
 
@@ -120,6 +137,31 @@ pub fn reference_points(m: usize, k: usize) -> Vec<Vec<f64>> {
         .into_iter()
         .map(|l| l.iter().map(|v| scale * v).collect())
         .collect()
+}
+
+/// The start of the subproblem with reference point `r`: the anchors'
+/// designs weighted by `λ = r/(m − 1)` (wrapped into the box), when every
+/// anchor is certified.
+fn between_anchors(
+    problem: &dyn MultiProblem,
+    anchors: &[Option<Vec<f64>>],
+    r: &[f64],
+) -> Option<Vec<f64>> {
+    let m = anchors.len();
+    let xs: Vec<&Vec<f64>> = anchors.iter().map(|a| a.as_ref()).collect::<Option<_>>()?;
+    let vars = problem.variables();
+    Some(
+        (0..vars.len())
+            .map(|j| {
+                let v: f64 = xs
+                    .iter()
+                    .zip(r)
+                    .map(|(x, l)| x[j] * l / (m - 1) as f64)
+                    .sum();
+                vars[j].wrap(v)
+            })
+            .collect(),
+    )
 }
 
 /// One settled MMFD run of `p` from `x0`.
@@ -160,6 +202,7 @@ fn objectives(
 /// Build the front's gradient side (see the module doc).
 pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Result<GradientFront> {
     let t0 = Instant::now();
+    let tol = s.end.tolerances.feasibility;
     let m = problem.objective_names().len();
     if !(2..=3).contains(&m) {
         return Err(Error::input(
@@ -168,46 +211,108 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
             "2 or 3 objectives",
         ));
     }
-    let tol = s.end.tolerances.feasibility;
     let x0 = problem.start();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(s.threads)
         .build()
         .map_err(|e| Error::input("threads", s.threads, format!("a usable count ({e})")))?;
     let names = problem.objective_names();
-    // 1. Anchors and their lexicographic refinement.
-    let anchors: Vec<(RunRecord, RunRecord)> = pool.install(|| {
+    // 1. Anchors from every start, the best of each objective, and its
+    // lexicographic refinement.
+    let mut starts = vec![x0.clone()];
+    let mut rng = ChaCha8Rng::seed_from_u64(s.seed);
+    for _ in 1..s.anchor_starts.max(1) {
+        starts.push(
+            (problem.variables().iter())
+                .map(|v| v.wrap(v.lower + rng.random::<f64>() * (v.upper - v.lower)))
+                .collect(),
+        );
+    }
+    let pairs: Vec<(usize, usize)> = (0..m)
+        .flat_map(|i| (0..starts.len()).map(move |k| (i, k)))
+        .collect();
+    let firsts: Vec<RunRecord> = pool.install(|| {
+        pairs
+            .par_iter()
+            .map(|&(i, k)| {
+                let mut w = vec![0.0; m];
+                w[i] = 1.0;
+                solve(
+                    &EpsilonConstraint::new(problem, w, vec![]),
+                    s,
+                    i,
+                    &starts[k],
+                )
+            })
+            .collect()
+    });
+    // The best first run per objective: certified first, then lowest f.
+    let best: Vec<RunRecord> = (0..m)
+        .map(|i| {
+            let runs = &firsts[i * starts.len()..(i + 1) * starts.len()];
+            let key = |r: &RunRecord| {
+                let f = r.result.as_ref().map_or(f64::INFINITY, |x| x.f);
+                (
+                    !certified(r, tol),
+                    if f.is_nan() { f64::INFINITY } else { f },
+                )
+            };
+            runs.iter()
+                .min_by(|a, b| {
+                    let (ka, kb) = (key(a), key(b));
+                    ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+                })
+                .expect("at least one start")
+                .clone()
+        })
+        .collect();
+    let anchors: Vec<RunRecord> = pool.install(|| {
         (0..m)
             .into_par_iter()
             .map(|i| {
-                let mut w = vec![0.0; m];
-                w[i] = 1.0;
-                let first = solve(&EpsilonConstraint::new(problem, w, vec![]), s, i, &x0);
+                let first = &best[i];
                 let fi = first.result.as_ref().map(|r| r.f);
-                let second = match fi {
-                    Some(fi) if fi.is_finite() => {
+                let second = match (fi, &first.result) {
+                    (Some(fi), Some(end)) if fi.is_finite() => {
                         let scale = fi.abs().max(1.0);
                         let w = (0..m).map(|j| if j == i { 0.0 } else { 1.0 }).collect();
                         let cap = vec![(i, fi + ANCHOR_CAP * scale, scale)];
-                        solve(&EpsilonConstraint::new(problem, w, cap), s, i, &x0)
+                        let p = EpsilonConstraint::new(problem, w, cap);
+                        let from_end = solve(&p, s, i, &end.x);
+                        if certified(&from_end, tol) {
+                            from_end
+                        } else {
+                            let mut again = solve(&p, s, i, &x0);
+                            again.function_calls += from_end.function_calls;
+                            again.gradient_calls += from_end.gradient_calls;
+                            again
+                        }
                     }
                     _ => first.clone(),
                 };
-                (first, second)
+                second
             })
             .collect()
     });
     let mut extra_calls = 0;
     let mut ends = Vec::new();
-    for (i, (first, second)) in anchors.into_iter().enumerate() {
+    for ((i, k), first) in pairs.iter().zip(firsts) {
         ends.push(SubproblemEnd {
-            label: format!("anchor-{}", names[i]),
+            label: format!("anchor-{}-start-{k}", names[*i]),
+            certified: certified(&first, tol),
             run: first,
             f: None,
         });
+    }
+    let mut anchor_x: Vec<Option<Vec<f64>>> = vec![None; m];
+    for (i, second) in anchors.into_iter().enumerate() {
         let f = objectives(problem, &second, tol, &mut extra_calls)?;
+        if f.is_some() {
+            anchor_x[i] = second.result.as_ref().map(|r| r.x.clone());
+        }
         ends.push(SubproblemEnd {
             label: format!("lexicographic-{}", names[i]),
+            certified: certified(&second, tol),
             run: second,
             f,
         });
@@ -250,7 +355,7 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
         .collect();
     // 2. The subproblems.
     let refs = reference_points(m, s.subproblems);
-    let runs: Vec<Result<RunRecord>> = pool.install(|| {
+    let runs: Vec<Result<(RunRecord, usize)>> = pool.install(|| {
         refs.par_iter()
             .enumerate()
             .map(|(k, r)| {
@@ -261,46 +366,59 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
                     RHO,
                     (-(m as f64) - 1.0, f64::MAX / 4.0),
                 )?;
-                let start = t_probe.start(&x0)?;
-                let t0 = start[x0.len()];
+                let x_start = between_anchors(problem, &anchor_x, r).unwrap_or_else(|| x0.clone());
+                // (x, t0) from the anchors' blend and from the start design
+                // (one evaluation each, counted); t's upper bound admits both.
+                let from_blend = t_probe.start(&x_start)?;
+                let from_x0 = t_probe.start(&x0)?;
+                let t_hi = from_blend[x0.len()].max(from_x0[x0.len()]).max(0.0) + 1.0;
                 let p = Tchebycheff::new(
                     problem,
                     (ideal.clone(), scale.clone()),
                     r.clone(),
                     RHO,
-                    (-(m as f64) - 1.0, t0.max(0.0) + 1.0),
+                    (-(m as f64) - 1.0, t_hi),
                 )?;
-                Ok(solve(&p, s, m + k, &start))
+                let run = solve(&p, s, m + k, &from_blend);
+                if certified(&run, tol) || x_start == x0 {
+                    return Ok((run, 2));
+                }
+                // Once more from the start design (counted together).
+                let mut again = solve(&p, s, m + k, &from_x0);
+                again.function_calls += run.function_calls;
+                again.gradient_calls += run.gradient_calls;
+                Ok((again, 2))
             })
             .collect()
     });
     for (k, run) in runs.into_iter().enumerate() {
-        let run = run?;
+        let (run, probes) = run?;
+        extra_calls += probes;
         let f = objectives(problem, &run, tol, &mut extra_calls)?;
         ends.push(SubproblemEnd {
             label: format!("subproblem-{k}"),
+            certified: certified(&run, tol),
             run,
             f,
         });
     }
     // 3. The non-dominated certified ends.
     let n = problem.variables().len();
-    let certified: Vec<(Vec<f64>, Vec<f64>)> = ends
+    let kept: Vec<(Vec<f64>, Vec<f64>)> = ends
         .iter()
         .filter_map(|e| {
             let f = e.f.clone()?;
             Some((e.run.result.as_ref()?.x[..n].to_vec(), f))
         })
         .collect();
-    let fs: Vec<Vec<f64>> = certified.iter().map(|c| c.1.clone()).collect();
+    let fs: Vec<Vec<f64>> = kept.iter().map(|c| c.1.clone()).collect();
     let points = non_dominated(&fs)
         .into_iter()
-        .map(|i| certified[i].clone())
+        .map(|i| kept[i].clone())
         .collect();
-    // Extra calls: the subproblems' start evaluations (one per Tchebycheff
-    // start) and the final objective evaluations.
-    let function_calls =
-        ends.iter().map(|e| e.run.function_calls).sum::<usize>() + refs.len() + extra_calls;
+    // Extra calls: the subproblems' start evaluations and the final
+    // objective evaluations.
+    let function_calls = ends.iter().map(|e| e.run.function_calls).sum::<usize>() + extra_calls;
     let gradient_calls = ends.iter().map(|e| e.run.gradient_calls).sum();
     Ok(GradientFront {
         points,

@@ -196,8 +196,8 @@ pub struct Series {
     pub line: bool,
 }
 
-/// Draw point sets (filled circles, a distinct colour each; line series
-/// in grey) on linear axes with a legend, e.g. Pareto fronts in objective
+/// Draw point sets (a distinct colour each: the first as rings, the
+/// others as dots; line series in grey) on linear axes with a legend, e.g. Pareto fronts in objective
 /// space.
 pub fn scatter_plot(path: &Path, axes: &Axes, series: &[Series]) -> Result<()> {
     let pts: Vec<Vec<(f64, f64)>> = series
@@ -260,13 +260,21 @@ pub fn scatter_plot(path: &Path, axes: &Axes, series: &[Series]) -> Result<()> {
                     PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1))
                 });
         } else {
+            // The first marker series as rings around the others' dots,
+            // so that points on top of each other stay visible.
             let c = Palette99::pick(colour).to_rgba();
+            let style = if colour == 0 {
+                c.stroke_width(2)
+            } else {
+                c.filled()
+            };
+            let r = if colour == 0 { 5 } else { 3 };
             colour += 1;
             chart
-                .draw_series(p.into_iter().map(|q| Circle::new(q, 3, c.filled())))
+                .draw_series(p.into_iter().map(|q| Circle::new(q, r, style)))
                 .map_err(|e| plot_err(path, e))?
                 .label(s.label.clone())
-                .legend(move |(x, y)| Circle::new((x + 10, y), 3, c.filled()));
+                .legend(move |(x, y)| Circle::new((x + 10, y), r, style));
         }
     }
     chart

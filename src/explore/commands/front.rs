@@ -83,6 +83,11 @@ pub struct FrontSection {
     /// Hypervolume reference point, one value per objective in its own
     /// sign (default: see the module doc).
     pub reference: Option<Vec<f64>>,
+    /// Starts of each single-objective anchor of the gradient side: the
+    /// start design and seeded random designs (default 1: the start design
+    /// only).
+    #[serde(default = "default_anchor_starts")]
+    pub anchor_starts: usize,
     /// Feasible: `max g <= feasibility_tolerance` (default 1e-6), for the
     /// certificate, MMFD's CTMIN and NSGA-II's constraint-domination.
     pub feasibility_tolerance: Option<f64>,
@@ -90,6 +95,10 @@ pub struct FrontSection {
 
 fn default_subproblems() -> usize {
     32
+}
+
+fn default_anchor_starts() -> usize {
+    1
 }
 
 fn default_population() -> usize {
@@ -143,6 +152,9 @@ pub fn check(study: &Study) -> Result<FrontSection> {
     let k = s.objectives.len();
     if !(2..=3).contains(&k) {
         return Err(study.error("front.objectives", format!("({k} objectives)"), "2 or 3"));
+    }
+    if s.anchor_starts == 0 {
+        return Err(study.error("front.anchor_starts", 0, "at least 1 start"));
     }
     if s.subproblems == 0 {
         return Err(study.error("front.subproblems", 0, "at least 1 subproblem"));
@@ -226,6 +238,8 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
             tolerances,
             polish: true,
         },
+        anchor_starts: section.anchor_starts,
+        seed: study.meta.seed,
     };
     let grad = gradient_front(&problem, &settings)?;
     let budget = section.evaluations.unwrap_or(grad.function_calls);
