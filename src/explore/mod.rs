@@ -21,9 +21,11 @@
 //! `[scene_problem]`, [`scene_problem`]), `[multistart]`
 //! ([`MultistartSection`]), `[evolve]` ([`EvolveSection`]), `[compare]` (no
 //! keys), `[map]` ([`MapSection`]), `[scaling]`
-//! ([`scaling::ScalingSection`]) and `[optimum_report]`
+//! ([`scaling::ScalingSection`]), `[optimum_report]`
 //! ([`optimum_report`]: the run from the first start as the paper's
-//! Table 5 and Figs. 10–12, written by the multistart).
+//! Table 5 and Figs. 10–12, written by the multistart) and `[front]`
+//! ([`commands::front`]: the Pareto front of two or three objectives, its
+//! gradient side in [`front`], NSGA-II in [`crate::optimize::nsga2`]).
 //!
 //! Layout: the algorithms are [`multistart`], [`cluster`], [`evolve`],
 //! [`map`] and [`sampling`], over the problems of [`problems`] and
@@ -74,6 +76,7 @@ pub mod config;
 pub mod context;
 pub mod evolve;
 pub mod fingerprint;
+pub mod front;
 pub mod manifest;
 pub mod map;
 pub mod merge;

@@ -18,6 +18,7 @@
 //! measurements of the drivers.
 
 use crate::error::{Error, Result};
+use crate::optimize::multiobjective::MultiProblem;
 use crate::optimize::testproblems as tp;
 use crate::optimize::{Evaluation, Problem, Variable};
 use serde::Deserialize;
@@ -48,11 +49,42 @@ fn default_cost_mode() -> String {
     "spin".into()
 }
 
+/// Names accepted by [`ProblemSpec::build_multi`] (the problems of
+/// `optimize::mo_testproblems`, for `[front]`).
+pub const MULTI_PROBLEM_NAMES: &str = "zdt1, zdt2, zdt3, dtlz2";
+
 /// Names accepted by [`ProblemSpec::build`].
 pub const PROBLEM_NAMES: &str =
     "himmelblau, rosenbrock, rastrigin, hs21, hs22, hs35, hs43, hs76, hs100, disc, seam, periodic2, scene (with [scene_problem])";
 
 impl ProblemSpec {
+    /// Build the named multi-objective problem (`[front]`): one of
+    /// [`MULTI_PROBLEM_NAMES`], with none of the single-objective keys
+    /// (`dimension`, `bounds`, `cost_ms`). Errors name the key within the
+    /// `[problem]` section.
+    pub fn build_multi(&self) -> Result<Box<dyn MultiProblem>> {
+        let p = crate::optimize::mo_testproblems::by_name(&self.name).ok_or_else(|| {
+            Error::input(
+                "name",
+                format!("\"{}\"", self.name),
+                format!("a problem with several objectives for [front]: {MULTI_PROBLEM_NAMES}"),
+            )
+        })?;
+        let unused = [
+            ("dimension", self.dimension.is_some()),
+            ("bounds", self.bounds.is_some()),
+            ("cost_ms", self.cost_ms != 0.0),
+        ];
+        if let Some((key, _)) = unused.iter().find(|(_, set)| *set) {
+            return Err(Error::input(
+                *key,
+                "(given)",
+                format!("no `{key}` for {} (its size and box are fixed)", self.name),
+            ));
+        }
+        Ok(Box::new(p))
+    }
+
     /// Build the named problem (wrapped in [`Costly`] when `cost_ms > 0`).
     /// Errors name the key within the `[problem]` section.
     pub fn build(&self) -> Result<Box<dyn Problem>> {
@@ -99,6 +131,11 @@ impl ProblemSpec {
             "seam" => Box::new(tp::seam()),
             "hs22" => Box::new(Hs22::new()),
             "periodic2" => Box::new(Periodic2::new()),
+            multi @ ("zdt1" | "zdt2" | "zdt3" | "dtlz2") => return Err(Error::input(
+                "name",
+                format!("\"{multi}\""),
+                "a single-objective problem here: it has several objectives, use it with [front]",
+            )),
             "scene" => {
                 return Err(Error::input(
                     "name",

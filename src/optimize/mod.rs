@@ -15,8 +15,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 pub mod cmaes;
 pub mod driver;
+pub mod indicators;
 pub mod kkt;
 pub mod mmfd;
+pub mod mo_testproblems;
+pub mod multiobjective;
+pub mod nsga2;
 pub mod qp;
 pub mod testproblems;
 

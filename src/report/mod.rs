@@ -11,7 +11,9 @@ pub mod lock;
 pub mod manifest;
 pub mod plot;
 
-pub use plot::{heat_map, line_plot, line_plot_floored, Axes, Curve, HeatMap, Scale};
+pub use plot::{
+    heat_map, line_plot, line_plot_floored, scatter_plot, Axes, Curve, HeatMap, Scale, Series,
+};
 
 use crate::error::{Error, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};

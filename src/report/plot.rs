@@ -185,6 +185,107 @@ fn draw_lines(path: &Path, axes: &Axes, curves: &[Curve], floor: Option<f64>) ->
     root.present().map_err(|e| plot_err(path, e))
 }
 
+/// A set of points for [`scatter_plot`]: markers, or a line through the
+/// points in their order.
+pub struct Series {
+    /// Legend label.
+    pub label: String,
+    /// Points `(x, y)`; non-finite ones are left out.
+    pub points: Vec<(f64, f64)>,
+    /// Draw a line through the points instead of markers.
+    pub line: bool,
+}
+
+/// Draw point sets (a distinct colour each: the first as rings, the
+/// others as dots; line series in grey) on linear axes with a legend, e.g. Pareto fronts in objective
+/// space.
+pub fn scatter_plot(path: &Path, axes: &Axes, series: &[Series]) -> Result<()> {
+    let pts: Vec<Vec<(f64, f64)>> = series
+        .iter()
+        .map(|s| {
+            s.points
+                .iter()
+                .copied()
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+                .collect()
+        })
+        .collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y) in pts.iter().flatten() {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    if !(x0.is_finite() && y0.is_finite()) {
+        return Ok(());
+    }
+    let pad = |a: f64, b: f64| {
+        if b > a {
+            0.05 * (b - a)
+        } else {
+            0.5 * a.abs().max(1.0)
+        }
+    };
+    let (px, py) = (pad(x0, x1), pad(y0, y1));
+    let root = SVGBackend::new(path, (800, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(axes.title, ("sans-serif", 20))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0 - px..x1 + px, y0 - py..y1 + py)
+        .map_err(|e| plot_err(path, e))?;
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(axes.x).y_desc(axes.y);
+    if needs_sci(x0, x1) {
+        mesh.x_label_formatter(&sci_tick);
+    }
+    if needs_sci(y0, y1) {
+        mesh.y_label_formatter(&sci_tick);
+    }
+    mesh.draw().map_err(|e| plot_err(path, e))?;
+    let mut colour = 0;
+    for (s, p) in series.iter().zip(pts) {
+        if s.line {
+            let grey = RGBColor(150, 150, 150);
+            chart
+                .draw_series(LineSeries::new(p, grey.stroke_width(1)))
+                .map_err(|e| plot_err(path, e))?
+                .label(s.label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(1))
+                });
+        } else {
+            // The first marker series as rings around the others' dots,
+            // so that points on top of each other stay visible.
+            let c = Palette99::pick(colour).to_rgba();
+            let style = if colour == 0 {
+                c.stroke_width(2)
+            } else {
+                c.filled()
+            };
+            let r = if colour == 0 { 5 } else { 3 };
+            colour += 1;
+            chart
+                .draw_series(p.into_iter().map(|q| Circle::new(q, r, style)))
+                .map_err(|e| plot_err(path, e))?
+                .label(s.label.clone())
+                .legend(move |(x, y)| Circle::new((x + 10, y), r, style));
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| plot_err(path, e))?;
+    root.present().map_err(|e| plot_err(path, e))
+}
+
 /// Hollow triangles on the points where a curve comes down to `floor`
 /// (the first of each run of points at or below it), and one legend entry
 /// for them (none when no point is there).

@@ -133,6 +133,12 @@ pub static SECTIONS: &[Section] = &[
         uses_problem: true,
     },
     Section {
+        key: "front",
+        check: |s| explore::commands::front::check(s).map(|_| ()),
+        run: Some(run_front),
+        uses_problem: false,
+    },
+    Section {
         key: "kernel_bench",
         check: |s| super::kernel_bench::check(s).map(|_| ()),
         run: Some(|c| super::kernel_bench::run_kernel_bench(&c.study, &c.out, c.quiet).map(|_| ())),
@@ -203,6 +209,27 @@ pub static SECTIONS: &[Section] = &[
 /// The section called `key`, if there is one.
 pub fn section(key: &str) -> Option<&'static Section> {
     SECTIONS.iter().find(|s| s.key == key)
+}
+
+/// The `[front]` section: the Pareto front of both methods, its tables and
+/// plot, and its manifest entry (wall time, points and calls per method).
+pub fn run_front(cfg: &RunConfig) -> Result<()> {
+    let t0 = std::time::Instant::now();
+    let dir = cfg.study.output_dir(&cfg.out)?;
+    let report = explore::commands::front::run_front(&cfg.study, &dir, cfg.threads, cfg.quiet)?;
+    let mut entry = serde_json::Map::new();
+    entry.insert("wall_seconds".into(), t0.elapsed().as_secs_f64().into());
+    for mf in &report.methods {
+        entry.insert(
+            mf.method.clone(),
+            serde_json::json!({
+                "points": mf.points.len(),
+                "function_calls": mf.function_calls,
+                "gradient_calls": mf.gradient_calls,
+            }),
+        );
+    }
+    crate::report::record_command(&dir, &cfg.study, cfg.threads, "front", entry, None)
 }
 
 /// The `[modes]` section: panel modal analysis (and its manifest entry).

@@ -44,6 +44,7 @@ fn probe_sections(p: &RefCell<Probe>) {
     section::<ex::EvolveSection>(p, "evolve");
     section::<ex::CompareSection>(p, "compare");
     section::<ex::MapSection>(p, "map");
+    section::<ex::commands::front::FrontSection>(p, "front");
     section::<ex::scaling::ScalingSection>(p, "scaling");
     section::<ex::optimum_report::OptimumReportSection>(p, "optimum_report");
     section::<sec::kernel_bench::BenchSpec>(p, "kernel_bench");

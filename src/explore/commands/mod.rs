@@ -9,5 +9,6 @@
 pub mod compare;
 pub mod convergence;
 pub mod evolve;
+pub mod front;
 pub mod map;
 pub mod multistart;

@@ -1,0 +1,504 @@
+//! Several objectives at once: the least a Pareto front needs.
+//!
+//! A [`MultiProblem`] returns, for a design `x`, the objectives `f_i`
+//! (all minimized), the constraints `g_j(x) <= 0` and, when asked, all
+//! their exact gradients in one call, like [`Problem`] does for one
+//! objective. Objectives a study maximizes are negated by [`Oriented`],
+//! which also picks the study's objectives by name, so that every algorithm
+//! minimizes.
+//!
+//! Dominance (minimization): `a` dominates `b` when `a_i <= b_i` for every
+//! objective and `a_i < b_i` for at least one ([`dominates`]).
+//!
+//! The gradient side of a front solves single-objective problems made from
+//! a [`MultiProblem`] (scalarizations, each a [`Problem`]):
+//! - [`EpsilonConstraint`]: minimize `Σ_i w_i f_i` subject to
+//!   `(f_j − ε_j)/s_j <= 0` for the capped objectives (and the problem's own
+//!   constraints): the single-objective optima and their lexicographic
+//!   refinement.
+//! - [`Tchebycheff`]: the reference-point (Pascoletti–Serafini) form of the
+//!   augmented weighted Tchebycheff problem in normalized objectives
+//!   `u_i = (f_i − z_i)/s_i` (`z` the ideal point, `s` the ideal-to-nadir
+//!   range): minimize `t + ρ Σ_i u_i` over `(x, t)` subject to
+//!   `u_i(x) − r_i − t <= 0` for a reference point `r`. Its solution is the
+//!   point of the front where the ray `r + t·(1, …, 1)` meets it (or the
+//!   front's nearest point in the max-norm when it misses), Pareto optimal
+//!   for `ρ > 0` (Miettinen, *Nonlinear Multiobjective Optimization*,
+//!   Kluwer 1999, Thm 3.4.6); reference points spread evenly over a simplex
+//!   give points spread along the front, convex or not.
+
+use super::{Evaluation, Problem, Variable};
+use crate::error::{Error, Result};
+
+/// What one evaluation of a [`MultiProblem`] returns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MultiEvaluation {
+    /// Objective values (minimized).
+    pub f: Vec<f64>,
+    /// Constraint values, feasible when `g[j] <= 0`.
+    pub g: Vec<f64>,
+    /// Gradient of each objective (k rows of length n) when asked for.
+    pub grad_f: Option<Vec<Vec<f64>>>,
+    /// Gradients of each `g[j]` (m rows of length n) when asked for.
+    pub grad_g: Option<Vec<Vec<f64>>>,
+}
+
+impl MultiEvaluation {
+    /// Largest constraint value (`-inf` without constraints).
+    pub fn max_g(&self) -> f64 {
+        self.g.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// A problem with several objectives, all minimized, subject to
+/// `g(x) <= 0` and the variables' bounds. Deterministic and thread-safe,
+/// like [`Problem`].
+pub trait MultiProblem: Sync {
+    /// The design variables.
+    fn variables(&self) -> &[Variable];
+    /// The objectives' names (`f1`, `f2`, …), in evaluation order.
+    fn objective_names(&self) -> Vec<String>;
+    /// Number of inequality constraints `g_j <= 0`.
+    fn n_constraints(&self) -> usize;
+    /// Evaluate at `x`; with `gradients` also every objective's and
+    /// constraint's gradient.
+    fn evaluate(&self, x: &[f64], gradients: bool) -> Result<MultiEvaluation>;
+    /// Short name for reports.
+    fn name(&self) -> &str;
+    /// Objective `i` with its unit, for plot axes (default: its name, a
+    /// dimensionless test objective).
+    fn objective_label(&self, i: usize) -> String {
+        format!("{} [-]", self.objective_names()[i])
+    }
+    /// The analytic front, sampled (objectives in evaluation order), when
+    /// the problem has a known one (default: none).
+    fn known_front(&self) -> Option<Vec<Vec<f64>>> {
+        None
+    }
+    /// The start design of the gradient side: the centre of the box.
+    fn start(&self) -> Vec<f64> {
+        self.variables()
+            .iter()
+            .map(|v| 0.5 * (v.lower + v.upper))
+            .collect()
+    }
+}
+
+/// Does `a` dominate `b` (minimization)?
+pub fn dominates(a: &[f64], b: &[f64]) -> bool {
+    a.iter().zip(b).all(|(x, y)| x <= y) && a.iter().zip(b).any(|(x, y)| x < y)
+}
+
+/// Indices of the non-dominated points of `points` (minimization), in
+/// their order; of equal points only the first is kept.
+pub fn non_dominated(points: &[Vec<f64>]) -> Vec<usize> {
+    (0..points.len())
+        .filter(|&i| {
+            !points.iter().enumerate().any(|(j, q)| {
+                dominates(q, &points[i]) || (j < i && q.as_slice() == points[i].as_slice())
+            })
+        })
+        .collect()
+}
+
+/// One objective of a study: which of the problem's, and its direction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pick {
+    /// Index among the problem's objectives.
+    pub index: usize,
+    /// Maximized (negated inside, so that every algorithm minimizes).
+    pub maximize: bool,
+}
+
+/// A problem's objectives chosen and oriented: objective `k` is the
+/// problem's `picks[k].index`, negated when maximized.
+pub struct Oriented<'a> {
+    inner: &'a dyn MultiProblem,
+    picks: Vec<Pick>,
+    names: Vec<String>,
+}
+
+impl<'a> Oriented<'a> {
+    /// The objectives named `names` (`maximize[k]` for each) of `inner`;
+    /// an unknown name is an input error at `objectives[k].name`.
+    pub fn new(inner: &'a dyn MultiProblem, names: &[(String, bool)]) -> Result<Self> {
+        let all = inner.objective_names();
+        let mut picks = Vec::new();
+        for (k, (name, maximize)) in names.iter().enumerate() {
+            let index = all.iter().position(|n| n == name).ok_or_else(|| {
+                Error::input(
+                    format!("objectives[{k}].name"),
+                    format!("\"{name}\""),
+                    format!("an objective of {}: {}", inner.name(), all.join(", ")),
+                )
+            })?;
+            picks.push(Pick {
+                index,
+                maximize: *maximize,
+            });
+        }
+        Ok(Oriented {
+            inner,
+            picks,
+            names: names.iter().map(|(n, _)| n.clone()).collect(),
+        })
+    }
+
+    /// The sign that turns a study's value into the minimized one and back
+    /// (`-1` for maximized objectives).
+    pub fn sign(&self, k: usize) -> f64 {
+        if self.picks[k].maximize {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+}
+
+impl MultiProblem for Oriented<'_> {
+    fn variables(&self) -> &[Variable] {
+        self.inner.variables()
+    }
+    fn objective_names(&self) -> Vec<String> {
+        self.names.clone()
+    }
+    fn n_constraints(&self) -> usize {
+        self.inner.n_constraints()
+    }
+    fn evaluate(&self, x: &[f64], gradients: bool) -> Result<MultiEvaluation> {
+        let e = self.inner.evaluate(x, gradients)?;
+        let s: Vec<f64> = (0..self.picks.len()).map(|k| self.sign(k)).collect();
+        Ok(MultiEvaluation {
+            f: self
+                .picks
+                .iter()
+                .zip(&s)
+                .map(|(p, s)| s * e.f[p.index])
+                .collect(),
+            grad_f: e.grad_f.map(|gf| {
+                self.picks
+                    .iter()
+                    .zip(&s)
+                    .map(|(p, s)| gf[p.index].iter().map(|v| s * v).collect())
+                    .collect()
+            }),
+            g: e.g,
+            grad_g: e.grad_g,
+        })
+    }
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+    fn objective_label(&self, k: usize) -> String {
+        self.inner.objective_label(self.picks[k].index)
+    }
+    /// The inner problem's front in the picked order, when every objective
+    /// is picked and minimized (a front of some of the objectives, or with
+    /// one maximized, is another front).
+    fn known_front(&self) -> Option<Vec<Vec<f64>>> {
+        let all = self.inner.objective_names().len();
+        if self.picks.len() != all || self.picks.iter().any(|p| p.maximize) {
+            return None;
+        }
+        let front = self.inner.known_front()?;
+        Some(
+            front
+                .iter()
+                .map(|f| {
+                    (0..self.picks.len())
+                        .map(|k| self.sign(k) * f[self.picks[k].index])
+                        .collect()
+                })
+                .collect(),
+        )
+    }
+    fn start(&self) -> Vec<f64> {
+        self.inner.start()
+    }
+}
+
+/// Minimize `Σ_i w_i f_i` subject to `(f_j − ε_j)/s_j <= 0` for every
+/// capped objective `j` and the problem's own constraints (first). Only
+/// the objectives with `w_i != 0` or a cap enter, so an objective whose
+/// gradient is unbounded somewhere (ZDT's `f2` at `x1 = 0`) does not
+/// spoil a problem that does not use it.
+pub struct EpsilonConstraint<'a> {
+    inner: &'a dyn MultiProblem,
+    weights: Vec<f64>,
+    caps: Vec<(usize, f64, f64)>,
+    name: String,
+}
+
+impl<'a> EpsilonConstraint<'a> {
+    /// Weights `weights` (one per objective) and caps `(j, ε_j, s_j)` with
+    /// `s_j > 0`.
+    pub fn new(
+        inner: &'a dyn MultiProblem,
+        weights: Vec<f64>,
+        caps: Vec<(usize, f64, f64)>,
+    ) -> Self {
+        let name = format!("{}-epsilon", inner.name());
+        EpsilonConstraint {
+            inner,
+            weights,
+            caps,
+            name,
+        }
+    }
+}
+
+impl Problem for EpsilonConstraint<'_> {
+    fn variables(&self) -> &[Variable] {
+        self.inner.variables()
+    }
+    fn n_constraints(&self) -> usize {
+        self.inner.n_constraints() + self.caps.len()
+    }
+    fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
+        let e = self.inner.evaluate(x, gradients)?;
+        let n = x.len();
+        let used = |i: usize| self.weights[i] != 0.0;
+        let f = (0..e.f.len())
+            .filter(|&i| used(i))
+            .map(|i| self.weights[i] * e.f[i])
+            .sum();
+        let mut g = e.g.clone();
+        g.extend(self.caps.iter().map(|&(j, eps, s)| (e.f[j] - eps) / s));
+        let (grad_f, grad_g) = match (e.grad_f, e.grad_g) {
+            (Some(gf), Some(gg)) => {
+                let mut df = vec![0.0; n];
+                for (i, row) in gf.iter().enumerate().filter(|(i, _)| used(*i)) {
+                    for (d, v) in df.iter_mut().zip(row) {
+                        *d += self.weights[i] * v;
+                    }
+                }
+                let mut dg = gg;
+                dg.extend(
+                    self.caps
+                        .iter()
+                        .map(|&(j, _, s)| gf[j].iter().map(|v| v / s).collect()),
+                );
+                (Some(df), Some(dg))
+            }
+            _ => (None, None),
+        };
+        Ok(Evaluation {
+            f,
+            g,
+            grad_f,
+            grad_g,
+        })
+    }
+    fn name(&self) -> &str {
+        &self.name
+    }
+}
+
+/// The augmented reference-point Tchebycheff problem of the module doc
+/// over `(x, t)`: the problem's constraints first, then one
+/// `u_i − r_i − t <= 0` per objective.
+pub struct Tchebycheff<'a> {
+    inner: &'a dyn MultiProblem,
+    ideal: Vec<f64>,
+    scale: Vec<f64>,
+    reference: Vec<f64>,
+    rho: f64,
+    vars: Vec<Variable>,
+    name: String,
+}
+
+impl<'a> Tchebycheff<'a> {
+    /// The problem for reference point `reference` (normalized), with the
+    /// ideal point `ideal`, ranges `scale` (> 0), augmentation `rho`, and
+    /// `t` bounded by `[t_lower, t_upper]`.
+    pub fn new(
+        inner: &'a dyn MultiProblem,
+        (ideal, scale): (Vec<f64>, Vec<f64>),
+        reference: Vec<f64>,
+        rho: f64,
+        (t_lower, t_upper): (f64, f64),
+    ) -> Result<Self> {
+        let mut vars = inner.variables().to_vec();
+        vars.push(Variable::bounded("t", t_lower, t_upper)?);
+        let name = format!("{}-tchebycheff", inner.name());
+        Ok(Tchebycheff {
+            inner,
+            ideal,
+            scale,
+            reference,
+            rho,
+            vars,
+            name,
+        })
+    }
+
+    /// Normalized objectives `u_i = (f_i − z_i)/s_i`.
+    pub fn normalized(&self, f: &[f64]) -> Vec<f64> {
+        f.iter()
+            .zip(self.ideal.iter().zip(&self.scale))
+            .map(|(f, (z, s))| (f - z) / s)
+            .collect()
+    }
+
+    /// The start `(x0, t0)` with `t0 = max_i (u_i(x0) − r_i)` (every added
+    /// constraint satisfied, the largest active), clamped to `t`'s bounds.
+    pub fn start(&self, x0: &[f64]) -> Result<Vec<f64>> {
+        let e = self.inner.evaluate(x0, false)?;
+        let u = self.normalized(&e.f);
+        let t0 = u
+            .iter()
+            .zip(&self.reference)
+            .map(|(u, r)| u - r)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let mut x = x0.to_vec();
+        x.push(self.vars[x0.len()].wrap(t0));
+        Ok(x)
+    }
+}
+
+impl Problem for Tchebycheff<'_> {
+    fn variables(&self) -> &[Variable] {
+        &self.vars
+    }
+    fn n_constraints(&self) -> usize {
+        self.inner.n_constraints() + self.ideal.len()
+    }
+    fn evaluate(&self, xt: &[f64], gradients: bool) -> Result<Evaluation> {
+        let n = self.vars.len() - 1;
+        if xt.len() != n + 1 {
+            return Err(Error::input(
+                "tchebycheff.x",
+                format!("a vector of length {}", xt.len()),
+                format!("length {}", n + 1),
+            ));
+        }
+        let (x, t) = (&xt[..n], xt[n]);
+        let e = self.inner.evaluate(x, gradients)?;
+        let u = self.normalized(&e.f);
+        let f = t + self.rho * u.iter().sum::<f64>();
+        let mut g = e.g.clone();
+        g.extend(u.iter().zip(&self.reference).map(|(u, r)| u - r - t));
+        let (grad_f, grad_g) = match (e.grad_f, e.grad_g) {
+            (Some(gf), Some(gg)) => {
+                let mut df = vec![0.0; n + 1];
+                df[n] = 1.0;
+                let mut dg: Vec<Vec<f64>> = gg
+                    .into_iter()
+                    .map(|mut row| {
+                        row.push(0.0);
+                        row
+                    })
+                    .collect();
+                for (row, s) in gf.iter().zip(&self.scale) {
+                    let mut du: Vec<f64> = row.iter().map(|v| v / s).collect();
+                    for (d, v) in df.iter_mut().zip(&du) {
+                        *d += self.rho * v;
+                    }
+                    du.push(-1.0);
+                    dg.push(du);
+                }
+                (Some(df), Some(dg))
+            }
+            _ => (None, None),
+        };
+        Ok(Evaluation {
+            f,
+            g,
+            grad_f,
+            grad_g,
+        })
+    }
+    fn name(&self) -> &str {
+        &self.name
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optimize::mo_testproblems::{dtlz2, zdt1};
+
+    #[test]
+    fn dominance_and_the_non_dominated_filter() {
+        assert!(dominates(&[1.0, 2.0], &[1.0, 3.0]));
+        assert!(!dominates(&[1.0, 2.0], &[1.0, 2.0]));
+        assert!(!dominates(&[0.0, 3.0], &[1.0, 2.0]));
+        let p = vec![
+            vec![1.0, 2.0],
+            vec![2.0, 1.0],
+            vec![2.0, 2.0],
+            vec![1.0, 2.0],
+            vec![0.5, 3.0],
+        ];
+        assert_eq!(non_dominated(&p), vec![0, 1, 4]);
+    }
+
+    /// Central differences of every objective and constraint of a
+    /// scalarization against its exact gradients.
+    fn check(p: &dyn Problem, x: &[f64]) {
+        let e = p.evaluate(x, true).unwrap();
+        let (gf, gg) = (e.grad_f.unwrap(), e.grad_g.unwrap());
+        for i in 0..x.len() {
+            let h = 1e-6;
+            let (mut a, mut b) = (x.to_vec(), x.to_vec());
+            a[i] += h;
+            b[i] -= h;
+            let (ea, eb) = (
+                p.evaluate(&a, false).unwrap(),
+                p.evaluate(&b, false).unwrap(),
+            );
+            let fd = (ea.f - eb.f) / (2.0 * h);
+            assert!((fd - gf[i]).abs() < 1e-6 * (1.0 + fd.abs()), "df/dx{i}");
+            for (j, row) in gg.iter().enumerate() {
+                let fd = (ea.g[j] - eb.g[j]) / (2.0 * h);
+                assert!((fd - row[i]).abs() < 1e-6 * (1.0 + fd.abs()), "dg{j}/dx{i}");
+            }
+        }
+    }
+
+    #[test]
+    fn scalarizations_have_exact_gradients() {
+        let z = zdt1();
+        let x: Vec<f64> = (0..30).map(|i| 0.1 + 0.025 * i as f64).collect();
+        check(
+            &EpsilonConstraint::new(&z, vec![1.0, 0.0], vec![(1, 0.4, 2.0)]),
+            &x,
+        );
+        let t = Tchebycheff::new(
+            &z,
+            (vec![0.0, 0.0], vec![1.0, 2.0]),
+            vec![0.3, 0.7],
+            1e-3,
+            (-2.0, 20.0),
+        )
+        .unwrap();
+        let mut xt = x.clone();
+        xt.push(0.2);
+        check(&t, &xt);
+        // Maximizing −f2 is minimizing f2: same values, same gradients.
+        let d = dtlz2();
+        let o = Oriented::new(&d, &[("f3".into(), false), ("f1".into(), true)]).unwrap();
+        let x: Vec<f64> = (0..12).map(|i| 0.2 + 0.05 * i as f64).collect();
+        let (eo, ed) = (o.evaluate(&x, true).unwrap(), d.evaluate(&x, true).unwrap());
+        assert_eq!(eo.f, vec![ed.f[2], -ed.f[0]]);
+        assert_eq!(eo.grad_f.unwrap()[1][3], -ed.grad_f.unwrap()[0][3]);
+        let e = Oriented::new(&d, &[("f4".into(), false)]).err().unwrap();
+        assert!(e.to_string().contains("objectives[0].name"), "{e}");
+    }
+
+    #[test]
+    fn the_tchebycheff_start_satisfies_its_constraints() {
+        let z = zdt1();
+        let t = Tchebycheff::new(
+            &z,
+            (vec![0.0, 0.0], vec![1.0, 1.0]),
+            vec![0.5, 0.5],
+            1e-4,
+            (-2.0, 20.0),
+        )
+        .unwrap();
+        let x0 = vec![0.5; 30];
+        let e = t.evaluate(&t.start(&x0).unwrap(), false).unwrap();
+        assert!(e.max_g().abs() < 1e-12, "{:?}", e.g);
+    }
+}
