@@ -215,5 +215,6 @@ pub(super) fn modal_geometric(
         n,
         cases,
         derivatives,
+        point_nodes: Vec::new(),
     })
 }

@@ -44,6 +44,9 @@ pub struct Counters {
     pub quadratic: Cell<u64>,
     /// Modal damping forces evaluated (per flexible body).
     pub modal_damping: Cell<u64>,
+    /// Back-substitutions of the joint-load prestress iteration
+    /// (`crate::mbs::constraints::prestress`).
+    pub prestress_iterations: Cell<u64>,
 }
 
 /// The assembled system: model + state layout.
