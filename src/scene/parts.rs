@@ -15,9 +15,16 @@ use nalgebra::{Matrix3, Vector3};
 
 /// Builds the modal basis of a `kind = "panel"` body: `(panel name,
 /// modes, derivatives, geometric)` → basis, with the modal geometric
-/// stiffness of the inertial load cases when `geometric` (the scene's
-/// `geometric_stiffening`); errors name the study's keys.
-pub type PanelBases<'a> = &'a dyn Fn(&str, usize, Option<ModeUpdate>, bool) -> Result<ModalBasis>;
+/// stiffness of the inertial load cases when `geometric` is given (the
+/// scene's `geometric_stiffening`) and the point-force cases at the
+/// panel-frame joint points it lists; errors name the study's keys.
+pub type PanelBases<'a> =
+    &'a dyn Fn(&str, usize, Option<ModeUpdate>, Stiffening) -> Result<ModalBasis>;
+
+/// The geometric stiffening a panel basis is built with: `None` (none),
+/// or the inertial cases and the point cases at these panel-frame joint
+/// points (m).
+pub type Stiffening<'a> = Option<&'a [Vector3<f64>]>;
 
 fn vec3(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
@@ -381,15 +388,20 @@ pub(super) fn flexible_body(
                     "a rigid-body content share in (0, 1] (1 keeps every mode)",
                 ));
             }
-            panels(panel, f.modes, f.derivatives, geometric)
-                .map_err(|e| match e {
-                    // The mode count is this body's key, not the panel's.
-                    Error::Input { key, expected, .. } if key.ends_with("n_modes") => {
-                        Error::input(format!("{fk}.modes"), f.modes, expected)
-                    }
-                    e => e,
-                })?
-                .screened(limit)?
+            panels(
+                panel,
+                f.modes,
+                f.derivatives,
+                geometric.then_some(&local[..]),
+            )
+            .map_err(|e| match e {
+                // The mode count is this body's key, not the panel's.
+                Error::Input { key, expected, .. } if key.ends_with("n_modes") => {
+                    Error::input(format!("{fk}.modes"), f.modes, expected)
+                }
+                e => e,
+            })?
+            .screened(limit)?
         }
     };
     basis.validate(&fk)?;
