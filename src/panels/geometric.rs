@@ -19,9 +19,9 @@
 //!   `INREL`): `f_k ← (I − M R Rᵀ) f_k` with the M-orthonormal rigid modes
 //!   `R`, and `u_k` the solution M-orthogonal to `R`
 //!   ([`crate::modal::ModalSolver::solve_static`]). The joint reactions of
-//!   the mechanism are not known when the basis is built, so they are not
-//!   part of the prestress; on a free–free panel their share of the load
-//!   is the part inertia relief takes off.
+//!   the mechanism are not known when the basis is built; they enter at
+//!   run time through the joint-load cases below (their own stress
+//!   fields, solved the same way).
 //!
 //! Per element the membrane resultants are `N_k = A ε(u_k) + B κ(u_k)`
 //! (N/m per unit coefficient; constant over the CST), and the geometric

@@ -1,5 +1,6 @@
 //! Geometric (dynamic) stiffening of floating-frame bodies: the modal
-//! geometric stiffness of the inertial prestress, as unit load cases.
+//! geometric stiffness of the inertial and joint-load prestress, as unit
+//! load cases.
 //!
 //! ## Why
 //! The linear floating-frame model (paper Eqs. 5–6) keeps the elastic
