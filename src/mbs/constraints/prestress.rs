@@ -106,6 +106,38 @@ impl System {
         !ws.pcols.is_empty()
     }
 
+    /// Record a prestress iteration that did not converge (time NaN until
+    /// [`System::rhs`] sets it): the bodies with joint-load columns and
+    /// the last two iterates' largest change.
+    pub(crate) fn note_prestress_failure<T: Scalar>(
+        &self,
+        ws: &Workspace<T>,
+        last: &[f64],
+        before: &[f64],
+    ) {
+        let mut bodies: Vec<&str> = Vec::new();
+        for &(_, s, _) in &ws.pcols {
+            let name = self.model.bodies[self.moving[s]].name.as_str();
+            if !bodies.contains(&name) {
+                bodies.push(name);
+            }
+        }
+        let change = last
+            .iter()
+            .zip(before)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let size = last.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        *self.counters.prestress_failure.borrow_mut() = Some((
+            f64::NAN,
+            format!(
+                "the joint-load prestress iteration of body {} did not converge in \
+                 {PRESTRESS_ITERATIONS} back-substitutions (last change {change:.3e} of |λ| \
+                 {size:.3e})",
+                bodies.join(", ")
+            ),
+        ));
+    }
+
     /// `out = B λ` (velocity layout, modal entries only) with the real
     /// parts of the columns (`lane = None`) or lane `l` of them (`B' λ`).
     pub(crate) fn prestress_force<T: Scalar>(

@@ -220,7 +220,9 @@ impl System {
                 (&mut z, &mut r, &mut next),
             );
             if !ok {
-                // Non-finite accelerations: the integrator reports the time.
+                // Non-finite accelerations end the run; the time and the
+                // bodies go into its error (System::rhs, simulate).
+                self.note_prestress_failure(ws, &lam, &next);
                 lam.fill(f64::NAN);
             }
             (sol.lam, sol.bz, sol.prhs, sol.plam, sol.dropped) = (lam, z, r, next, dropped);

@@ -47,6 +47,10 @@ pub struct Counters {
     /// Back-substitutions of the joint-load prestress iteration
     /// (`crate::mbs::constraints::prestress`).
     pub prestress_iterations: Cell<u64>,
+    /// The last evaluation whose prestress iteration did not converge:
+    /// time (s) and what failed (bodies, last change), for the error of
+    /// the run it ends.
+    pub prestress_failure: std::cell::RefCell<Option<(f64, String)>>,
 }
 
 /// The assembled system: model + state layout.
