@@ -358,7 +358,43 @@ impl Beam {
             n,
             cases,
             derivatives: Vec::new(),
+            point_nodes: Vec::new(),
         }
+    }
+
+    /// The three point-force cases ([`crate::mbs::model::geometric`],
+    /// joint-load prestress) of a unit force at the axis point `x = x_p`
+    /// for the basis columns `order`: held at the clamped root, a unit
+    /// force along body x puts the axial force `N = 1` (tension) into
+    /// `[0, x_p]` and none beyond, so `K_{P,x,ij} = ∫₀^{x_p} φ_i' φ_j' dx`
+    /// (same plane, by `segments` × [`GAUSS_POINTS`] Gauss points on
+    /// `[0, x_p]`); a transverse unit force bends the beam without axial
+    /// force, so `K_{P,y} = K_{P,z} = 0`. Three n × n blocks, row-major
+    /// (1/s² per N).
+    pub fn point_cases(&self, order: &[(Plane, usize)], segments: usize, x_p: f64) -> Vec<f64> {
+        let n = order.len();
+        let fns: Vec<ModeFn> = (0..order.iter().map(|o| o.1 + 1).max().unwrap_or(0))
+            .map(|j| ModeFn::new(j, self.length, self.rho_a))
+            .collect();
+        let (gx, gw) = gauss_legendre(GAUSS_POINTS);
+        let x_p = x_p.clamp(0.0, self.length);
+        let h = x_p / segments.max(1) as f64;
+        let mut out = vec![0.0; 3 * n * n];
+        for s in 0..segments.max(1) {
+            for (xi, wi) in gx.iter().zip(&gw) {
+                let x = (s as f64 + 0.5 * (1.0 + xi)) * h;
+                let w = 0.5 * h * wi;
+                let d: Vec<f64> = order.iter().map(|&(_, j)| fns[j].eval(x)[1]).collect();
+                for (i, oi) in order.iter().enumerate() {
+                    for (j, oj) in order.iter().enumerate() {
+                        if oi.0 == oj.0 {
+                            out[i * n + j] += w * d[i] * d[j];
+                        }
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// Static deflection `(v(x), v'(x))` (m, rad) in `plane` of the

@@ -79,10 +79,12 @@
 //!   (`crate::scene::forces`).
 //!
 //! ## Limitations
-//! - Linear elasticity in a floating frame: no geometric stiffening, so a
-//!   fast-spinning flexible body softens by about `Ω²/ω₁²` (the classic
-//!   spin-up limitation of the linear floating frame; the beam spin-up
-//!   study shows the size).
+//! - Linear elasticity in a floating frame: without the effect
+//!   `geometric_stiffening` a fast-spinning flexible body softens by about
+//!   `Ω²/ω₁²` (the classic spin-up limitation of the linear floating frame;
+//!   the beam spin-up study shows the size); with it the geometric
+//!   stiffness of the inertial and joint-load prestress is kept to first
+//!   order ([`model::geometric`]), joint moments not loaded.
 //! - A revolute relative angle is measured in (−π, π]; marker frames are
 //!   set so that the scene's initial angle sits inside that range. A
 //!   driven joint's prescribed angle is compared modulo 2π.

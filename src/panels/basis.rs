@@ -146,6 +146,9 @@ pub struct BasisBuilder {
     analysis: PanelAnalysis,
     update: Option<ModeUpdate>,
     geometric: bool,
+    /// Panel-frame points whose nearest mesh nodes get the point-force
+    /// cases of the joint-load prestress.
+    points: Vec<Vector3<f64>>,
 }
 
 /// Lumped node masses of a panel: translational (kg) and rotary
@@ -164,6 +167,7 @@ impl BasisBuilder {
             analysis: PanelAnalysis::new(panel, derivatives)?,
             update: derivatives,
             geometric: false,
+            points: Vec::new(),
         })
     }
 
@@ -174,6 +178,34 @@ impl BasisBuilder {
     /// Off by default (12 static solves and, per design variable, 12 more).
     pub fn set_geometric(&mut self, on: bool) {
         self.geometric = on;
+    }
+
+    /// The joint points (panel frame, m) whose mesh nodes get the three
+    /// point-force cases of the joint-load prestress with the geometric
+    /// stiffness (`panels::geometric`; 3 more static solves per node and
+    /// per design variable). A point farther than 1e-6 of the panel's
+    /// size from every node is skipped (the scene refuses such a marker).
+    pub fn set_joint_points(&mut self, points: &[Vector3<f64>]) {
+        self.points = points.to_vec();
+    }
+
+    /// The distinct mesh nodes at the joint points, in the order first met.
+    fn joint_nodes(&self) -> Vec<usize> {
+        let nodes = &self.analysis.panel.mesh.nodes;
+        let at = |k: usize| Vector3::new(nodes[k][0], nodes[k][1], 0.0);
+        let size = (0..nodes.len()).fold(1e-3f64, |m, k| m.max(at(k).norm()));
+        let mut out = Vec::new();
+        for p in &self.points {
+            let near = (0..nodes.len())
+                .map(|k| (k, (at(k) - p).norm()))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some((k, d)) = near {
+                if d <= 1e-6 * size && !out.contains(&k) {
+                    out.push(k);
+                }
+            }
+        }
+        out
     }
 
     /// The basis of the panel with lay-up `laminate` (same ply count as the
@@ -233,6 +265,7 @@ impl BasisBuilder {
                 laminate,
                 x,
                 &dmodes,
+                &self.joint_nodes(),
             )?)
         } else {
             None
@@ -337,29 +370,33 @@ pub fn panel_basis(
     n_modes: usize,
     derivatives: Option<ModeUpdate>,
 ) -> Result<ModalBasis> {
-    panel_basis_geometric(panel, n_modes, derivatives, false)
+    panel_basis_geometric(panel, n_modes, derivatives, None)
 }
 
 /// [`panel_basis`] with the modal geometric stiffness of the inertial
-/// unit load cases ([`BasisBuilder::set_geometric`]) when `geometric`.
+/// unit load cases ([`BasisBuilder::set_geometric`]) when `geometric` is
+/// given, and the point-force cases at the nodes of the panel-frame
+/// joint points it lists ([`BasisBuilder::set_joint_points`]).
 pub fn panel_basis_geometric(
     panel: &Panel,
     n_modes: usize,
     derivatives: Option<ModeUpdate>,
-    geometric: bool,
+    geometric: Option<&[Vector3<f64>]>,
 ) -> Result<ModalBasis> {
     if n_modes == 0 {
         return Err(Error::input("n_modes", 0, "at least 1 mode"));
     }
     let mut builder = BasisBuilder::new(panel, derivatives)?;
-    builder.set_geometric(geometric);
+    builder.set_geometric(geometric.is_some());
+    builder.set_joint_points(geometric.unwrap_or(&[]));
     builder
         .basis(&panel.laminate, n_modes)
         .map_err(|e| in_panel(e, &panel.name))
 }
 
 /// [`panel_basis`] for the panel named `name` in the study's `[[panels]]`
-/// section (with the geometric stiffness when `geometric`). Errors name
+/// section (with the geometric stiffness and joint points of `geometric`,
+/// as [`panel_basis_geometric`]). Errors name
 /// the study file: an unknown name is an input error on key `panels.name`
 /// listing the names available; errors of the panel entry carry
 /// `panels[i]`.
@@ -368,7 +405,7 @@ pub fn basis_for_study(
     name: &str,
     n_modes: usize,
     derivatives: Option<ModeUpdate>,
-    geometric: bool,
+    geometric: Option<&[Vector3<f64>]>,
 ) -> Result<ModalBasis> {
     if n_modes == 0 {
         return Err(Error::input("n_modes", 0, "at least 1 mode"));

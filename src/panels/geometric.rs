@@ -19,9 +19,9 @@
 //!   `INREL`): `f_k ← (I − M R Rᵀ) f_k` with the M-orthonormal rigid modes
 //!   `R`, and `u_k` the solution M-orthogonal to `R`
 //!   ([`crate::modal::ModalSolver::solve_static`]). The joint reactions of
-//!   the mechanism are not known when the basis is built, so they are not
-//!   part of the prestress; on a free–free panel their share of the load
-//!   is the part inertia relief takes off.
+//!   the mechanism are not known when the basis is built; they enter at
+//!   run time through the joint-load cases below (their own stress
+//!   fields, solved the same way).
 //!
 //! Per element the membrane resultants are `N_k = A ε(u_k) + B κ(u_k)`
 //! (N/m per unit coefficient; constant over the CST), and the geometric
@@ -31,6 +31,14 @@
 //! one). Projected on the mass-normalized modes `X` (w rows):
 //! `K_k,ij = Σ_e A_e (∇w_i)ᵀ N_k,e ∇w_j`, units of the table in
 //! [`crate::mbs::model::geometric`].
+//!
+//! # Joint-load cases
+//! For each joint node `P` ([`crate::mbs::model::geometric`], "Joint-load
+//! prestress") the load is a unit force `e_a` on the translations of `P`
+//! (no mass factor), solved and projected exactly as above — on a
+//! free–free panel inertia relief balances it by the rigid-body
+//! acceleration, which is what the rest of the mechanism's joints and
+//! the panel's own inertia share. Units: 1/s² per N.
 //!
 //! # Ply-angle derivatives (exact)
 //! For a design variable `θ` with `K' = dK/dθ` (paper Eq. 20) and
@@ -117,7 +125,11 @@ fn add_block(k: &mut [f64], area: f64, n: [f64; 3], ga: &[[f64; 2]], gb: &[[f64;
 /// The modal geometric stiffness of the unit load cases (module doc) for
 /// the modes `x` (free DOFs × n, mass-normalized) of the analysis's last
 /// run with lay-up `laminate`, and its derivative for each design
-/// variable `v` with `dmodes[v]` = `dX/dθ_v` (None: fixed-mode, `dX = 0`).
+/// variable `v` with `dmodes[v]` = `dX/dθ_v` (None: fixed-mode, `dX = 0`);
+/// after the inertial cases, the three point-force cases of each mesh
+/// node in `points` (joint-load prestress: a unit force along x, y, z on
+/// the node's translations, held like the inertial cases; a force on a
+/// supported DOF goes into the support and stresses nothing).
 /// The derivatives need the analysis's `dK/dθ_v` (built with mode
 /// derivatives).
 pub(super) fn modal_geometric(
@@ -125,6 +137,7 @@ pub(super) fn modal_geometric(
     laminate: &Laminate,
     x: &Mat<f64>,
     dmodes: &[Option<&Mat<f64>>],
+    points: &[usize],
 ) -> Result<Geometric> {
     let (sys, mesh) = (&an.sys, &an.panel.mesh);
     let (nd, n) = (sys.m_diag.len(), x.ncols());
@@ -138,10 +151,19 @@ pub(super) fn modal_geometric(
             ),
         ));
     }
-    let mut u = Mat::<f64>::from_fn(nd, CASES, |f, k| {
+    let cols = CASES + 3 * points.len();
+    let mut u = Mat::<f64>::from_fn(nd, cols, |f, k| {
         let (node, comp) = sys.dof_map[f];
         if comp >= 3 {
             return 0.0;
+        }
+        if k >= CASES {
+            let (p, a) = ((k - CASES) / 3, (k - CASES) % 3);
+            return if points[p] == node && a == comp {
+                1.0
+            } else {
+                0.0
+            };
         }
         let p = mesh.nodes[node];
         sys.m_diag[f] * case_load(k, &Vector3::new(p[0], p[1], 0.0))[comp]
@@ -163,8 +185,8 @@ pub(super) fn modal_geometric(
         dst.push(laminate.design_derivative(&an.panel.design, v));
     }
     let nn = n * n;
-    let mut cases = vec![0.0; CASES * nn];
-    let mut derivatives = vec![vec![0.0; CASES * nn]; dmodes.len()];
+    let mut cases = vec![0.0; cols * nn];
+    let mut derivatives = vec![vec![0.0; cols * nn]; dmodes.len()];
     for (e, nodes) in mesh.triangles.iter().enumerate() {
         let (tri, _) = an.model.element(e);
         let ops = an.model.element_ops(e);
@@ -173,7 +195,7 @@ pub(super) fn modal_geometric(
             .iter()
             .map(|d| d.map(|d| mode_slopes(an, tri, nodes, d)))
             .collect();
-        for k in 0..CASES {
+        for k in 0..cols {
             let q = element_vector(an, nodes, &u, k);
             let nk = tri.membrane_resultants(ops, &st.a, &st.b, &q);
             let block = &mut cases[k * nn..(k + 1) * nn];
@@ -194,7 +216,7 @@ pub(super) fn modal_geometric(
     }
     // Exact symmetry (the sums above are symmetric up to rounding).
     for m in std::iter::once(&mut cases).chain(derivatives.iter_mut()) {
-        for k in 0..CASES {
+        for k in 0..cols {
             for i in 0..n {
                 for j in 0..i {
                     let (a, b) = (k * nn + i * n + j, k * nn + j * n + i);
@@ -215,5 +237,6 @@ pub(super) fn modal_geometric(
         n,
         cases,
         derivatives,
+        point_nodes: points.to_vec(),
     })
 }

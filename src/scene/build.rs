@@ -143,6 +143,13 @@ impl SceneSpec {
                             "a moving body (a fixed body cannot be flexible)",
                         ));
                     }
+                    // Joint points on this body (for the joint-load prestress).
+                    let joints: Vec<Vector3<f64>> = self
+                        .joints
+                        .iter()
+                        .filter(|j| j.body_i == b.name || j.body_j == b.name)
+                        .map(|j| Vector3::from(j.point))
+                        .collect();
                     flexible_body(
                         &key,
                         &b.name,
@@ -151,6 +158,7 @@ impl SceneSpec {
                             self.has(Effect::Damping),
                             self.has(Effect::GeometricStiffening),
                         ),
+                        &joints,
                         panels,
                     )?
                 }

@@ -15,6 +15,7 @@
 //! gives it back.
 
 use super::build::Scene;
+use super::parts::Stiffening;
 use super::spec::{FlexKind, OutputSpec, SceneSpec};
 use crate::error::{Error, Result};
 use crate::fe::Panel;
@@ -50,7 +51,7 @@ pub struct BuildProfile {
 pub fn load_scene(study: &Study) -> Result<Scene> {
     let mut spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
     spec.prune_derivatives();
-    let panels = |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: bool| {
+    let panels = |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: Stiffening| {
         crate::panels::basis_for_study(study, name, modes, update, geometric)
     };
     spec.build_with(&panels).map_err(study.locate("scene"))
@@ -187,16 +188,17 @@ impl ScenePlan {
         }
         spec.prune_derivatives();
         let profile = Cell::new(BuildProfile::default());
-        let bases = |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: bool| {
-            let t = Instant::now();
-            let basis = self.basis(name, modes, (update, geometric), laminates);
-            let mut p = profile.get();
-            p.bases += 1;
-            p.derivative_bases += usize::from(update.is_some());
-            p.bases_seconds += t.elapsed().as_secs_f64();
-            profile.set(p);
-            basis
-        };
+        let bases =
+            |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: Stiffening| {
+                let t = Instant::now();
+                let basis = self.basis(name, modes, (update, geometric), laminates);
+                let mut p = profile.get();
+                p.bases += 1;
+                p.derivative_bases += usize::from(update.is_some());
+                p.bases_seconds += t.elapsed().as_secs_f64();
+                profile.set(p);
+                basis
+            };
         let scene = spec
             .build_with(&bases)
             .map_err(self.study.locate("scene"))?;
@@ -211,7 +213,7 @@ impl ScenePlan {
         &self,
         name: &str,
         modes: usize,
-        (update, geometric): (Option<ModeUpdate>, bool),
+        (update, geometric): (Option<ModeUpdate>, Stiffening),
         laminates: &[Laminate],
     ) -> Result<ModalBasis> {
         if modes == 0 {
@@ -240,7 +242,8 @@ impl ScenePlan {
                 builder: BasisBuilder::new(&self.panels[i], update).map_err(located)?,
             },
         };
-        prepared.builder.set_geometric(geometric);
+        prepared.builder.set_geometric(geometric.is_some());
+        prepared.builder.set_joint_points(geometric.unwrap_or(&[]));
         let basis = prepared
             .builder
             .basis(&laminates[i], modes)

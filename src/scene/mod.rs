@@ -114,6 +114,6 @@ pub mod spec;
 
 pub use build::Scene;
 pub use load::{load_scene, BuildProfile, ScenePlan};
-pub use parts::PanelBases;
+pub use parts::{PanelBases, Stiffening};
 pub use quantity::{Quantity, QuantityKind, Response};
 pub use spec::{Effect, SceneSpec};

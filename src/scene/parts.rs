@@ -15,9 +15,16 @@ use nalgebra::{Matrix3, Vector3};
 
 /// Builds the modal basis of a `kind = "panel"` body: `(panel name,
 /// modes, derivatives, geometric)` → basis, with the modal geometric
-/// stiffness of the inertial load cases when `geometric` (the scene's
-/// `geometric_stiffening`); errors name the study's keys.
-pub type PanelBases<'a> = &'a dyn Fn(&str, usize, Option<ModeUpdate>, bool) -> Result<ModalBasis>;
+/// stiffness of the inertial load cases when `geometric` is given (the
+/// scene's `geometric_stiffening`) and the point-force cases at the
+/// panel-frame joint points it lists; errors name the study's keys.
+pub type PanelBases<'a> =
+    &'a dyn Fn(&str, usize, Option<ModeUpdate>, Stiffening) -> Result<ModalBasis>;
+
+/// The geometric stiffening a panel basis is built with: `None` (none),
+/// or the inertial cases and the point cases at these panel-frame joint
+/// points (m).
+pub type Stiffening<'a> = Option<&'a [Vector3<f64>]>;
 
 fn vec3(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
@@ -314,12 +321,15 @@ pub(super) fn load_table(key: &str, rows: &[[f64; 7]]) -> Result<Vec<(f64, [f64;
 }
 
 /// A flexible body from its `flexible` table: basis, invariants, frame
-/// placement; `geometric`: panel bases with their geometric stiffness.
+/// placement; `geometric`: panel bases with their geometric stiffness,
+/// and the point-force cases of the joint-load prestress at the nodes of
+/// the global points `joints` (the body's joint points).
 pub(super) fn flexible_body(
     key: &str,
     name: &str,
     f: &FlexSpec,
     (damping, geometric): (bool, bool),
+    joints: &[Vector3<f64>],
     panels: PanelBases,
 ) -> Result<Body> {
     let fk = format!("{key}.flexible");
@@ -333,8 +343,33 @@ pub(super) fn flexible_body(
             "a modal damping ratio in [0, 1)",
         ));
     }
+    let origin = finite3(format!("{fk}.origin"), f.origin)?;
+    let x = finite3(format!("{fk}.x_axis"), f.x_axis)?;
+    let y = finite3(format!("{fk}.y_axis"), f.y_axis)?;
+    if x.norm() < 1e-12
+        || (y - x * (x.dot(&y) / x.norm_squared())).norm() < 1e-9 * y.norm().max(1e-300)
+    {
+        return Err(Error::input(
+            format!("{fk}.y_axis"),
+            format!("{:?} with x_axis {:?}", f.y_axis, f.x_axis),
+            "non-zero, non-parallel x and y axis directions",
+        ));
+    }
+    let ex = x.normalize();
+    let ey = (y - ex * ex.dot(&y)).normalize();
+    let a0 = Matrix3::from_columns(&[ex, ey, ex.cross(&ey)]);
+    // The joint points in the body frame: their nodes get the point-force
+    // cases of the joint-load prestress (geometric stiffening only).
+    let local: Vec<Vector3<f64>> = if geometric {
+        joints
+            .iter()
+            .map(|p| a0.transpose() * (p - origin))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let basis = match f.kind {
-        FlexKind::Beam => beam_basis(&fk, f)?,
+        FlexKind::Beam => beam_basis(&fk, f, &local)?,
         FlexKind::Panel => {
             let panel = f.panel.as_deref().ok_or_else(|| {
                 Error::input(
@@ -353,33 +388,23 @@ pub(super) fn flexible_body(
                     "a rigid-body content share in (0, 1] (1 keeps every mode)",
                 ));
             }
-            panels(panel, f.modes, f.derivatives, geometric)
-                .map_err(|e| match e {
-                    // The mode count is this body's key, not the panel's.
-                    Error::Input { key, expected, .. } if key.ends_with("n_modes") => {
-                        Error::input(format!("{fk}.modes"), f.modes, expected)
-                    }
-                    e => e,
-                })?
-                .screened(limit)?
+            panels(
+                panel,
+                f.modes,
+                f.derivatives,
+                geometric.then_some(&local[..]),
+            )
+            .map_err(|e| match e {
+                // The mode count is this body's key, not the panel's.
+                Error::Input { key, expected, .. } if key.ends_with("n_modes") => {
+                    Error::input(format!("{fk}.modes"), f.modes, expected)
+                }
+                e => e,
+            })?
+            .screened(limit)?
         }
     };
     basis.validate(&fk)?;
-    let origin = finite3(format!("{fk}.origin"), f.origin)?;
-    let x = finite3(format!("{fk}.x_axis"), f.x_axis)?;
-    let y = finite3(format!("{fk}.y_axis"), f.y_axis)?;
-    if x.norm() < 1e-12
-        || (y - x * (x.dot(&y) / x.norm_squared())).norm() < 1e-9 * y.norm().max(1e-300)
-    {
-        return Err(Error::input(
-            format!("{fk}.y_axis"),
-            format!("{:?} with x_axis {:?}", f.y_axis, f.x_axis),
-            "non-zero, non-parallel x and y axis directions",
-        ));
-    }
-    let ex = x.normalize();
-    let ey = (y - ex * ex.dot(&y)).normalize();
-    let a0 = Matrix3::from_columns(&[ex, ey, ex.cross(&ey)]);
     let design = vec![0.0; basis.derivatives.len()];
     let flex = Flex::new(basis, if damping { f.damping } else { 0.0 }, design);
     let inv = &flex.inv;
@@ -404,8 +429,10 @@ pub(super) fn flexible_body(
 
 /// The closed-form cantilever basis of a `kind = "beam"` body (`fk` is
 /// the key of its `flexible` table), with the rotary inertia about the
-/// beam axis lumped like the mass.
-fn beam_basis(fk: &str, f: &FlexSpec) -> Result<ModalBasis> {
+/// beam axis lumped like the mass, and the point-force cases
+/// ([`Beam::point_cases`]) at the nodes of the body-frame points `joints`
+/// (points that are no node are left to the marker's own check).
+fn beam_basis(fk: &str, f: &FlexSpec, joints: &[Vector3<f64>]) -> Result<ModalBasis> {
     let get = |what: &str, v: Option<f64>| {
         v.ok_or_else(|| Error::input(format!("{fk}.{what}"), "(missing)", "a beam property"))
     };
@@ -432,14 +459,47 @@ fn beam_basis(fk: &str, f: &FlexSpec) -> Result<ModalBasis> {
             "a polar mass moment per length > 0 (kg·m): the frame needs a rotary inertia about the beam axis",
         ));
     }
-    let mut b = beam
-        .basis(f.modes, Beam::segments_for(f.modes))?
-        .truncated(f.modes);
+    let segments = Beam::segments_for(f.modes);
+    let mut b = beam.basis(f.modes, segments)?.truncated(f.modes);
+    let nodes = joint_nodes(&b, joints);
+    if let Some(g) = b.geometric.as_mut() {
+        if !nodes.is_empty() {
+            let order: Vec<_> = beam
+                .mode_order(f.modes)
+                .into_iter()
+                .take(b.n_modes)
+                .collect();
+            let cases: Vec<f64> = nodes
+                .iter()
+                .flat_map(|&k| beam.point_cases(&order, segments, b.nodes[k].x))
+                .collect();
+            g.add_points(&nodes, &cases, &[]);
+        }
+    }
     // Rotary inertia about the beam axis, lumped like the mass.
     for (k, m) in b.node_mass.iter().enumerate() {
         b.node_inertia[k].x = rho_ip * m / beam.rho_a;
     }
     Ok(b)
+}
+
+/// The distinct nodes of `basis` at the body-frame points `points`
+/// (within `1e-6` of the body's size, the rule of [`make_marker`]), in
+/// the order first met.
+pub(crate) fn joint_nodes(basis: &ModalBasis, points: &[Vector3<f64>]) -> Vec<usize> {
+    let size = basis
+        .nodes
+        .iter()
+        .fold(0.0f64, |m, s| m.max(s.norm()))
+        .max(1e-3);
+    let mut out = Vec::new();
+    for p in points {
+        let (k, dist) = basis.nearest_node(p);
+        if dist <= 1e-6 * size && !out.contains(&k) {
+            out.push(k);
+        }
+    }
+    out
 }
 
 pub(super) fn initial_distance(model: &Model, i: usize, j: usize) -> f64 {

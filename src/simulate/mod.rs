@@ -198,7 +198,26 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
     };
     let (stats, failure) = match run {
         Ok(stats) => (stats, None),
-        Err(e @ Error::Numerical { .. }) => (Stats::default(), Some(e)),
+        Err(Error::Numerical {
+            place,
+            time,
+            detail,
+        }) => {
+            // A joint-load prestress iteration that did not converge names
+            // its time and bodies.
+            let detail = match sys.counters.prestress_failure.borrow().as_ref() {
+                Some((t, what)) => format!("{detail}; at t = {t} s {what}"),
+                None => detail,
+            };
+            (
+                Stats::default(),
+                Some(Error::Numerical {
+                    place,
+                    time,
+                    detail,
+                }),
+            )
+        }
         Err(e) => return Err(e),
     };
     let responses = if failure.is_none() {

@@ -1,8 +1,11 @@
 //! Constraints: the rows of every joint kind's blocks ([`rows`]), their
 //! assembly with modal entries and Baumgarte stabilisation
 //! ([`assemble`]), and the constraint-space solve for the multipliers and
-//! accelerations, with its exact tangent for dual evaluations ([`solve`]).
+//! accelerations, with its exact tangent for dual evaluations ([`solve`]),
+//! including the joint-load prestress of geometric stiffening
+//! ([`prestress`]).
 
 pub mod assemble;
+pub mod prestress;
 pub mod rows;
 pub mod solve;

@@ -22,13 +22,14 @@
 //! lane costs one product with each `M'_b`, `M_b⁻¹` and the rows, and one
 //! constraint-space solve.
 
+use super::prestress::{PRESTRESS_ITERATIONS, PRESTRESS_STALL, PRESTRESS_TOL};
 use crate::mbs::math::Factored;
 use crate::mbs::math::{
     fdot, gram, min_degree_order, spd_factor, spd_solve, sym_times, CholPattern, Scalar, MAX_LANES,
 };
 use crate::mbs::model::Param;
 use crate::mbs::system::{
-    pval, BodyBlock, SolveScratch, System, Workspace, RANK_REG, RANK_TOL, RIGID,
+    bump, pval, BodyBlock, SolveScratch, System, Workspace, RANK_REG, RANK_TOL, RIGID,
 };
 
 impl System {
@@ -204,6 +205,28 @@ impl System {
         ws.rank = f.rank - ndrop;
         let rhs = std::mem::take(&mut sol.rhs);
         Self::solve_factored(ws, f, &rhs, &mut sol.lam);
+        // The joint-load prestress (`super::prestress`): λ by the
+        // fixed-point iteration on the same factor, `bz = Bλ`.
+        let prestress = self.prestress_columns(ws);
+        if prestress {
+            let (mut lam, mut z) = (std::mem::take(&mut sol.lam), std::mem::take(&mut sol.bz));
+            let (mut r, mut next) = (std::mem::take(&mut sol.prhs), std::mem::take(&mut sol.plam));
+            let dropped = std::mem::take(&mut sol.dropped);
+            let ok = self.prestress_iterate(
+                ws,
+                f,
+                (&rhs, &dropped),
+                &mut lam,
+                (&mut z, &mut r, &mut next),
+            );
+            if !ok {
+                // Non-finite accelerations end the run; the time and the
+                // bodies go into its error (System::rhs, simulate).
+                self.note_prestress_failure(ws, &lam, &next);
+                lam.fill(f64::NAN);
+            }
+            (sol.lam, sol.bz, sol.prhs, sol.plam, sol.dropped) = (lam, z, r, next, dropped);
+        }
         sol.rhs = rhs;
         // v̇ = M⁻¹Q + Σ_rows (M⁻¹d) λ.
         sol.acc.clear();
@@ -217,6 +240,14 @@ impl System {
                 let lam = sol.lam[*r];
                 for (a, w) in out.iter_mut().zip(&bb.w[i * d..(i + 1) * d]) {
                     *a += w * lam;
+                }
+            }
+            // − M⁻¹ B λ of the joint-load prestress.
+            if prestress && d > 6 {
+                sol.tmp.resize(d, 0.0);
+                self.minv_times(bb, s, &sol.bz[o..o + d], &mut sol.tmp);
+                for (a, t) in sol.acc[o..o + d].iter_mut().zip(&sol.tmp) {
+                    *a -= t;
                 }
             }
         }
@@ -240,6 +271,47 @@ impl System {
             .extend((0..m).map(|r| parts(sol.lam[r], &sol.dlam, r, m)));
         ws.sol = sol;
         acc
+    }
+
+    /// The fixed-point iteration of the joint-load prestress
+    /// (`super::prestress`): `λ ← (A + εD)⁻¹(base + G M⁻¹ B λ)` from the
+    /// `λ` given until its change is at rounding; `z` holds `B λ` of the
+    /// returned λ. False if it does not converge in
+    /// [`PRESTRESS_ITERATIONS`] back-substitutions.
+    fn prestress_iterate<T: Scalar>(
+        &self,
+        ws: &mut Workspace<T>,
+        f: Factored,
+        (base, dropped): (&[f64], &[bool]),
+        lam: &mut Vec<f64>,
+        (z, rhs, next): (&mut Vec<f64>, &mut Vec<f64>, &mut Vec<f64>),
+    ) -> bool {
+        let mut last = f64::INFINITY;
+        for _ in 0..PRESTRESS_ITERATIONS {
+            self.prestress_force(ws, lam, None, z);
+            self.prestress_rhs(ws, (base, dropped), z, rhs);
+            Self::solve_factored(ws, f, rhs, next);
+            bump(&self.counters.prestress_iterations);
+            let (mut change, mut size) = (0.0f64, 0.0f64);
+            for (a, b) in next.iter().zip(lam.iter()) {
+                change = change.max((a - b).abs());
+                size = size.max(a.abs());
+            }
+            std::mem::swap(lam, next);
+            if !change.is_finite() {
+                return false;
+            }
+            // Converged, or stalled at rounding: the change stopped
+            // shrinking once it was below PRESTRESS_STALL · |λ|.
+            if change <= PRESTRESS_TOL * size
+                || (change <= PRESTRESS_STALL * size && change >= last)
+            {
+                self.prestress_force(ws, lam, None, z);
+                return true;
+            }
+            last = change;
+        }
+        false
     }
 
     /// `out = (A + εD)⁻¹ b` with the factor `f` in `ws.a` (rows in the
@@ -280,7 +352,13 @@ impl System {
         let (mut dlam, mut mp) = (take(&mut sol.lane_lam), take(&mut sol.mp));
         rhs.resize(m, 0.0);
         dd.resize(m, 0.0);
+        let prestress = !ws.pcols.is_empty();
+        let mut bl = take(&mut sol.bz);
         for l in 0..nl {
+            // B'λ of the joint-load prestress (lane l of the columns).
+            if prestress {
+                self.prestress_force(ws, &sol.lam, Some(l), &mut bl);
+            }
             // r₂ = γ' − G'v̇ and, per body, r₁ = Q' − M'v̇ + G'ᵀλ, u = M⁻¹r₁;
             // the right-hand side r₂ − G u − εD'λ.
             for (r, row) in ws.rows.iter().enumerate() {
@@ -306,6 +384,11 @@ impl System {
                 } else {
                     for (x, v) in sol.r1.iter_mut().zip(&a[..3]) {
                         *x -= dm * v;
+                    }
+                }
+                if prestress && d > 6 {
+                    for (x, b) in sol.r1[6..].iter_mut().zip(&bl[o + 6..o + d]) {
+                        *x -= b;
                     }
                 }
                 for (i, &r) in bb.rows.iter().enumerate() {
@@ -338,6 +421,32 @@ impl System {
                 }
             }
             Self::solve_factored(ws, f, &rhs, &mut dlam);
+            if prestress {
+                // λ' by the same iteration; then v̇' −= M⁻¹ B λ'.
+                let (mut z, mut r) = (take(&mut sol.prhs), take(&mut sol.plam));
+                let mut next = take(&mut sol.tmp);
+                let ok = self.prestress_iterate(
+                    ws,
+                    f,
+                    (&rhs, &sol.dropped),
+                    &mut dlam,
+                    (&mut z, &mut r, &mut next),
+                );
+                if !ok {
+                    dlam.fill(f64::NAN);
+                }
+                for (s, bb) in ws.blocks.iter().enumerate() {
+                    let (o, d) = (self.vel_local(s), self.dof(s));
+                    if d > 6 {
+                        next.resize(d, 0.0);
+                        self.minv_times(bb, s, &z[o..o + d], &mut next);
+                        for (x, t) in sol.dacc[l * nv + o..l * nv + o + d].iter_mut().zip(&next) {
+                            *x -= t;
+                        }
+                    }
+                }
+                (sol.prhs, sol.plam, sol.tmp) = (z, r, next);
+            }
             // v̇' = u + Σ_rows w λ'.
             for (s, bb) in ws.blocks.iter().enumerate() {
                 let (o, d) = (self.vel_local(s), self.dof(s));
@@ -351,6 +460,7 @@ impl System {
             sol.dlam[l * m..(l + 1) * m].copy_from_slice(&dlam);
         }
         (sol.lane_rhs, sol.dd, sol.lane_lam, sol.mp) = (rhs, dd, dlam, mp);
+        sol.bz = bl;
     }
 
     /// Lane `l` of slot `s`'s mass matrix: a flexible body's `M'_l` into

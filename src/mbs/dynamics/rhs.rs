@@ -57,6 +57,11 @@ impl System {
         self.constraints(t, ws);
         self.applied(t, ws);
         let acc = self.solve(ws);
+        if let Some(f) = self.counters.prestress_failure.borrow_mut().as_mut() {
+            if f.0.is_nan() {
+                f.0 = t;
+            }
+        }
         let vo = self.voff();
         dy[vo..vo + self.nvel()].copy_from_slice(&acc);
         let io = self.integral_off();

@@ -48,7 +48,8 @@ pub struct FlexEffects {
     /// Modal damping ratio (0 = none).
     pub zeta: f64,
     /// Geometric stiffening ([`crate::mbs::model::geometric`]): the
-    /// modal geometric stiffness of the inertial prestress, when the
+    /// modal geometric stiffness of the inertial prestress (the joint-load
+    /// part is in `crate::mbs::constraints::prestress`), when the
     /// invariants carry it.
     pub geometric: bool,
     /// Gravity (global axes, m/s²) for the prestress of the geometric

@@ -111,8 +111,9 @@ pub struct ModalBasis {
     pub derivatives: Vec<BasisDerivative>,
     /// Rigid-body content of the modes and the modes dropped for it.
     pub rigid: RigidScreen,
-    /// The modal geometric stiffness of the inertial unit load cases
-    /// (geometric stiffening, [`super::geometric`]); `None` when the
+    /// The modal geometric stiffness of the inertial unit load cases and
+    /// of the point-force cases at joint nodes (geometric stiffening,
+    /// [`super::geometric`]); `None` when the
     /// basis's source does not provide it.
     pub geometric: Option<Geometric>,
 }

@@ -1,5 +1,6 @@
 //! Geometric (dynamic) stiffening of floating-frame bodies: the modal
-//! geometric stiffness of the inertial prestress, as unit load cases.
+//! geometric stiffness of the inertial and joint-load prestress, as unit
+//! load cases.
 //!
 //! ## Why
 //! The linear floating-frame model (paper Eqs. 5–6) keeps the elastic
@@ -48,6 +49,23 @@
 //! (the change of the rotational inertia by the foreshortening, order
 //! `w²`) are left out, so the total energy is conserved to `O(w²)` only.
 //!
+//! ## Joint-load prestress
+//! The joints load a body at its marker nodes, and that load stresses it
+//! too (a beam pulled at its tip by a joint is taut). For every node `P`
+//! of the body that carries a joint marker (only when the scene asks for
+//! the effect) three more cases follow the twelve above: a unit point
+//! force along frame axis `a = x, y, z` at `P`, held as the inertial cases
+//! are (the clamped root of a beam; inertia relief on a free–free panel),
+//! with `K_{P,a} = Φᵀ K_G(stress of the unit force a at P) Φ` (1/(N·s²)
+//! per mass-normalized coordinate, i.e. 1/s² per N). Joint moments are
+//! not loaded (forces only): the moment a revolute or locked joint passes
+//! does not stress a beam axially nor a plate in its plane to first
+//! order. At run time the force of the joints on the body at `P`, in
+//! frame axes, is linear in the multipliers, `f_P = Aᵀ Σ_r (∂ṙ-block of
+//! row r at P) λ_r`, and the modal equations get `−Σ_a f_P,a K_{P,a} w =
+//! −B(w) λ` ([`crate::mbs::constraints`] solves `M v̇ = Q + (Gᵀ − B) λ`).
+//! The point cases do not depend on the frame origin.
+//!
 //! ## Moving the frame origin
 //! The cases 0–8 are linear in `s`, so moving the frame origin to `o`
 //! (`s → s − o`) changes case `k` by the uniform body force `−b_k(o)`:
@@ -92,6 +110,11 @@ pub struct Geometric {
     /// `dK_k/db` in the layout of `cases`, one per design variable of the
     /// basis, in the order of its `derivatives`.
     pub derivatives: Vec<Vec<f64>>,
+    /// The joint nodes `P` with point-force cases (module doc): node
+    /// `point_nodes[p]` has its three cases `K_{P,x}, K_{P,y}, K_{P,z}`
+    /// as blocks `CASES + 3p + a` of `cases` (and of each derivative),
+    /// after the inertial ones.
+    pub point_nodes: Vec<usize>,
 }
 
 impl Geometric {
@@ -101,12 +124,36 @@ impl Geometric {
         self.cases[(k * self.n + i) * self.n + j]
     }
 
+    /// Number of blocks: the inertial cases and three per joint node.
+    pub fn blocks(&self) -> usize {
+        CASES + 3 * self.point_nodes.len()
+    }
+
+    /// Block index of the point case along frame axis `a` at node
+    /// `node`, if the node has point cases.
+    pub fn point_block(&self, node: usize, a: usize) -> Option<usize> {
+        let p = self.point_nodes.iter().position(|&k| k == node)?;
+        Some(CASES + 3 * p + a)
+    }
+
+    /// Add the point cases of `nodes` (`3 · nodes.len()` blocks of n × n,
+    /// row-major, and per design variable the same), after the existing
+    /// ones.
+    pub fn add_points(&mut self, nodes: &[usize], cases: &[f64], derivatives: &[Vec<f64>]) {
+        self.point_nodes.extend_from_slice(nodes);
+        self.cases.extend_from_slice(cases);
+        for (d, dd) in self.derivatives.iter_mut().zip(derivatives) {
+            d.extend_from_slice(dd);
+        }
+    }
+
     /// The cases restricted to the modes `keep` (in that order), with
     /// their derivatives.
     pub fn picked(&self, keep: &[usize]) -> Geometric {
         let n = self.n;
+        let blocks = self.blocks();
         let pick = |v: &[f64]| -> Vec<f64> {
-            (0..CASES)
+            (0..blocks)
                 .flat_map(|k| {
                     keep.iter()
                         .flat_map(move |&i| keep.iter().map(move |&j| v[(k * n + i) * n + j]))
@@ -117,6 +164,7 @@ impl Geometric {
             n: keep.len(),
             cases: pick(&self.cases),
             derivatives: self.derivatives.iter().map(|d| pick(d)).collect(),
+            point_nodes: self.point_nodes.clone(),
         }
     }
 
@@ -142,13 +190,14 @@ impl Geometric {
             n: self.n,
             cases: shift(&self.cases),
             derivatives: self.derivatives.iter().map(|d| shift(d)).collect(),
+            point_nodes: self.point_nodes.clone(),
         }
     }
 
     /// Check sizes (`n` modes, `n_derivatives` design variables) and
     /// values; `key` names the basis in errors.
     pub fn validate(&self, key: &str, n: usize, n_derivatives: usize) -> Result<()> {
-        let want = CASES * n * n;
+        let want = self.blocks() * n * n;
         if self.n != n
             || self.cases.len() != want
             || self.derivatives.iter().any(|d| d.len() != want)
@@ -163,7 +212,8 @@ impl Geometric {
                     self.derivatives.len()
                 ),
                 format!(
-                    "{CASES} blocks of {n} × {n} = {want} entries and {n_derivatives} derivatives"
+                    "{} blocks of {n} × {n} = {want} entries and {n_derivatives} derivatives",
+                    self.blocks()
                 ),
             ));
         }
@@ -225,6 +275,7 @@ mod tests {
             n,
             cases,
             derivatives: vec![],
+            point_nodes: vec![],
         };
         let o = Vector3::new(0.5, 2.0, -1.0);
         let s = g.shifted(&o);

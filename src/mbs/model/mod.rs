@@ -1,6 +1,6 @@
 //! The model as data: bodies and markers ([`body`]), modal bases and
 //! their inertia invariants ([`flex`]), the geometric stiffness of
-//! their inertial prestress ([`geometric`]), joints and the table of joint
+//! their inertial and joint-load prestress ([`geometric`]), joints and the table of joint
 //! kinds ([`joint`]) with the prescribed motion of driven joints
 //! ([`drive`]), force elements ([`force`]), the whole model with its
 //! energy terms ([`mechanism`]) and sensitivity parameters ([`param`]),

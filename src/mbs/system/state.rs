@@ -44,6 +44,13 @@ pub struct Counters {
     pub quadratic: Cell<u64>,
     /// Modal damping forces evaluated (per flexible body).
     pub modal_damping: Cell<u64>,
+    /// Back-substitutions of the joint-load prestress iteration
+    /// (`crate::mbs::constraints::prestress`).
+    pub prestress_iterations: Cell<u64>,
+    /// The last evaluation whose prestress iteration did not converge:
+    /// time (s) and what failed (bodies, last change), for the error of
+    /// the run it ends.
+    pub prestress_failure: std::cell::RefCell<Option<(f64, String)>>,
 }
 
 /// The assembled system: model + state layout.

@@ -99,6 +99,13 @@ pub struct Workspace<T: Scalar> {
     pub(crate) perm: Vec<f64>,
     /// Modal Jacobian entries of the rows' flexible sides.
     pub mjac: Vec<T>,
+    /// The columns of the joint-load prestress `B` (geometric stiffening,
+    /// `crate::mbs::constraints::prestress`): `(row, slot, offset)` of each
+    /// row side on a joint node with point cases; its n modal entries
+    /// `β = Σ_a (Aᵀ∂ṙ)_a K_{P,a} w` are at `offset` in `pvals`.
+    pub(crate) pcols: Vec<(usize, usize, usize)>,
+    /// The entries of the columns of `pcols`.
+    pub(crate) pvals: Vec<T>,
     /// Position of each row in the fill-reducing order.
     pub(crate) inv_order: Vec<usize>,
     pub(crate) spd: SpdScratch,
@@ -184,6 +191,11 @@ pub struct SolveScratch {
     /// Per row: whether it is left out of the solve (the workspace's set
     /// or the system's), for the tangent.
     pub(crate) dropped: Vec<bool>,
+    /// The joint-load prestress force `B λ` (velocity layout, modal
+    /// entries only), the iteration's λ and right-hand side.
+    pub(crate) bz: Vec<f64>,
+    pub(crate) plam: Vec<f64>,
+    pub(crate) prhs: Vec<f64>,
 }
 
 /// Translational and rotational mode-shape rows of a node (n columns each).
@@ -278,6 +290,8 @@ impl<T: Scalar> Workspace<T> {
             segments: Vec::new(),
             drop: None,
             rotations: Vec::new(),
+            pcols: Vec::new(),
+            pvals: Vec::new(),
         }
     }
 }

@@ -7,6 +7,7 @@ mod events;
 mod flex;
 mod free;
 mod input;
+mod joint_prestress;
 mod kernel;
 mod loads;
 mod mechanisms;

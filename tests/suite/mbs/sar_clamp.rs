@@ -64,7 +64,7 @@ fn centre_clamp_bases_drop_the_drilling_mode() {
     // dropped; every kept mode is well below the limit.
     let text = STUDY.replace("divisions = 32", "divisions = 16");
     let study = Study::parse("clamp16.toml", &text).unwrap();
-    let basis = plyscape::panels::basis_for_study(&study, "panel3", 14, None, false)
+    let basis = plyscape::panels::basis_for_study(&study, "panel3", 14, None, None)
         .unwrap()
         .screened(plyscape::panels::basis::RIGID_CONTENT_LIMIT)
         .unwrap();

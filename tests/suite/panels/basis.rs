@@ -496,10 +496,10 @@ plies = [{ angle = 0.0, thickness = 0.5e-3 }, { angle = 90.0, thickness = 0.5e-3
 "#;
     let study = Study::parse("basis.toml", text).unwrap();
     // The named panel works.
-    let b = basis_for_study(&study, "panel3", 3, None, false).unwrap();
+    let b = basis_for_study(&study, "panel3", 3, None, None).unwrap();
     assert_eq!(b.n_modes, 3);
     // Unknown name: input error naming file, key and value.
-    match basis_for_study(&study, "panel9", 3, None, false) {
+    match basis_for_study(&study, "panel9", 3, None, None) {
         Err(Error::Input {
             file,
             key,
@@ -514,7 +514,7 @@ plies = [{ angle = 0.0, thickness = 0.5e-3 }, { angle = 90.0, thickness = 0.5e-3
         other => panic!("expected an input error, got {other:?}"),
     }
     // No modes.
-    let e = basis_for_study(&study, "panel3", 0, None, false).unwrap_err();
+    let e = basis_for_study(&study, "panel3", 0, None, None).unwrap_err();
     assert!(
         matches!(&e, Error::Input { key, .. } if key == "n_modes"),
         "{e:?}"

@@ -5,6 +5,7 @@
 //! differences (supported and free–free panels).
 
 use super::basis::laminate;
+use nalgebra::Vector3;
 use plyscape::beams::Beam;
 use plyscape::fe::{Mesh, MeshParams, Panel, Support};
 use plyscape::laminate::{DesignMap, Laminate};
@@ -56,7 +57,7 @@ fn a_spinning_clamped_strip_stiffens_like_a_beam() {
             width,
         },
     );
-    let b = panel_basis_geometric(&p, 2, None, true).unwrap();
+    let b = panel_basis_geometric(&p, 2, None, Some(&[])).unwrap();
     b.validate("strip").unwrap();
     let g = b.geometric.as_ref().unwrap();
     // The two lowest modes: one flexural mode per half (equal frequencies).
@@ -88,11 +89,12 @@ fn a_spinning_clamped_strip_stiffens_like_a_beam() {
     assert!(g.get(0, 0, 0).abs() < 0.05 * s_beam, "{}", g.get(0, 0, 0));
 }
 
-/// Basis with the geometric stiffness and updated-mode derivatives.
-fn basis(p: &Panel, lam: &Laminate, n: usize) -> ModalBasis {
+/// Basis with the geometric stiffness (point cases at the panel-frame
+/// `points`) and updated-mode derivatives.
+fn basis(p: &Panel, lam: &Laminate, n: usize, points: &[Vector3<f64>]) -> ModalBasis {
     let mut q = p.clone();
     q.laminate = lam.clone();
-    panel_basis_geometric(&q, n, Some(ModeUpdate::Updated), true).unwrap()
+    panel_basis_geometric(&q, n, Some(ModeUpdate::Updated), Some(points)).unwrap()
 }
 
 fn check_derivatives(support: Support) {
@@ -103,11 +105,20 @@ fn check_derivatives(support: Support) {
     let design = DesignMap::symmetric(4);
     let p = panel(0.6, 0.4, 6, lam.clone(), support);
     let n = 3;
-    let b = basis(&p, &lam, n);
+    // Two joint nodes (the last and an inner one): their point-force cases
+    // (joint-load prestress) follow the inertial ones and are checked too,
+    // against their own largest entry (1/s² per N, not per unit
+    // coefficient).
+    let at = |k: usize| Vector3::new(p.mesh.nodes[k][0], p.mesh.nodes[k][1], 0.0);
+    let points = [at(p.mesh.nodes.len() - 1), at(p.mesh.nodes.len() / 3)];
+    let b = basis(&p, &lam, n, &points);
     let g = b.geometric.as_ref().unwrap();
     assert_eq!(g.derivatives.len(), 2);
-    let scale = g.cases.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    assert!(scale > 0.0);
+    assert_eq!(g.point_nodes.len(), 2);
+    let split = CASES * n * n;
+    let largest = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let (scale, point_scale) = (largest(&g.cases[..split]), largest(&g.cases[split..]));
+    assert!(scale > 0.0 && point_scale > 0.0);
     let h = 1e-4;
     let angles = |v: usize, d: f64| {
         let mut x: Vec<f64> = design
@@ -119,12 +130,13 @@ fn check_derivatives(support: Support) {
         lam.with_design(&design, &x).unwrap()
     };
     for v in 0..2 {
-        let gp = basis(&p, &angles(v, h), n).geometric.unwrap();
-        let gm = basis(&p, &angles(v, -h), n).geometric.unwrap();
+        let gp = basis(&p, &angles(v, h), n, &points).geometric.unwrap();
+        let gm = basis(&p, &angles(v, -h), n, &points).geometric.unwrap();
         let mut worst = 0.0f64;
-        for e in 0..CASES * n * n {
+        for e in 0..g.cases.len() {
             let fd = (gp.cases[e] - gm.cases[e]) / (2.0 * h);
-            let err = (g.derivatives[v][e] - fd).abs() / scale;
+            let s = if e < split { scale } else { point_scale };
+            let err = (g.derivatives[v][e] - fd).abs() / s;
             worst = worst.max(err);
         }
         println!("{support:?} variable {v}: worst error {worst:e} of the largest entry");
