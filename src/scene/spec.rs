@@ -186,7 +186,7 @@ fn default_divergence_limit() -> f64 {
 }
 
 fn default_spin_warning_fraction() -> f64 {
-    crate::simulate::spin::SPIN_FRACTION
+    crate::mbs::model::SPIN_WARNING_FRACTION
 }
 
 /// One `[[scene.bodies]]` entry: a rigid body, or a flexible one with a

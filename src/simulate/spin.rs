@@ -20,10 +20,7 @@
 use crate::mbs::system::BodyKin;
 use crate::mbs::System;
 
-/// The default fraction of a flexible body's first frequency above which
-/// its frame's angular speed draws the fast-rotation warning (module doc;
-/// the scene's `spin_warning_fraction`).
-pub const SPIN_FRACTION: f64 = 0.3;
+pub use crate::mbs::model::SPIN_WARNING_FRACTION as SPIN_FRACTION;
 
 /// One flexible body under watch.
 #[derive(Debug, Clone)]

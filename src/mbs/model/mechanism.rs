@@ -44,9 +44,14 @@ pub struct Model {
     /// Fast-rotation warning: a flexible body without geometric
     /// stiffening warns when its frame turns faster than this fraction
     /// of its first modal frequency (`crate::simulate::spin`); `None`:
-    /// the default 0.3.
+    /// [`SPIN_WARNING_FRACTION`].
     pub spin_warning_fraction: Option<f64>,
 }
+
+/// The default fraction of a flexible body's first modal frequency above
+/// which its frame's angular speed draws the fast-rotation warning
+/// (`crate::simulate::spin`; the scene's `spin_warning_fraction`).
+pub const SPIN_WARNING_FRACTION: f64 = 0.3;
 
 /// `∫ scale · Σ terms dt` over energy terms (strain and kinetic energies
 /// of bodies, [`Energy`]): the paper's objective Ψ₀ = ∫ 2U dt (Eq. 33) is

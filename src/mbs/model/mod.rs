@@ -21,5 +21,5 @@ pub use drive::{Drive, Harmonic, Piece, Spline};
 pub use flex::{BasisDerivative, DroppedMode, Invariants, ModalBasis, RigidScreen};
 pub use force::{Force, Load, LoadFrame, PiecewiseLaw, Segment};
 pub use joint::{Joint, JointKind, RowBlock};
-pub use mechanism::{Energy, Integral, Model};
+pub use mechanism::{Energy, Integral, Model, SPIN_WARNING_FRACTION};
 pub use param::Param;
