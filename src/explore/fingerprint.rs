@@ -749,7 +749,10 @@ mod tests {
         let what = b.differences(&old, None, &modes.table);
         assert_eq!(
             what,
-            ["code changed (evaluation version 0 → 2)", "scene changed"]
+            [
+                format!("code changed (evaluation version 0 → {EVALUATION_VERSION})"),
+                "scene changed".to_string()
+            ]
         );
         // The map's evaluation parts leave the solver out.
         let e = b.evaluation_only();
