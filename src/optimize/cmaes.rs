@@ -105,6 +105,14 @@ pub struct CmaesOptions {
     /// Active covariance update (module doc): the worst `λ − μ` samples
     /// enter the rank-μ update with negative weights. Default false.
     pub active: bool,
+    /// Lower bounds of the standard deviation `σ √C_ii` of each coordinate,
+    /// in range units (empty: none, the default): after each update σ is
+    /// raised to `max_i min_std_i / √C_ii` when below it. The integer
+    /// handling of discrete coordinates (`explore::discrete`, after
+    /// N. Hansen, "A CMA-ES for mixed-integer nonlinear optimization",
+    /// INRIA research report RR-7751, 2011): a coordinate whose spread has
+    /// shrunk below its lattice step would freeze on one set member.
+    pub min_std: Vec<f64>,
 }
 
 /// Restart schedule of [`Cmaes`] (module doc for the formulas); written
@@ -235,6 +243,7 @@ impl Default for CmaesOptions {
             target: None,
             feasibility_tolerance: 0.0,
             active: false,
+            min_std: Vec::new(),
         }
     }
 }
@@ -268,6 +277,15 @@ impl CmaesOptions {
             if !(v >= 0.0 && v.is_finite()) {
                 return bad(k, v.to_string(), "a finite value >= 0");
             }
+        }
+        if !(self.min_std.is_empty()
+            || (self.min_std.len() == n && self.min_std.iter().all(|v| v.is_finite() && *v >= 0.0)))
+        {
+            return bad(
+                "min_std",
+                format!("{:?}", self.min_std),
+                &format!("none, or {n} finite values >= 0"),
+            );
         }
         if let Some(x0) = &self.x0 {
             if x0.len() != n || x0.iter().any(|v| !v.is_finite()) {
@@ -708,6 +726,10 @@ impl Cmaes {
         run.cov = decay * &run.cov + p.c1 * (&run.pc * run.pc.transpose()) + p.cmu * rank_mu;
         run.cov = 0.5 * (&run.cov + run.cov.transpose());
         run.sigma *= ((p.cs / p.ds) * (ps_norm / p.chi_n - 1.0)).exp();
+        for (i, &floor) in self.options.min_std.iter().enumerate() {
+            let sd = run.cov[(i, i)].max(1e-300).sqrt();
+            run.sigma = run.sigma.max(floor / sd);
+        }
         let eig = run.cov.clone().symmetric_eigen();
         run.b = eig.eigenvectors;
         run.d = eig.eigenvalues.map(|l| l.max(1e-300).sqrt());

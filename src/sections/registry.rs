@@ -127,6 +127,15 @@ pub static SECTIONS: &[Section] = &[
         uses_problem: true,
     },
     Section {
+        key: "discrete",
+        check: explore::commands::discrete::check,
+        run: Some(|cfg| {
+            explore::commands::discrete::run_discrete(&cfg.explore(DriveFlags::default()))
+                .map(|_| ())
+        }),
+        uses_problem: true,
+    },
+    Section {
         key: "map",
         check: |s| explore::map_section(s).map(|_| ()),
         run: Some(|cfg| explore::run_map(&cfg.explore(DriveFlags::default())).map(|_| ())),
@@ -198,6 +207,12 @@ pub static SECTIONS: &[Section] = &[
     data("convergence"),
     data("scene_problem"),
     // Read and written by the multistart.
+    Section {
+        key: "robustness",
+        check: |s| explore::robustness::section(s).map(|_| ()),
+        run: None,
+        uses_problem: true,
+    },
     Section {
         key: explore::optimum_report::KEY,
         check: |s| explore::optimum_report::check(s).map(|_| ()),

@@ -47,6 +47,8 @@ fn probe_sections(p: &RefCell<Probe>) {
     section::<ex::commands::front::FrontSection>(p, "front");
     section::<ex::scaling::ScalingSection>(p, "scaling");
     section::<ex::optimum_report::OptimumReportSection>(p, "optimum_report");
+    section::<ex::robustness::RobustnessSection>(p, "robustness");
+    section::<ex::discrete::DiscreteSection>(p, "discrete");
     section::<sec::kernel_bench::BenchSpec>(p, "kernel_bench");
     section::<sec::events_bench::EventsSpec>(p, "events_bench");
     section::<sec::scene_convergence::ConvergenceSpec>(p, "scene_convergence");

@@ -8,6 +8,7 @@
 
 pub mod compare;
 pub mod convergence;
+pub mod discrete;
 pub mod evolve;
 pub mod front;
 pub mod map;

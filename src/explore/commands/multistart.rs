@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::explore::config::{multistart_plan, problem, MultistartPlan};
 use crate::explore::context::Context;
 use crate::explore::manifest::{MultistartCounts, MultistartEntry};
-use crate::explore::{fingerprint, multistart, optimum_report, solvers, violation};
+use crate::explore::{fingerprint, multistart, optimum_report, robustness, solvers, violation};
 use crate::optimize::Problem;
 use std::path::{Path, PathBuf};
 
@@ -85,6 +85,8 @@ pub fn multistart_with(
     if !ctx.quiet {
         print_optima(problem, &report);
     }
+    // `[robustness]`: optima.csv again, with the worst-case columns.
+    robustness::apply(ctx, problem, &report.optima, &dir)?;
     if let Some(p) = report_plan {
         p.finish(ctx, &dir, problem, plan, &report)?;
     }

@@ -1,10 +1,12 @@
 //! Tests of `plyscape::explore`: optimization drivers, multistart, shards, reports.
 mod certified;
 mod compare;
+mod discrete;
 mod front;
 mod kill;
 mod multistart;
 mod optimum_report;
 mod resume;
+mod robustness;
 mod scene;
 mod studies;

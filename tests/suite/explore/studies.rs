@@ -159,3 +159,26 @@ fn sar_explore_is_sar_optimize_with_64_starts_and_both_schedules() {
     assert!(s.has("compare"));
     assert_eq!(plyscape::explore::map_section(&s).unwrap().resolution, 19);
 }
+
+/// `studies/sar_discrete.toml` is sar_explore's problem and scene on the
+/// 15° set from −75° to 90° (12 values per angle), with a ±2° robustness
+/// check. (The study takes minutes and is run by hand; results in
+/// results/sar_discrete/.)
+#[test]
+fn sar_discrete_is_sar_explore_on_15_degree_steps() {
+    let s = Study::load("studies/sar_discrete.toml").unwrap();
+    let e = Study::load("studies/sar_explore.toml").unwrap();
+    for key in ["problem", "scene_problem", "scene", "panels"] {
+        assert_eq!(s.table[key], e.table[key], "{key}");
+    }
+    let d = plyscape::explore::discrete::lattice::section(&s)
+        .unwrap()
+        .unwrap();
+    let set: Vec<f64> = (0..12).map(|k| -75.0 + 15.0 * k as f64).collect();
+    assert_eq!(d.variables.len(), 2);
+    for v in &d.variables {
+        assert_eq!(v.values.as_deref(), Some(&set[..]), "{}", v.name);
+    }
+    let r = plyscape::explore::robustness::section(&s).unwrap().unwrap();
+    assert_eq!(r.tolerance, [2.0, 2.0]);
+}
