@@ -23,9 +23,14 @@
 //! keys), `[map]` ([`MapSection`]), `[scaling]`
 //! ([`scaling::ScalingSection`]), `[optimum_report]`
 //! ([`optimum_report`]: the run from the first start as the paper's
-//! Table 5 and Figs. 10–12, written by the multistart) and `[front]`
+//! Table 5 and Figs. 10–12, written by the multistart), `[front]`
 //! ([`commands::front`]: the Pareto front of two or three objectives, its
-//! gradient side in [`front`], NSGA-II in [`crate::optimize::nsga2`]).
+//! gradient side in [`front`], NSGA-II in [`crate::optimize::nsga2`]),
+//! `[robustness]` ([`robustness`]: each certified optimum's worst case
+//! under a tolerance per variable, in `optima.csv`) and `[discrete]`
+//! ([`discrete`], [`commands::discrete`]: the problem on a finite set per
+//! variable, searched exhaustively, by rounding and polishing the
+//! certified optima, and by CMA-ES on the set).
 //!
 //! Layout: the algorithms are [`multistart`], [`cluster`], [`evolve`],
 //! [`map`] and [`sampling`], over the problems of [`problems`] and
