@@ -25,7 +25,9 @@
 //! ([`optimum_report`]: the run from the first start as the paper's
 //! Table 5 and Figs. 10–12, written by the multistart) and `[front]`
 //! ([`commands::front`]: the Pareto front of two or three objectives, its
-//! gradient side in [`front`], NSGA-II in [`crate::optimize::nsga2`]).
+//! gradient side in [`front`], NSGA-II in [`crate::optimize::nsga2`], the
+//! grid of the box in [`front_grid`], and with `[problem] name = "scene"`
+//! the scene's responses as objectives in [`scene_front`]).
 //!
 //! Layout: the algorithms are [`multistart`], [`cluster`], [`evolve`],
 //! [`map`] and [`sampling`], over the problems of [`problems`] and
@@ -77,6 +79,7 @@ pub mod context;
 pub mod evolve;
 pub mod fingerprint;
 pub mod front;
+pub mod front_grid;
 pub mod manifest;
 pub mod map;
 pub mod merge;
@@ -85,6 +88,7 @@ pub mod optimum_report;
 pub mod problems;
 pub mod sampling;
 pub mod scaling;
+pub mod scene_front;
 pub mod scene_problem;
 pub mod settle;
 pub mod solvers;

@@ -10,5 +10,6 @@ pub mod compare;
 pub mod convergence;
 pub mod evolve;
 pub mod front;
+pub mod front_outputs;
 pub mod map;
 pub mod multistart;
