@@ -25,7 +25,9 @@
 //! ([`optimum_report`]: the run from the first start as the paper's
 //! Table 5 and Figs. 10–12, written by the multistart), `[front]`
 //! ([`commands::front`]: the Pareto front of two or three objectives, its
-//! gradient side in [`front`], NSGA-II in [`crate::optimize::nsga2`]),
+//! gradient side in [`front`], NSGA-II in [`crate::optimize::nsga2`], the
+//! grid of the box in [`front_grid`], and with `[problem] name = "scene"`
+//! the scene's responses as objectives in [`scene_front`]),
 //! `[robustness]` ([`robustness`]: each certified optimum's worst case
 //! under a tolerance per variable, in `optima.csv`) and `[discrete]`
 //! ([`discrete`], [`commands::discrete`]: the problem on a finite set per
@@ -83,6 +85,7 @@ pub mod discrete;
 pub mod evolve;
 pub mod fingerprint;
 pub mod front;
+pub mod front_grid;
 pub mod manifest;
 pub mod map;
 pub mod merge;
@@ -92,6 +95,7 @@ pub mod problems;
 pub mod robustness;
 pub mod sampling;
 pub mod scaling;
+pub mod scene_front;
 pub mod scene_problem;
 pub mod settle;
 pub mod solvers;

@@ -51,7 +51,7 @@ fn default_cost_mode() -> String {
 
 /// Names accepted by [`ProblemSpec::build_multi`] (the problems of
 /// `optimize::mo_testproblems`, for `[front]`).
-pub const MULTI_PROBLEM_NAMES: &str = "zdt1, zdt2, zdt3, dtlz2";
+pub const MULTI_PROBLEM_NAMES: &str = "zdt1, zdt2, zdt3, dtlz2, scene (with [scene_problem])";
 
 /// Names accepted by [`ProblemSpec::build`].
 pub const PROBLEM_NAMES: &str =

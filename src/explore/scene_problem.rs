@@ -172,6 +172,17 @@ struct Raw {
     profile: EvalProfile,
 }
 
+/// Responses evaluated beside the problem's own
+/// ([`SceneProblem::evaluate_with`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExtraResponses {
+    /// Values, in the responses' units.
+    pub values: Vec<f64>,
+    /// Gradients per degree of each variable (one row per response), when
+    /// asked.
+    pub gradients: Option<Vec<Vec<f64>>>,
+}
+
 /// What one evaluation computed and where its time went.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct EvalProfile {
@@ -329,7 +340,7 @@ impl SceneProblem {
     }
 
     /// SI unit of the `[[scene.responses]]` entry `name` (from its kind).
-    fn response_unit(&self, name: &str) -> &'static str {
+    pub fn response_unit(&self, name: &str) -> &'static str {
         let kind = self.plan.spec().responses.iter().find(|r| r.name == name);
         kind.map_or(ResponseKind::Peak.unit(), |r| r.kind.unit())
     }
@@ -436,6 +447,19 @@ impl SceneProblem {
         x: &[f64],
         gradients: bool,
     ) -> Result<(Evaluation, EvalProfile)> {
+        let (e, _, profile) = self.evaluate_with(x, gradients, &[])?;
+        Ok((e, profile))
+    }
+
+    /// [`Problem::evaluate`] and, from the same simulation, the raw values
+    /// of the `[[scene.responses]]` named `extra` (response units) with
+    /// their gradients per degree of each variable when asked.
+    pub fn evaluate_with(
+        &self,
+        x: &[f64],
+        gradients: bool,
+        extra: &[String],
+    ) -> Result<(Evaluation, ExtraResponses, EvalProfile)> {
         if x.len() != self.vars.len() || x.iter().any(|v| !v.is_finite()) {
             return Err(Error::input(
                 "scene_problem.x",
@@ -445,7 +469,13 @@ impl SceneProblem {
         }
         let mut names = vec![self.objective.0.clone()];
         names.extend(self.constraints.iter().map(|c| c.0.clone()));
+        let own = names.len();
+        names.extend(extra.iter().cloned());
         let raw = self.raw(x, &names, gradients)?;
+        let extra = ExtraResponses {
+            values: raw.values[own..].to_vec(),
+            gradients: (raw.gradients.as_ref()).map(|g| g[own..].to_vec()),
+        };
         let s = self.objective.1;
         let f = raw.values[0] / s;
         let g = self
@@ -474,6 +504,7 @@ impl SceneProblem {
                 grad_f,
                 grad_g,
             },
+            extra,
             raw.profile,
         ))
     }

@@ -70,6 +70,27 @@ pub trait MultiProblem: Sync {
     fn objective_label(&self, i: usize) -> String {
         format!("{} [-]", self.objective_names()[i])
     }
+    /// The unit of objective `i` as the study writes it (in its
+    /// [`objective_scale`](MultiProblem::objective_scale) multiple),
+    /// e.g. `J*s`, for table headers (default: none, a dimensionless test
+    /// objective).
+    fn objective_unit(&self, _i: usize) -> Option<String> {
+        None
+    }
+    /// The factor from objective `i` as evaluated to its value in its unit
+    /// (default 1; a normalised objective `f = R/|R(x_n)|` has `|R(x_n)|`).
+    fn objective_scale(&self, _i: usize) -> f64 {
+        1.0
+    }
+    /// Variable `i` with its unit, for plot axes (default: its name).
+    fn variable_label(&self, i: usize) -> String {
+        self.variables()[i].name.clone()
+    }
+    /// The simulations run so far, for a problem that caches evaluations
+    /// by design (default: none counted, every call evaluates).
+    fn simulations(&self) -> Option<usize> {
+        None
+    }
     /// The analytic front, sampled (objectives in evaluation order), when
     /// the problem has a known one (default: none).
     fn known_front(&self) -> Option<Vec<Vec<f64>>> {
@@ -191,6 +212,18 @@ impl MultiProblem for Oriented<'_> {
     }
     fn objective_label(&self, k: usize) -> String {
         self.inner.objective_label(self.picks[k].index)
+    }
+    fn objective_unit(&self, k: usize) -> Option<String> {
+        self.inner.objective_unit(self.picks[k].index)
+    }
+    fn objective_scale(&self, k: usize) -> f64 {
+        self.inner.objective_scale(self.picks[k].index)
+    }
+    fn variable_label(&self, i: usize) -> String {
+        self.inner.variable_label(i)
+    }
+    fn simulations(&self) -> Option<usize> {
+        self.inner.simulations()
     }
     /// The inner problem's front in the picked order, when every objective
     /// is picked and minimized (a front of some of the objectives, or with

@@ -5,6 +5,7 @@
 
 use crate::error::{Error, Result};
 use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -98,6 +99,66 @@ fn drawn_points(curves: &[Curve], scale: Scale) -> Vec<Vec<(f64, f64)>> {
         .collect()
 }
 
+/// The smallest box `(x0, x1, y0, y1)` around the drawn points, when
+/// there is one.
+fn bounds(drawn: &[Vec<(f64, f64)>]) -> Option<(f64, f64, f64, f64)> {
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y) in drawn.iter().flatten() {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    (x0.is_finite() && y0.is_finite()).then_some((x0, x1, y0, y1))
+}
+
+/// The axes every line and scatter plot draws on: white page, title, the
+/// data box `bounds` padded by 5 % of its range (half its magnitude, at
+/// least 0.5, where the range vanishes), the axis labels and the tick
+/// labels: `10^v` on a logarithmic axis, scientific on a linear y axis
+/// whose values need it ([`needs_sci`]) and on such an x axis when
+/// `sci_x`.
+fn frame<'a, 'b>(
+    root: &'b DrawingArea<SVGBackend<'a>, Shift>,
+    path: &Path,
+    axes: &Axes,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+    sci_x: bool,
+) -> Result<ChartContext<'b, SVGBackend<'a>, Cartesian2d<RangedCoordf64, RangedCoordf64>>> {
+    let pad = |a: f64, b: f64| {
+        if b > a {
+            0.05 * (b - a)
+        } else {
+            0.5 * a.abs().max(1.0)
+        }
+    };
+    let (px, py) = (pad(x0, x1), pad(y0, y1));
+    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
+    let mut chart = ChartBuilder::on(root)
+        .caption(axes.title, ("sans-serif", 20))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0 - px..x1 + px, y0 - py..y1 + py)
+        .map_err(|e| plot_err(path, e))?;
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(axes.x).y_desc(axes.y);
+    if axes.scale.log_x() {
+        mesh.x_label_formatter(&log_tick);
+    } else if sci_x && needs_sci(x0, x1) {
+        mesh.x_label_formatter(&sci_tick);
+    }
+    if axes.scale.log_y() {
+        mesh.y_label_formatter(&log_tick);
+    } else if needs_sci(y0, y1) {
+        mesh.y_label_formatter(&sci_tick);
+    }
+    mesh.draw().map_err(|e| plot_err(path, e))?;
+    Ok(chart)
+}
+
 /// Draw curves into an SVG (legend; linear or logarithmic axes).
 pub fn line_plot(path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()> {
     draw_lines(path, axes, curves, None)
@@ -114,55 +175,11 @@ pub fn line_plot_floored(path: &Path, axes: &Axes, curves: &[Curve], floor: f64)
 /// [`line_plot`], with the points at `floor` marked when given.
 fn draw_lines(path: &Path, axes: &Axes, curves: &[Curve], floor: Option<f64>) -> Result<()> {
     let drawn = drawn_points(curves, axes.scale);
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for &(x, y) in drawn.iter().flatten() {
-        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
-    }
-    if !(x0.is_finite() && y0.is_finite()) {
+    let Some(bounds) = bounds(&drawn) else {
         return Ok(());
-    }
-    let pad = |a: f64, b: f64| {
-        if b > a {
-            0.05 * (b - a)
-        } else {
-            0.5 * a.abs().max(1.0)
-        }
     };
-    let (px, py) = (pad(x0, x1), pad(y0, y1));
     let root = SVGBackend::new(path, (800, 500)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(axes.title, ("sans-serif", 20))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0 - px..x1 + px, y0 - py..y1 + py)
-        .map_err(|e| plot_err(path, e))?;
-    let plain = |v: &f64| format!("{v}");
-    let fx: &dyn Fn(&f64) -> String = if axes.scale.log_x() {
-        &log_tick
-    } else {
-        &plain
-    };
-    let fy: &dyn Fn(&f64) -> String = if axes.scale.log_y() {
-        &log_tick
-    } else {
-        &sci_tick
-    };
-    let mut mesh = chart.configure_mesh();
-    mesh.x_desc(axes.x).y_desc(axes.y);
-    if axes.scale.log_x() {
-        mesh.x_label_formatter(fx);
-    }
-    if axes.scale.log_y() || needs_sci(y0, y1) {
-        mesh.y_label_formatter(fy);
-    }
-    mesh.draw().map_err(|e| plot_err(path, e))?;
+    let mut chart = frame(&root, path, axes, bounds, false)?;
     for (i, (c, pts)) in curves.iter().zip(drawn).enumerate() {
         let color = Palette99::pick(i).to_rgba();
         chart
@@ -210,44 +227,11 @@ pub fn scatter_plot(path: &Path, axes: &Axes, series: &[Series]) -> Result<()> {
                 .collect()
         })
         .collect();
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for &(x, y) in pts.iter().flatten() {
-        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
-    }
-    if !(x0.is_finite() && y0.is_finite()) {
+    let Some(bounds) = bounds(&pts) else {
         return Ok(());
-    }
-    let pad = |a: f64, b: f64| {
-        if b > a {
-            0.05 * (b - a)
-        } else {
-            0.5 * a.abs().max(1.0)
-        }
     };
-    let (px, py) = (pad(x0, x1), pad(y0, y1));
     let root = SVGBackend::new(path, (800, 600)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| plot_err(path, e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(axes.title, ("sans-serif", 20))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0 - px..x1 + px, y0 - py..y1 + py)
-        .map_err(|e| plot_err(path, e))?;
-    let mut mesh = chart.configure_mesh();
-    mesh.x_desc(axes.x).y_desc(axes.y);
-    if needs_sci(x0, x1) {
-        mesh.x_label_formatter(&sci_tick);
-    }
-    if needs_sci(y0, y1) {
-        mesh.y_label_formatter(&sci_tick);
-    }
-    mesh.draw().map_err(|e| plot_err(path, e))?;
+    let mut chart = frame(&root, path, axes, bounds, true)?;
     let mut colour = 0;
     for (s, p) in series.iter().zip(pts) {
         if s.line {

@@ -235,14 +235,15 @@ pub fn run_front(cfg: &RunConfig) -> Result<()> {
     let mut entry = serde_json::Map::new();
     entry.insert("wall_seconds".into(), t0.elapsed().as_secs_f64().into());
     for mf in &report.methods {
-        entry.insert(
-            mf.method.clone(),
-            serde_json::json!({
-                "points": mf.points.len(),
-                "function_calls": mf.function_calls,
-                "gradient_calls": mf.gradient_calls,
-            }),
-        );
+        let mut m = serde_json::json!({
+            "points": mf.points.len(),
+            "function_calls": mf.function_calls,
+            "gradient_calls": mf.gradient_calls,
+        });
+        if let Some(s) = mf.simulations {
+            m["simulations"] = s.into();
+        }
+        entry.insert(mf.method.clone(), m);
     }
     crate::report::record_command(&dir, &cfg.study, cfg.threads, "front", entry, None)
 }

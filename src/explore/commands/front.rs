@@ -10,34 +10,59 @@
 //! `population`.
 //!
 //! Outputs in the study's folder, all through [`crate::report`]:
-//! - `front.csv`: the non-dominated designs of each method; columns
-//!   `method`, `x_<variable>` per variable, then one column per objective
-//!   named as the objective, in its own sign (a maximized objective is
-//!   written as its value, not negated).
-//! - `front_summary.csv`: one row per method: `points`, `function_calls`,
-//!   `gradient_calls`, `wall_seconds`, `certified_ends` (the gradient
-//!   side's certified ends of all its runs), `hypervolume` with the
-//!   reference point in `reference_<objective>` columns, `igd_union` (IGD
-//!   to the non-dominated union of both methods' fronts) and
-//!   `igd_analytic` (IGD to the problem's analytic front when it has one).
-//!   Hypervolume and IGD are computed in the minimized orientation
-//!   ([`crate::optimize::indicators`]); the reference point is
-//!   `[front] reference` or, by default, the union's nadir plus a tenth of
-//!   its ideal-to-nadir range in each objective (`(1.1, 1.1)` on ZDT1).
-//! - `front.svg`: the first two objectives, both methods' fronts, the start
-//!   design and the analytic front (two objectives) when known.
+//! Problems: the analytic ones (`zdt1`, `zdt2`, `zdt3`, `dtlz2`) or
+//! `[problem] name = "scene"`, whose objectives are `[[scene.responses]]`
+//! normalised at one design ([`crate::explore::scene_front`]).
+//!
+//! With `grid = N` the box is also evaluated on a grid of `N` values per
+//! variable ([`crate::explore::front_grid`]), after both methods; its
+//! non-dominated feasible designs are a third method, `grid`.
+//!
+//! Outputs in the study's folder, all through [`crate::report`]
+//! ([`super::front_outputs`]):
+//! - `front.csv`: the non-dominated designs of each method (and of the
+//!   grid); columns `method`, `x_<variable>` per variable, then one column
+//!   per objective named as the objective, with its unit in brackets when
+//!   the problem has one (`psi0 [J*s]`), in its own sign and unit (a
+//!   maximized objective is written as its value, not negated; a
+//!   normalised one in the response's unit).
+//! - `front_summary.csv`: one row per method (`grid` last): `points`,
+//!   `function_calls`, `gradient_calls`, `wall_seconds`, `certified_ends`
+//!   (the gradient side's certified ends of all its runs), `hypervolume`
+//!   with the reference point in `reference_<objective>` columns (own sign
+//!   and unit), `igd_union` (IGD to the non-dominated union of all
+//!   methods' fronts) and `igd_analytic` (IGD to the problem's analytic
+//!   front when it has one). Hypervolume and IGD are computed on the
+//!   objectives as evaluated, in the minimized orientation
+//!   ([`crate::optimize::indicators`]): for the scene, the normalised
+//!   objectives `R_i/|R_i(x_n)|` (dimensionless). The reference point is
+//!   `[front] reference` (own sign and unit), `reference_relative` (a
+//!   factor of each objective's value at the start design) or, by default,
+//!   the union's nadir plus a tenth of its ideal-to-nadir range in each
+//!   objective (`(1.1, 1.1)` on ZDT1).
+//! - `front_ends.csv`: every run of the gradient side (label, class,
+//!   exit, calls, Kuhn–Tucker residual, end design, objectives of the ends
+//!   that enter the front), to see which ends were certified and why not.
+//! - `grid.csv` (with `grid`): every grid design, its objectives (own
+//!   sign and unit), `max_g`, and the error of a failed evaluation.
+//! - `front.svg`: the first two objectives, every method's front, the
+//!   start design and the analytic front (two objectives) when known;
+//!   `front_design.svg` (two variables): the same designs in design space.
 
+use super::front_outputs::write_outputs;
+pub use super::front_outputs::{FrontReport, MethodFront};
 use crate::error::{Error, Result};
 use crate::explore::front::{gradient_front, GradientSettings};
+use crate::explore::front_grid::{evaluate_grid, grid_size, MAX_GRID_DESIGNS};
 use crate::explore::problems::ProblemSpec;
+use crate::explore::scene_front::SceneFrontProblem;
 use crate::explore::settle::EndPolicy;
 use crate::optimize::indicators::{hypervolume, igd};
 use crate::optimize::kkt::KktTolerances;
 use crate::optimize::mmfd::MmfdOptions;
 use crate::optimize::multiobjective::{non_dominated, MultiProblem, Oriented};
 use crate::optimize::nsga2::{self, Nsga2Options};
-use crate::report::csv::{num, write_table};
-use crate::report::{scatter_plot, Axes, Scale, Series};
+use crate::report::csv::num;
 use crate::study::Study;
 use serde::Deserialize;
 use std::path::Path;
@@ -58,7 +83,8 @@ pub enum Goal {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectiveSpec {
-    /// The problem's name of the objective (`f1`, …).
+    /// The problem's name of the objective (`f1`, …; for the scene a
+    /// `[[scene.responses]]` name).
     pub name: String,
     /// `minimize` (default) or `maximize`.
     #[serde(default)]
@@ -81,8 +107,15 @@ pub struct FrontSection {
     /// function calls).
     pub evaluations: Option<usize>,
     /// Hypervolume reference point, one value per objective in its own
-    /// sign (default: see the module doc).
+    /// sign and unit (default: see the module doc).
     pub reference: Option<Vec<f64>>,
+    /// Hypervolume reference point as factors of the objectives' values
+    /// at the start design (`[1.2, 1.2]`: 1.2 × each start value, in its
+    /// own sign); not with `reference`.
+    pub reference_relative: Option<Vec<f64>>,
+    /// Also evaluate a grid of this many values per variable (>= 2) and
+    /// compare its non-dominated set (row `grid`).
+    pub grid: Option<usize>,
     /// Starts of each single-objective anchor of the gradient side: the
     /// start design and seeded random designs (default 1: the start design
     /// only).
@@ -105,48 +138,20 @@ fn default_population() -> usize {
     100
 }
 
-/// One method's front and its indicators.
-#[derive(Debug, Clone)]
-pub struct MethodFront {
-    /// `mmfd-tchebycheff` or `nsga2`.
-    pub method: String,
-    /// Designs and objectives (minimized orientation).
-    pub points: Vec<(Vec<f64>, Vec<f64>)>,
-    /// Function calls.
-    pub function_calls: usize,
-    /// Gradient calls.
-    pub gradient_calls: usize,
-    /// Wall time \[s\].
-    pub wall_seconds: f64,
-    /// Certified ends of all runs (`(certified, runs)`; gradient side).
-    pub certified: Option<(usize, usize)>,
-    /// Hypervolume to the reference point.
-    pub hypervolume: f64,
-    /// IGD to the union front.
-    pub igd_union: Option<f64>,
-    /// IGD to the analytic front, when known.
-    pub igd_analytic: Option<f64>,
-}
-
-/// What `[front]` computed.
-#[derive(Debug, Clone)]
-pub struct FrontReport {
-    /// The objectives' names.
-    pub objectives: Vec<String>,
-    /// The methods, gradient side first.
-    pub methods: Vec<MethodFront>,
-    /// The reference point (minimized orientation).
-    pub reference: Vec<f64>,
-}
-
-/// The study's multi-objective problem (`[problem] name`: `zdt1`,
-/// `zdt2`, `zdt3` or `dtlz2`).
-pub fn multi_problem(study: &Study) -> Result<Box<dyn MultiProblem>> {
+/// The study's multi-objective problem with the section's objectives:
+/// `[problem] name` `zdt1`, `zdt2`, `zdt3` or `dtlz2`, or `scene` (the
+/// `[[scene.responses]]` named by the objectives).
+pub fn multi_problem(study: &Study, section: &FrontSection) -> Result<Box<dyn MultiProblem>> {
     let spec: ProblemSpec = study.require_section("problem", "the problem to solve")?;
+    if spec.name == "scene" {
+        let names: Vec<String> = section.objectives.iter().map(|o| o.name.clone()).collect();
+        return Ok(Box::new(SceneFrontProblem::from_study(study, &names)?));
+    }
     spec.build_multi().map_err(study.locate("problem"))
 }
 
-/// Read and check `[front]` and the problem's objectives without running.
+/// Read and check `[front]` and the problem's objectives without running
+/// (the scene is parsed and checked, not simulated).
 pub fn check(study: &Study) -> Result<FrontSection> {
     let s: FrontSection = study.require_section("front", "the Pareto front")?;
     let k = s.objectives.len();
@@ -169,39 +174,77 @@ pub fn check(study: &Study) -> Result<FrontSection> {
             format!("at least the population ({})", s.population),
         ));
     }
-    if let Some(r) = &s.reference {
-        if r.len() != k || r.iter().any(|v| !v.is_finite()) {
-            return Err(study.error(
-                "front.reference",
-                format!("{r:?}"),
-                format!("{k} finite values, one per objective"),
-            ));
+    for (key, r) in [
+        ("reference", &s.reference),
+        ("reference_relative", &s.reference_relative),
+    ] {
+        if let Some(r) = r {
+            if r.len() != k || r.iter().any(|v| !v.is_finite()) {
+                return Err(study.error(
+                    format!("front.{key}"),
+                    format!("{r:?}"),
+                    format!("{k} finite values, one per objective"),
+                ));
+            }
         }
+    }
+    if s.reference.is_some() && s.reference_relative.is_some() {
+        return Err(study.error(
+            "front.reference_relative",
+            "(given)",
+            "either `reference` or `reference_relative`, not both",
+        ));
     }
     if let Some(t) = s.feasibility_tolerance {
         crate::error::require_positive("feasibility_tolerance", t)
             .map_err(study.locate("front"))?;
     }
-    let problem = multi_problem(study)?;
-    oriented(problem.as_ref(), &s).map_err(study.locate("front"))?;
+    let spec: ProblemSpec = study.require_section("problem", "the problem to solve")?;
+    let names: Vec<String> = s.objectives.iter().map(|o| o.name.clone()).collect();
+    let variables = if spec.name == "scene" {
+        SceneFrontProblem::check(study, &names)?;
+        let sp: crate::explore::scene_problem::SceneProblemSpec =
+            study.require_section("scene_problem", "the scene problem")?;
+        sp.variables.len()
+    } else {
+        let problem = spec.build_multi().map_err(study.locate("problem"))?;
+        oriented(problem.as_ref(), &s).map_err(study.locate("front"))?;
+        problem.variables().len()
+    };
+    duplicate_names(&s).map_err(study.locate("front"))?;
+    if let Some(n) = s.grid {
+        if n < 2 || grid_size(variables, n).is_none() {
+            return Err(study.error(
+                "front.grid",
+                n,
+                format!("at least 2 values per variable and at most {MAX_GRID_DESIGNS} designs ({variables} variables)"),
+            ));
+        }
+    }
     Ok(s)
 }
 
+/// Each objective named once.
+fn duplicate_names(s: &FrontSection) -> Result<()> {
+    for (i, o) in s.objectives.iter().enumerate() {
+        if s.objectives[..i].iter().any(|p| p.name == o.name) {
+            return Err(Error::input(
+                format!("objectives[{i}].name"),
+                format!("\"{}\"", o.name),
+                "each objective once",
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn oriented<'a>(p: &'a dyn MultiProblem, s: &FrontSection) -> Result<Oriented<'a>> {
+    duplicate_names(s)?;
     let names: Vec<(String, bool)> = s
         .objectives
         .iter()
         .map(|o| (o.name.clone(), o.goal == Goal::Maximize))
         .collect();
-    for (i, (n, _)) in names.iter().enumerate() {
-        if names[..i].iter().any(|(m, _)| m == n) {
-            return Err(Error::input(
-                format!("objectives[{i}].name"),
-                format!("\"{n}\""),
-                "each objective once",
-            ));
-        }
-    }
     Oriented::new(p, &names)
 }
 
@@ -218,11 +261,43 @@ fn default_reference(union: &[Vec<f64>], m: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Run `[front]`: both methods, the indicators, the tables and the plot
-/// in `dir`.
+/// The reference point in the evaluated (minimized, possibly normalised)
+/// objectives: `reference` (own sign and unit) turned into them,
+/// `reference_relative` times the start design's objectives, or the
+/// default.
+fn reference_point(
+    problem: &Oriented,
+    section: &FrontSection,
+    union: &[Vec<f64>],
+) -> Result<Vec<f64>> {
+    let m = section.objectives.len();
+    if let Some(r) = &section.reference {
+        return Ok((0..m)
+            .map(|k| r[k] * problem.sign(k) / problem.objective_scale(k))
+            .collect());
+    }
+    if let Some(r) = &section.reference_relative {
+        // sign·scale·f is the start's value in its own unit; r times that,
+        // turned back, is r·f.
+        let start = problem.evaluate(&problem.start(), false)?;
+        return Ok(r.iter().zip(&start.f).map(|(r, f)| r * f).collect());
+    }
+    if union.is_empty() {
+        return Ok(vec![0.0; m]);
+    }
+    Ok(default_reference(union, m))
+}
+
+/// Simulations the problem ran since `before` (problems that count them).
+fn since(problem: &dyn MultiProblem, before: Option<usize>) -> Option<usize> {
+    Some(problem.simulations()? - before?)
+}
+
+/// Run `[front]`: both methods (and the grid), the indicators, the tables
+/// and the plots in `dir`.
 pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Result<FrontReport> {
     let section = check(study)?;
-    let inner = multi_problem(study)?;
+    let inner = multi_problem(study, &section)?;
     let problem = oriented(inner.as_ref(), &section).map_err(study.locate("front"))?;
     let m = section.objectives.len();
     let tol = section.feasibility_tolerance.unwrap_or(1e-6);
@@ -241,7 +316,9 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
         anchor_starts: section.anchor_starts,
         seed: study.meta.seed,
     };
+    let sims = problem.simulations();
     let grad = gradient_front(&problem, &settings)?;
+    let grad_sims = since(&problem, sims);
     let budget = section.evaluations.unwrap_or(grad.function_calls);
     let options = Nsga2Options {
         population: section.population,
@@ -255,16 +332,19 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
         .build()
         .map_err(|e| Error::input("threads", threads, format!("a usable count ({e})")))?;
     let t = Instant::now();
+    let sims = problem.simulations();
     let evo = pool
         .install(|| nsga2::minimize(&problem, &options))
         .map_err(study.locate("front"))?;
     let evo_seconds = t.elapsed().as_secs_f64();
+    let evo_sims = since(&problem, sims);
     let mut methods = vec![
         MethodFront {
             method: "mmfd-tchebycheff".into(),
             points: grad.points.clone(),
             function_calls: grad.function_calls,
             gradient_calls: grad.gradient_calls,
+            simulations: grad_sims,
             wall_seconds: grad.wall_seconds,
             certified: Some((grad.certified(), grad.ends.len())),
             hypervolume: 0.0,
@@ -280,6 +360,7 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
                 .collect(),
             function_calls: evo.evaluations,
             gradient_calls: 0,
+            simulations: evo_sims,
             wall_seconds: evo_seconds,
             certified: None,
             hypervolume: 0.0,
@@ -287,6 +368,33 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
             igd_analytic: None,
         },
     ];
+    let grid = match section.grid {
+        Some(n) => {
+            let sims = problem.simulations();
+            let g = evaluate_grid(&problem, n, threads, quiet, tol)?;
+            methods.push(MethodFront {
+                method: "grid".into(),
+                points: g.front.clone(),
+                function_calls: g.points.len(),
+                gradient_calls: 0,
+                simulations: since(&problem, sims),
+                wall_seconds: g.wall_seconds,
+                certified: None,
+                hypervolume: 0.0,
+                igd_union: None,
+                igd_analytic: None,
+            });
+            if g.failures() > 0 && !quiet {
+                eprintln!(
+                    "warning: {} of {} grid designs failed to evaluate (grid.csv, column error)",
+                    g.failures(),
+                    g.points.len()
+                );
+            }
+            Some(g)
+        }
+        None => None,
+    };
     let all: Vec<Vec<f64>> = methods
         .iter()
         .flat_map(|mf| mf.points.iter().map(|p| p.1.clone()))
@@ -296,11 +404,7 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
         .map(|i| all[i].clone())
         .collect();
     let signs: Vec<f64> = (0..m).map(|k| problem.sign(k)).collect();
-    let reference = match &section.reference {
-        Some(r) => r.iter().zip(&signs).map(|(v, s)| v * s).collect(),
-        None if union.is_empty() => vec![0.0; m],
-        None => default_reference(&union, m),
-    };
+    let reference = reference_point(&problem, &section, &union)?;
     let analytic = problem.known_front();
     for mf in &mut methods {
         let f: Vec<Vec<f64>> = mf.points.iter().map(|p| p.1.clone()).collect();
@@ -313,15 +417,24 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
         methods,
         reference,
     };
-    write_outputs(&problem, &report, &signs, analytic.as_deref(), dir)?;
+    write_outputs(
+        &problem,
+        &report,
+        &signs,
+        analytic.as_deref(),
+        grid.as_ref(),
+        &grad.ends,
+        dir,
+    )?;
     if !quiet {
         for mf in &report.methods {
             println!(
-                "{}: {} points, {} function + {} gradient calls, {:.2} s, hypervolume {}, IGD to the union {}, to the analytic front {}",
+                "{}: {} points, {} function + {} gradient calls{}, {:.2} s, hypervolume {}, IGD to the union {}, to the analytic front {}",
                 mf.method,
                 mf.points.len(),
                 mf.function_calls,
                 mf.gradient_calls,
+                mf.simulations.map(|s| format!(" ({s} simulations)")).unwrap_or_default(),
                 mf.wall_seconds,
                 num(mf.hypervolume),
                 field(mf.igd_union),
@@ -335,103 +448,4 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
 
 fn field(v: Option<f64>) -> String {
     v.map(num).unwrap_or_default()
-}
-
-/// `front.csv`, `front_summary.csv` and `front.svg`.
-fn write_outputs(
-    problem: &Oriented,
-    report: &FrontReport,
-    signs: &[f64],
-    analytic: Option<&[Vec<f64>]>,
-    dir: &Path,
-) -> Result<()> {
-    let names = &report.objectives;
-    let mut header = vec!["method".to_string()];
-    header.extend(problem.variables().iter().map(|v| format!("x_{}", v.name)));
-    header.extend(names.iter().cloned());
-    let mut rows = Vec::new();
-    for mf in &report.methods {
-        for (x, f) in &mf.points {
-            let mut r = vec![mf.method.clone()];
-            r.extend(x.iter().map(|&v| num(v)));
-            r.extend(f.iter().zip(signs).map(|(v, s)| num(v * s)));
-            rows.push(r);
-        }
-    }
-    write_table(&dir.join("front.csv"), &header, &rows)?;
-    let mut header: Vec<String> = [
-        "method",
-        "points",
-        "function_calls",
-        "gradient_calls",
-        "wall_seconds",
-        "certified_ends",
-        "hypervolume",
-    ]
-    .map(String::from)
-    .to_vec();
-    header.extend(names.iter().map(|n| format!("reference_{n}")));
-    header.extend(["igd_union".to_string(), "igd_analytic".into()]);
-    let rows: Vec<Vec<String>> = report
-        .methods
-        .iter()
-        .map(|mf| {
-            let mut r = vec![
-                mf.method.clone(),
-                mf.points.len().to_string(),
-                mf.function_calls.to_string(),
-                mf.gradient_calls.to_string(),
-                format!("{:.3}", mf.wall_seconds),
-                mf.certified
-                    .map(|(c, n)| format!("{c}/{n}"))
-                    .unwrap_or_default(),
-                num(mf.hypervolume),
-            ];
-            r.extend(report.reference.iter().zip(signs).map(|(v, s)| num(v * s)));
-            r.push(field(mf.igd_union));
-            r.push(field(mf.igd_analytic));
-            r
-        })
-        .collect();
-    write_table(&dir.join("front_summary.csv"), &header, &rows)?;
-    let pair = |f: &[f64]| (f[0] * signs[0], f[1] * signs[1]);
-    let mut series = Vec::new();
-    if let (Some(a), 2) = (analytic, names.len()) {
-        series.push(Series {
-            label: "analytic front".into(),
-            points: a.iter().map(|f| pair(f)).collect(),
-            line: true,
-        });
-    }
-    for mf in &report.methods {
-        series.push(Series {
-            label: format!("{} ({} points)", mf.method, mf.points.len()),
-            points: mf.points.iter().map(|p| pair(&p.1)).collect(),
-            line: false,
-        });
-    }
-    let start = problem.evaluate(&problem.start(), false)?;
-    series.push(Series {
-        label: "start design".into(),
-        points: vec![pair(&start.f)],
-        line: false,
-    });
-    let title = if names.len() == 3 {
-        format!(
-            "{}: front, {} against {} (projection)",
-            problem.name(),
-            names[1],
-            names[0]
-        )
-    } else {
-        format!("{}: Pareto front", problem.name())
-    };
-    let (x, y) = (problem.objective_label(0), problem.objective_label(1));
-    let axes = Axes {
-        title: &title,
-        x: &x,
-        y: &y,
-        scale: Scale::Linear,
-    };
-    scatter_plot(&dir.join("front.svg"), &axes, &series)
 }

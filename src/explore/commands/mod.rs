@@ -11,5 +11,6 @@ pub mod convergence;
 pub mod discrete;
 pub mod evolve;
 pub mod front;
+pub mod front_outputs;
 pub mod map;
 pub mod multistart;

@@ -9,4 +9,5 @@ mod optimum_report;
 mod resume;
 mod robustness;
 mod scene;
+mod scene_front;
 mod studies;
