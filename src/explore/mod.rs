@@ -86,6 +86,7 @@ pub mod problems;
 pub mod sampling;
 pub mod scaling;
 pub mod scene_problem;
+mod scene_vars;
 pub mod settle;
 pub mod solvers;
 pub mod tables;
