@@ -71,19 +71,23 @@ fn eight_ply_angles_have_exact_gradients() {
 #[test]
 fn ply_angles_with_scene_parameters_have_exact_gradients() {
     // sar_codesign: the two shared angles (deg), the actuator's damping
-    // (N·m·s/rad) and the slope of its law on one segment (N·m/rad).
+    // (N·m·s/rad) and the slope of its law on its first segment (N·m/rad).
     let p = build(&coarse_sar(CODESIGN, 8, 4)).unwrap();
     assert_eq!(p.variables().len(), 4);
     assert_eq!(p.variable_label(2), "damping [SI]");
     assert_eq!(p.variable_label(0), "θ1 [deg]");
     // At the start the normalized values are 1 and 0.
-    let e0 = p.evaluate(&[55.0, -55.0, 0.5, -5.19], false).unwrap();
+    let e0 = p.evaluate(&[55.0, -55.0, 0.5, 9.0], false).unwrap();
     assert!((e0.f - 1.0).abs() < 1e-12 && e0.g[0].abs() < 1e-12);
-    let x = [40.0, -25.0, 0.8, -6.0];
+    let x = [40.0, -25.0, 0.8, 12.0];
     check_gradients(p.as_ref(), &x, &[0.01, 0.01, 1e-4, 1e-3], 1e-5);
+    // The law's slope acts on the segment the actuator is on (3.08-3.12
+    // rad over the run): its derivative is not zero.
+    let e = p.evaluate(&x, true).unwrap();
+    assert!(e.grad_f.unwrap()[3].abs() > 1e-6, "df/dslope");
     // Moving a scene variable changes the result (the value reaches the
     // model, not only its lane).
-    let e1 = p.evaluate(&[40.0, -25.0, 1.6, -6.0], false).unwrap();
+    let e1 = p.evaluate(&[40.0, -25.0, 1.6, 12.0], false).unwrap();
     let e2 = p.evaluate(&x, false).unwrap();
     assert!((e1.f - e2.f).abs() > 1e-6, "{} vs {}", e1.f, e2.f);
 }
