@@ -97,6 +97,7 @@ pub mod sampling;
 pub mod scaling;
 pub mod scene_front;
 pub mod scene_problem;
+mod scene_vars;
 pub mod settle;
 pub mod solvers;
 pub mod tables;

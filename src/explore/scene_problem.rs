@@ -31,8 +31,12 @@
 //!
 //! Each problem variable is a ply angle in degrees written into every
 //! listed `[[panels]]` design variable (all plies of its group, e.g. plies
-//! 1 and 4 of `theta_1_4`); tying one variable to both panels is the
-//! paper's shared θ1/θ2. The objective is `f = R₀(x) / R₀(x_ref)` (or
+//! 1 and 4 of `theta_1_4`; `design = [[1], [2], [3], [4]]` frees every
+//! ply); tying one variable to both panels is the paper's shared θ1/θ2.
+//! A variable may instead set scene parameters, `sets =
+//! ["scene:forces[0].damping"]` (any `[scene] sensitivities` name but a
+//! ply angle, in its SI unit; [`super::scene_vars`]), so that ply angles
+//! and mechanism parameters are designed together. The objective is `f = R₀(x) / R₀(x_ref)` (or
 //! `R₀(x)` without `normalize_at`), each constraint
 //! `g_j = R_j(x) / c_j − 1 <= 0` (Eq. 34 with `c_j` the bound).
 //!
@@ -61,6 +65,8 @@
 //! written as given, and `x` and `x + 180°` give the same laminate up to
 //! the rounding of the rotation's sines and cosines.
 
+pub use super::scene_vars::VariableSpec;
+use super::scene_vars::{problem_error, Target, Ties};
 use crate::error::{Error, Result};
 use crate::integrate::SensitivityForm;
 use crate::laminate::Laminate;
@@ -98,22 +104,6 @@ fn yes() -> bool {
     true
 }
 
-/// One `[[scene_problem.variables]]` entry.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct VariableSpec {
-    /// Name in reports (e.g. `theta1_deg`).
-    pub name: String,
-    /// `[lower, upper]` \[deg\].
-    pub bounds: [f64; 2],
-    /// Periodic ply angle (`upper − lower` must be 180°).
-    #[serde(default)]
-    pub periodic: bool,
-    /// `"<panel>:<design variable>"` entries this variable sets, e.g.
-    /// `"panel3:theta_1_4"`.
-    pub sets: Vec<String>,
-}
-
 /// `[scene_problem.objective]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -137,25 +127,13 @@ pub struct ConstraintSpec {
     pub upper_relative: Option<f64>,
 }
 
-/// Where one problem variable writes: a `[[panels]]` entry and the
-/// 0-based plies of one of its design variables.
-#[derive(Debug, Clone)]
-struct PlyTarget {
-    panel: usize,
-    plies: Vec<usize>,
-}
-
 /// A scene response as an optimization problem (see the module doc).
 pub struct SceneProblem {
     vars: Vec<Variable>,
     /// The scene prepared once; a design goes in as laminates.
     plan: ScenePlan,
-    /// Per variable: the plies it sets.
-    targets: Vec<Vec<PlyTarget>>,
-    /// All sensitivity lanes, in the order they are passed to the scene.
-    lanes: Vec<String>,
-    /// Per variable: indices into `lanes`.
-    lanes_of: Vec<Vec<usize>>,
+    /// What each variable sets, and the sensitivity lanes.
+    ties: Ties,
     /// Objective response and divisor.
     objective: (String, f64),
     /// Constraint responses and bounds `c`.
@@ -212,11 +190,9 @@ impl SceneProblem {
     pub fn from_study(study: &Study) -> Result<SceneProblem> {
         let (spec, plan, ties) = Self::checked(study)?;
         let mut problem = SceneProblem {
-            vars: ties.vars,
+            vars: ties.vars.clone(),
             plan,
-            targets: ties.targets,
-            lanes: ties.lanes,
-            lanes_of: ties.lanes_of,
+            ties,
             objective: (spec.objective.response.clone(), 1.0),
             constraints: Vec::new(),
             start: spec.start.clone(),
@@ -239,7 +215,7 @@ impl SceneProblem {
             "the scene problem (variables, start, objective)",
         )?;
         let plan = ScenePlan::new(study)?;
-        let ties = Ties::resolve(study, &spec, &plan)?;
+        let ties = Ties::resolve(study, &spec.variables, spec.tied_lanes, &plan)?;
         check_objective_and_constraints(study, &spec, &plan, &ties.vars)?;
         Ok((spec, plan, ties))
     }
@@ -350,10 +326,11 @@ impl SceneProblem {
     pub fn simulate_outputs(&self, x: &[f64], quantities: &[String]) -> Result<Simulation> {
         let at = |e: Error| at_design(e, &self.vars, x);
         let laminates = self.laminates_at(x)?;
-        let scene = self
+        let mut scene = self
             .plan
             .build_outputs(&laminates, quantities)
             .map_err(at)?;
+        self.ties.apply_scene(&self.plan, &mut scene, x)?;
         Ok(simulate(&scene).map_err(at)?.1)
     }
 
@@ -363,10 +340,12 @@ impl SceneProblem {
     pub fn laminates_at(&self, x: &[f64]) -> Result<Vec<Laminate>> {
         let panels = self.plan.panels();
         let mut angles: Vec<Vec<f64>> = panels.iter().map(|p| p.laminate.angles()).collect();
-        for (xi, targets) in x.iter().zip(&self.targets) {
+        for (xi, targets) in x.iter().zip(&self.ties.targets) {
             for t in targets {
-                for &k in &t.plies {
-                    angles[t.panel][k] = xi.to_radians();
+                if let Target::Plies { panel, plies } = t {
+                    for &k in plies {
+                        angles[*panel][k] = xi.to_radians();
+                    }
                 }
             }
         }
@@ -383,12 +362,13 @@ impl SceneProblem {
         let design = || design_label(&self.vars, x);
         let at = |e: Error| at_design(e, &self.vars, x);
         let t0 = std::time::Instant::now();
-        let lanes: &[String] = if gradients { &self.lanes } else { &[] };
+        let lanes: &[String] = if gradients { &self.ties.lanes } else { &[] };
         let laminates = self.laminates_at(x)?;
-        let (scene, build) = self
+        let (mut scene, build) = self
             .plan
             .build_profiled(&laminates, lanes, false)
             .map_err(at)?;
+        self.ties.apply_scene(&self.plan, &mut scene, x)?;
         let sim = simulate(&scene).map_err(at)?.1;
         let find = |name: &str| -> Result<&ResponseValue> {
             sim.responses
@@ -396,7 +376,6 @@ impl SceneProblem {
                 .find(|r| r.name == name)
                 .ok_or_else(|| Error::input("scene.responses", name, "a response of the scene"))
         };
-        let deg = std::f64::consts::PI / 180.0;
         let mut values = Vec::new();
         let mut grads = Vec::new();
         for name in names {
@@ -410,9 +389,11 @@ impl SceneProblem {
             values.push(r.value);
             if gradients {
                 let g: Vec<f64> = self
+                    .ties
                     .lanes_of
                     .iter()
-                    .map(|l| l.iter().map(|&k| r.gradient[k]).sum::<f64>() * deg)
+                    .zip(&self.ties.scale)
+                    .map(|(l, s)| l.iter().map(|&k| r.gradient[k]).sum::<f64>() * s)
                     .collect();
                 if g.iter().any(|v| !v.is_finite()) {
                     return Err(Error::numerical(
@@ -510,156 +491,6 @@ impl SceneProblem {
     }
 }
 
-/// An input error on `scene_problem.<key>`.
-fn problem_error(
-    study: &Study,
-    key: String,
-    value: impl std::fmt::Display,
-    expected: String,
-) -> Error {
-    study.error(format!("scene_problem.{key}"), value, expected)
-}
-
-/// The problem variables and what each one sets: ply targets in the
-/// panels and sensitivity lanes of the scene.
-struct Ties {
-    vars: Vec<Variable>,
-    targets: Vec<Vec<PlyTarget>>,
-    lanes: Vec<String>,
-    lanes_of: Vec<Vec<usize>>,
-}
-
-impl Ties {
-    /// Resolve `[[scene_problem.variables]]` against the plan's panels and
-    /// scene (each panel design variable tied to one problem variable).
-    fn resolve(study: &Study, spec: &SceneProblemSpec, plan: &ScenePlan) -> Result<Ties> {
-        if spec.variables.is_empty() {
-            return Err(problem_error(
-                study,
-                "variables".into(),
-                "[]",
-                "at least one variable".into(),
-            ));
-        }
-        let mut ties = Ties {
-            vars: Vec::new(),
-            targets: Vec::new(),
-            lanes: Vec::new(),
-            lanes_of: Vec::new(),
-        };
-        let mut used: Vec<(usize, usize)> = Vec::new();
-        for (i, v) in spec.variables.iter().enumerate() {
-            let key = format!("variables[{i}]");
-            ties.vars.push(variable(study, &key, v)?);
-            if v.sets.is_empty() {
-                return Err(problem_error(
-                    study,
-                    format!("{key}.sets"),
-                    "[]",
-                    "at least one \"<panel>:<design variable>\"".into(),
-                ));
-            }
-            let (mut t, mut names) = (Vec::new(), Vec::new());
-            for (k, entry) in v.sets.iter().enumerate() {
-                let key = format!("{key}.sets[{k}]");
-                let (target, lanes) = tie(study, plan, &key, entry, &mut used)?;
-                t.push(target);
-                names.extend(lanes);
-            }
-            if spec.tied_lanes && names.len() > 1 {
-                names = vec![names.join("+")];
-            }
-            let l: Vec<usize> = (ties.lanes.len()..ties.lanes.len() + names.len()).collect();
-            ties.lanes.extend(names);
-            ties.targets.push(t);
-            ties.lanes_of.push(l);
-        }
-        Ok(ties)
-    }
-}
-
-/// One `[[scene_problem.variables]]` entry as an optimization variable.
-fn variable(study: &Study, key: &str, v: &VariableSpec) -> Result<Variable> {
-    let [lo, hi] = v.bounds;
-    if v.periodic {
-        if !(lo.is_finite() && hi - lo == 180.0) {
-            return Err(problem_error(
-                study,
-                format!("{key}.bounds"),
-                format!("[{lo}, {hi}]"),
-                "finite bounds 180° apart (ply angles repeat every 180°)".into(),
-            ));
-        }
-        Variable::periodic(v.name.clone(), lo, 180.0)
-    } else {
-        Variable::bounded(v.name.clone(), lo, hi)
-    }
-    .map_err(|e| e.in_file(&study.path, &format!("scene_problem.{key}")))
-}
-
-/// One `"<panel>:<design variable>"` entry: the plies it sets and the
-/// scene's sensitivity lanes of the bodies built from that panel (each
-/// must be listed in `[scene] sensitivities`). `used` holds the panel
-/// design variables already tied.
-fn tie(
-    study: &Study,
-    plan: &ScenePlan,
-    key: &str,
-    entry: &str,
-    used: &mut Vec<(usize, usize)>,
-) -> Result<(PlyTarget, Vec<String>)> {
-    let bad =
-        |expected: String| problem_error(study, key.to_string(), format!("\"{entry}\""), expected);
-    let panels = plan.panels();
-    let (pname, dname) = entry
-        .split_once(':')
-        .ok_or_else(|| bad("\"<panel>:<design variable>\", e.g. \"panel3:theta_1_4\"".into()))?;
-    let Some(p) = panels.iter().position(|p| p.name == pname) else {
-        let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
-        return Err(bad(format!(
-            "a [[panels]] name before ':' ({})",
-            names.join(", ")
-        )));
-    };
-    let names = design_names(&panels[p].design);
-    let Some(d) = names.iter().position(|n| n == dname) else {
-        return Err(bad(format!(
-            "a design variable of panel {pname} after ':' ({})",
-            names.join(", ")
-        )));
-    };
-    if used.contains(&(p, d)) {
-        return Err(bad(
-            "each panel design variable set by one problem variable".into(),
-        ));
-    }
-    used.push((p, d));
-    let bodies = plan.bodies_of_panel(pname);
-    if bodies.is_empty() {
-        return Err(bad(format!(
-            "a panel of a flexible scene body (no [[scene.bodies]] uses panel {pname})"
-        )));
-    }
-    let listed = &plan.spec().sensitivities;
-    let mut lanes = Vec::new();
-    for b in bodies {
-        let lane = format!("{b}.design.{dname}");
-        if !listed.contains(&lane) {
-            return Err(study.error(
-                "scene.sensitivities",
-                format!("{listed:?}"),
-                format!("a list containing \"{lane}\" (the gradient of scene_problem.{key})"),
-            ));
-        }
-        lanes.push(lane);
-    }
-    let target = PlyTarget {
-        panel: p,
-        plies: panels[p].design.groups()[d].clone(),
-    };
-    Ok((target, lanes))
-}
-
 /// The objective's and constraints' responses exist, their bounds are
 /// valid, and the start and normalization designs are within the bounds.
 fn check_objective_and_constraints(
@@ -749,18 +580,6 @@ fn at_design(e: Error, vars: &[Variable], x: &[f64]) -> Error {
     e.at_place(&format!("scene problem at [{}]", design_label(vars, x)))
 }
 
-/// Names of a panel's design variables (`theta_1_4` for plies 1 and 4),
-/// as the modal basis names them.
-fn design_names(map: &crate::laminate::DesignMap) -> Vec<String> {
-    map.groups()
-        .iter()
-        .map(|g| {
-            let plies: Vec<String> = g.iter().map(|k| (k + 1).to_string()).collect();
-            format!("theta_{}", plies.join("_"))
-        })
-        .collect()
-}
-
 impl Problem for SceneProblem {
     fn variables(&self) -> &[Variable] {
         &self.vars
@@ -775,9 +594,13 @@ impl Problem for SceneProblem {
     fn name(&self) -> &str {
         &self.study
     }
-    /// Ply angles in degrees: `theta1_deg` is `θ1 [deg]`.
+    /// Ply angles in degrees: `theta1_deg` is `θ1 [deg]`; a scene
+    /// parameter is its name in SI units: `damping [SI]`.
     fn variable_label(&self, i: usize) -> String {
         let name = &self.vars[i].name;
+        if self.ties.is_scene(i) {
+            return format!("{name} [SI]");
+        }
         let name = name.strip_suffix("_deg").unwrap_or(name);
         match name.strip_prefix("theta") {
             Some(rest) => format!("θ{rest} [deg]"),

@@ -44,6 +44,16 @@
 //! bending (w, θx, θy) DOFs are then uncoupled in K and K' exactly, which
 //! the modal derivatives exploit (`modal::blocks`).
 //!
+//! # Ply thickness
+//! With the mid-plane fixed at z = 0, the interfaces move with each ply's
+//! thickness tₖ: `zᵢ = −h/2 + Σ_{j<i} tⱼ`, so `∂zᵢ/∂tₖ = −½` for `i ≤ k`
+//! and `+½` for `i > k`. Then `∂A/∂tₖ = Q̄ₖ`, `∂S/∂tₖ = κ C̄ₖ`,
+//! `∂B/∂tₖ = Σᵢ Q̄ᵢ (zᵢ₊₁ ∂zᵢ₊₁ − zᵢ ∂zᵢ)`,
+//! `∂D/∂tₖ = Σᵢ Q̄ᵢ (zᵢ₊₁² ∂zᵢ₊₁ − zᵢ² ∂zᵢ)`; the mass per area moves by
+//! `ρₖ` and the rotary inertia by `Σᵢ ρᵢ (zᵢ₊₁² ∂zᵢ₊₁ − zᵢ² ∂zᵢ)`
+//! ([`Laminate::thickness_derivative`]). A thicker ply of a symmetric stack
+//! breaks the symmetry, so `∂B/∂tₖ` is the plain sum (not zeroed).
+//!
 //! [`ply_stiffness_generic`] and [`stiffness_generic`] are a twin of the same
 //! mechanics written generic over the scalar with the explicit `c⁴, s²c², …`
 //! transformation polynomials (an independent route); tests drive them with
@@ -322,6 +332,48 @@ impl Laminate {
         Ok(Laminate { plies })
     }
 
+    /// The same stack with new ply thicknesses (one per ply, \[m\], each
+    /// finite and > 0).
+    pub fn with_thicknesses(&self, thicknesses: &[f64]) -> Result<Laminate> {
+        if thicknesses.len() != self.plies.len() {
+            return Err(Error::input(
+                "thicknesses",
+                thicknesses.len(),
+                format!("one thickness per ply ({})", self.plies.len()),
+            ));
+        }
+        let mut plies = self.plies.clone();
+        for (p, &t) in plies.iter_mut().zip(thicknesses) {
+            p.thickness = t;
+        }
+        Laminate::new(plies)
+    }
+
+    /// Exact first derivatives with respect to the thickness of ply `k`
+    /// (module doc, "Ply thickness"): A, B, D, S per metre of ply
+    /// thickness, and (mass per area \[kg/m² per m\], rotary inertia per
+    /// area \[kg per m\]). Zero for `k` out of range.
+    pub fn thickness_derivative(&self, k: usize) -> (Stiffness, [f64; 2]) {
+        let mut st = Stiffness::default();
+        let mut inertia = [0.0, 0.0];
+        if k >= self.plies.len() {
+            return (st, inertia);
+        }
+        let z = self.interfaces();
+        let dz = |i: usize| if i > k { 0.5 } else { -0.5 };
+        for (i, p) in self.plies.iter().enumerate() {
+            let q = p.stiffness_derivative(0);
+            let (z0, z1, d0, d1) = (z[i], z[i + 1], dz(i), dz(i + 1));
+            st.a += q.q * (d1 - d0);
+            st.b += q.q * (z1 * d1 - z0 * d0);
+            st.d += q.q * (z1 * z1 * d1 - z0 * z0 * d0);
+            st.s += q.g * (SHEAR_CORRECTION * (d1 - d0));
+            inertia[1] += p.material.rho * (z1 * z1 * d1 - z0 * z0 * d0);
+        }
+        inertia[0] = self.plies[k].material.rho;
+        (st, inertia)
+    }
+
     /// Ply interface coordinates z₀ = −h/2 < z₁ < … < z_n = h/2.
     fn interfaces(&self) -> Vec<f64> {
         let mut z = Vec::with_capacity(self.plies.len() + 1);
@@ -585,6 +637,80 @@ mod tests {
                 for j in 0..2 {
                     assert!((a.g[(i, j)] - g[i][j]).abs() < 1e-12 * m.g23);
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn thickness_derivatives_match_central_differences() {
+        // A, B, D and the inertias are polynomials of degree ≤ 3 in each
+        // thickness, so central differences (step 1e-8 m on 0.13-0.5 mm
+        // plies) carry truncation ~(h/t)² ≈ 1e-9 and rounding ~1e-10 of
+        // the largest entry; the exact derivatives must agree to 1e-7.
+        let m = Orthotropic::im6_sc1081();
+        let ply = |deg: f64, t: f64| Ply {
+            material: m,
+            thickness: t,
+            angle: f64::to_radians(deg),
+        };
+        let stacks = [
+            // Unsymmetric (B ≠ 0) with unequal plies.
+            vec![
+                ply(30.0, 0.5e-3),
+                ply(-45.0, 0.13e-3),
+                ply(60.0, 0.3e-3),
+                ply(10.0, 0.2e-3),
+            ],
+            // Symmetric (B = 0 exactly): one thicker ply makes B ≠ 0.
+            vec![
+                ply(55.0, 0.5e-3),
+                ply(-55.0, 0.5e-3),
+                ply(-55.0, 0.5e-3),
+                ply(55.0, 0.5e-3),
+            ],
+        ];
+        let h = 1e-8;
+        for plies in stacks {
+            let lam = Laminate::new(plies).unwrap();
+            let t = lam.plies().iter().map(|p| p.thickness).collect::<Vec<_>>();
+            for k in 0..t.len() {
+                let (d, [dm, dr]) = lam.thickness_derivative(k);
+                let at = |s: f64| {
+                    let mut tt = t.clone();
+                    tt[k] += s;
+                    lam.with_thicknesses(&tt).unwrap()
+                };
+                let (lp, lm) = (at(h), at(-h));
+                let (sp, sm) = (lp.stiffness(), lm.stiffness());
+                // Each quantity's scale: its largest reference entry or
+                // `floor` (B' may vanish: on [55/-55/-55/55] thickening
+                // ply 2 or 3 moves no B, and the differences leave rounding).
+                let close = |an: &[f64], fd: &[f64], what: &str, floor: f64| {
+                    let scale = fd.iter().fold(floor, |a, v| a.max(v.abs()));
+                    for (a, b) in an.iter().zip(fd) {
+                        assert!((a - b).abs() <= 1e-7 * scale, "ply {k} {what}: {a} vs {b}");
+                    }
+                };
+                let (qa, ht) = (d.a.abs().max(), lam.thickness());
+                let fd3 =
+                    |p: &Matrix3<f64>, q: &Matrix3<f64>| ((p - q) / (2.0 * h)).as_slice().to_vec();
+                close(d.a.as_slice(), &fd3(&sp.a, &sm.a), "A", 0.0);
+                close(d.b.as_slice(), &fd3(&sp.b, &sm.b), "B", qa * ht);
+                close(d.d.as_slice(), &fd3(&sp.d, &sm.d), "D", qa * ht * ht);
+                close(
+                    d.s.as_slice(),
+                    ((sp.s - sm.s) / (2.0 * h)).as_slice(),
+                    "S",
+                    0.0,
+                );
+                let fm = (lp.mass_per_area() - lm.mass_per_area()) / (2.0 * h);
+                close(&[dm], &[fm], "mass", 0.0);
+                let fr = (lp.rotary_inertia_per_area() - lm.rotary_inertia_per_area()) / (2.0 * h);
+                close(&[dr], &[fr], "rotary inertia", 0.0);
+            }
+            // The unsymmetric stack's outer ply moves B.
+            if !lam.is_symmetric() {
+                assert!(lam.thickness_derivative(0).0.b.abs().max() > 1.0);
             }
         }
     }

@@ -41,7 +41,8 @@
 //! with `f⁻`/`f⁺` the right-hand side with the old/new segment at the
 //! event. Here `g = θ(y) − b` and the breakpoints `b` (the segments'
 //! `lower`/`upper`) are not parameters: the anchor of [`super::Param::Anchor`]
-//! moves the law's line, not its interval, and damping, stiffness and mass
+//! and the slope of [`super::Param::Slope`] move the law's line, not its
+//! interval, and damping, stiffness and mass
 //! do not enter `g`. So `g_p = 0` for every [`super::Param`] (θ of a rigid joint
 //! does not depend on a ply angle either), and `g_y v` is one dual-number
 //! evaluation of θ at `y + ε v`.

@@ -35,6 +35,9 @@ pub struct Scene {
     pub params: Vec<(String, Param)>,
     /// Response functionals.
     pub responses: Vec<Response>,
+    /// The model force built from each `[[scene.forces]]` entry (`None`
+    /// where the scene's effects build none), to resolve parameter names.
+    pub force_index: Vec<Option<usize>>,
 }
 
 impl SceneSpec {
@@ -86,7 +89,16 @@ impl SceneSpec {
             effects: self.effects.clone(),
             params,
             responses,
+            force_index,
         })
+    }
+
+    /// The model parameter a sensitivity name (`forces[0].damping`,
+    /// `B5.mass`, ... as in `[scene] sensitivities`, ply angles excluded)
+    /// names in `scene`, built from this spec, whether or not it is a
+    /// sensitivity lane; `None` if it names none.
+    pub fn param_of(&self, scene: &Scene, name: &str) -> Option<Param> {
+        parse_param(&scene.model, &self.forces, &scene.force_index, name).filter(|p| !p.is_design())
     }
 
     /// Whether the scene lists effect `e`.

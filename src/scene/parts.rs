@@ -40,7 +40,8 @@ pub(crate) fn finite3(key: String, a: [f64; 3]) -> Result<Vector3<f64>> {
 
 /// The kinds of sensitivity parameter, by the last part of their dotted
 /// name: `<body>.mass`, `<force>.stiffness`, `<force>.damping`,
-/// `<body>.design.<variable>`, `forces[i].segments[k].anchor`. The one
+/// `<body>.design.<variable>`, `forces[i].segments[k].anchor`,
+/// `forces[i].segments[k].slope`. The one
 /// table of these names: [`parse_param`] and its message follow from it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum ParamKind {
@@ -54,16 +55,19 @@ pub(super) enum ParamKind {
     Design,
     /// Anchor of a segment of an actuator's law.
     Anchor,
+    /// Slope of a segment of an actuator's law (N·m/rad).
+    Slope,
 }
 
 impl ParamKind {
     /// Every kind.
-    const ALL: [ParamKind; 5] = [
+    const ALL: [ParamKind; 6] = [
         ParamKind::Mass,
         ParamKind::Stiffness,
         ParamKind::Damping,
         ParamKind::Design,
         ParamKind::Anchor,
+        ParamKind::Slope,
     ];
 
     /// The name part as written in study files, and the forms it is
@@ -75,6 +79,7 @@ impl ParamKind {
             ParamKind::Damping => ("damping", "<force name>.damping, forces[i].damping"),
             ParamKind::Design => ("design", "<body>.design.<variable> (flexible body)"),
             ParamKind::Anchor => ("anchor", "forces[i].segments[k].anchor"),
+            ParamKind::Slope => ("slope", "forces[i].segments[k].slope"),
         }
     }
 
@@ -134,7 +139,8 @@ pub(super) fn parse_param(
         Some(kind @ (ParamKind::Stiffness | ParamKind::Damping)) => spring(kind, fi)?,
         _ => {
             let (seg, kind) = rest.strip_prefix(".segments[")?.rsplit_once("].")?;
-            if ParamKind::find(kind)? != ParamKind::Anchor {
+            let kind = ParamKind::find(kind)?;
+            if !matches!(kind, ParamKind::Anchor | ParamKind::Slope) {
                 return None;
             }
             let seg: usize = seg.parse().ok()?;
@@ -149,7 +155,11 @@ pub(super) fn parse_param(
                 .segments
                 .iter()
                 .position(|s| s.lower == spec.lower && s.upper == spec.upper)?;
-            Param::Anchor(fi, sorted)
+            if kind == ParamKind::Slope {
+                Param::Slope(fi, sorted)
+            } else {
+                Param::Anchor(fi, sorted)
+            }
         }
     };
     p.value(model).map(|_| p)

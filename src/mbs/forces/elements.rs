@@ -219,7 +219,8 @@ impl System {
             };
             let seg = &law.segments[k];
             let anchor = pval(&ws.params, Param::Anchor(fi, k), seg.anchor);
-            m += cst::<T>(seg.value) + cst::<T>(seg.slope) * (anchor - th);
+            let slope = pval(&ws.params, Param::Slope(fi, k), seg.slope);
+            m += cst::<T>(seg.value) + slope * (anchor - th);
         }
         let axis: Vector3<T> = mi.frame.column(2).into();
         let tau = axis * (-m);

@@ -21,6 +21,10 @@ pub enum Param {
     /// Anchor (breakpoint) of segment `k` of the law of the actuator
     /// `forces[i]`: the `3.12` in `0.10 + 9.00(3.12 − θ)` (rad).
     Anchor(usize, usize),
+    /// Slope of segment `k` of the law of the actuator `forces[i]`: the
+    /// `9.00` in `0.10 + 9.00(3.12 − θ)` (N·m/rad), the law's spring rate
+    /// on that segment.
+    Slope(usize, usize),
     /// Design variable `k` (a ply angle, rad) of the modal basis of the
     /// flexible body `bodies[i]`: its exact effect on Λ and the mode
     /// shapes comes from the basis's derivatives (`dΛ/dθ`, `dX/dθ`).
@@ -52,6 +56,10 @@ impl Param {
             },
             Param::Anchor(f, k) => match model.forces.get(f) {
                 Some(Force::Rotational { law: Some(l), .. }) => l.segments.get(k).map(|s| s.anchor),
+                _ => None,
+            },
+            Param::Slope(f, k) => match model.forces.get(f) {
+                Some(Force::Rotational { law: Some(l), .. }) => l.segments.get(k).map(|s| s.slope),
                 _ => None,
             },
             Param::Design(b, k) => model
@@ -110,6 +118,11 @@ impl Param {
             Param::Anchor(f, k) => {
                 if let Force::Rotational { law: Some(l), .. } = &mut model.forces[f] {
                     l.segments[k].anchor = v;
+                }
+            }
+            Param::Slope(f, k) => {
+                if let Force::Rotational { law: Some(l), .. } = &mut model.forces[f] {
+                    l.segments[k].slope = v;
                 }
             }
             Param::Design(b, k) => {

@@ -1,6 +1,7 @@
 //! Tests of `plyscape::explore`: optimization drivers, multistart, shards, reports.
 mod certified;
 mod compare;
+mod design_vars;
 mod discrete;
 mod front;
 mod kill;
