@@ -85,6 +85,7 @@ pub mod optimum_report;
 pub mod problems;
 pub mod sampling;
 pub mod scaling;
+pub mod scene_bounds;
 pub mod scene_problem;
 pub mod settle;
 pub mod solvers;

@@ -7,4 +7,5 @@ mod multistart;
 mod optimum_report;
 mod resume;
 mod scene;
+mod scene_bounds;
 mod studies;
