@@ -95,6 +95,7 @@ pub mod problems;
 pub mod robustness;
 pub mod sampling;
 pub mod scaling;
+pub mod scene_bounds;
 pub mod scene_front;
 pub mod scene_problem;
 mod scene_vars;

@@ -43,7 +43,7 @@ pub struct SceneFrontProblem {
     /// The objectives' response names, in `[front]` order.
     names: Vec<String>,
     /// Their units (`J*s`, `J`, ...).
-    units: Vec<&'static str>,
+    units: Vec<String>,
     /// `|R_i(x_n)|`.
     scales: Vec<f64>,
     /// Evaluations by the bits of their design.
@@ -103,7 +103,7 @@ impl SceneFrontProblem {
                 ));
             }
         }
-        let units = names.iter().map(|n| inner.response_unit(n)).collect();
+        let units = extra.units.clone();
         Ok(SceneFrontProblem {
             inner,
             names: names.to_vec(),
@@ -179,7 +179,7 @@ impl MultiProblem for SceneFrontProblem {
         format!("{} [{}]", self.names[i], self.units[i])
     }
     fn objective_unit(&self, i: usize) -> Option<String> {
-        Some(self.units[i].to_string())
+        Some(self.units[i].clone())
     }
     fn objective_scale(&self, i: usize) -> f64 {
         self.scales[i]

@@ -26,7 +26,7 @@
 //!
 //! [[scene_problem.constraints]]
 //! response = "u3_peak"
-//! upper_relative = 1.0                   # c = 1.0 × value at `start` (or `upper = c`, absolute)
+//! upper_relative = 1.0                   # c = 1.0 × value at `start` (or `upper`/`lower`, absolute)
 //! ```
 //!
 //! Each problem variable is a ply angle in degrees written into every
@@ -38,7 +38,10 @@
 //! ply angle, in its SI unit; [`super::scene_vars`]), so that ply angles
 //! and mechanism parameters are designed together. The objective is `f = R₀(x) / R₀(x_ref)` (or
 //! `R₀(x)` without `normalize_at`), each constraint
-//! `g_j = R_j(x) / c_j − 1 <= 0` (Eq. 34 with `c_j` the bound).
+//! `g_j = R_j(x) / c_j − 1 <= 0` (Eq. 34 with `c_j` the bound) for an
+//! upper bound, or an absolute upper or lower bound normalized by a scale
+//! ([`super::scene_bounds`]). A problem whose responses are all
+//! frequencies builds the scene at each design without integrating it.
 //!
 //! Evaluation: a [`ScenePlan`] made once holds the parsed scene, the
 //! resolved panels and, per panel, a basis builder (mesh, sparsity
@@ -65,6 +68,7 @@
 //! written as given, and `x` and `x + 180°` give the same laminate up to
 //! the rounding of the rotation's sines and cosines.
 
+use super::scene_bounds::{self, Bound};
 pub use super::scene_vars::VariableSpec;
 use super::scene_vars::{problem_error, Target, Ties};
 use crate::error::{Error, Result};
@@ -73,6 +77,7 @@ use crate::laminate::Laminate;
 use crate::mbs::responses::{ResponseKind, ResponseValue};
 use crate::optimize::{Evaluation, Problem, Variable};
 use crate::scene::{BuildProfile, ScenePlan};
+use crate::simulate::sampled::frequencies;
 use crate::simulate::{simulate, Simulation};
 use crate::study::Study;
 use serde::Deserialize;
@@ -114,18 +119,7 @@ pub struct ObjectiveSpec {
     pub normalize_at: Option<Vec<f64>>,
 }
 
-/// One `[[scene_problem.constraints]]` entry: `R / c − 1 <= 0` with
-/// either `c = upper` or `c = upper_relative · R(start)`.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ConstraintSpec {
-    /// A `[[scene.responses]]` name.
-    pub response: String,
-    /// Absolute bound `c > 0` (response units).
-    pub upper: Option<f64>,
-    /// Bound as a factor of the response at the start design.
-    pub upper_relative: Option<f64>,
-}
+pub use super::scene_bounds::ConstraintSpec;
 
 /// A scene response as an optimization problem (see the module doc).
 pub struct SceneProblem {
@@ -136,8 +130,11 @@ pub struct SceneProblem {
     ties: Ties,
     /// Objective response and divisor.
     objective: (String, f64),
-    /// Constraint responses and bounds `c`.
-    constraints: Vec<(String, f64)>,
+    /// Constraint bounds, in the order of `g`.
+    constraints: Vec<Bound>,
+    /// SI units of the objective's and the constraints' responses (from
+    /// the start design's evaluation).
+    units: Vec<String>,
     start: Vec<f64>,
     /// The study's name, for reports.
     study: String,
@@ -146,6 +143,7 @@ pub struct SceneProblem {
 /// Raw response values (and their gradients per degree of each variable).
 struct Raw {
     values: Vec<f64>,
+    units: Vec<String>,
     gradients: Option<Vec<Vec<f64>>>,
     profile: EvalProfile,
 }
@@ -156,6 +154,8 @@ struct Raw {
 pub struct ExtraResponses {
     /// Values, in the responses' units.
     pub values: Vec<f64>,
+    /// The responses' SI units.
+    pub units: Vec<String>,
     /// Gradients per degree of each variable (one row per response), when
     /// asked.
     pub gradients: Option<Vec<Vec<f64>>>,
@@ -195,6 +195,7 @@ impl SceneProblem {
             ties,
             objective: (spec.objective.response.clone(), 1.0),
             constraints: Vec::new(),
+            units: Vec::new(),
             start: spec.start.clone(),
             study: study.name(),
         };
@@ -227,23 +228,10 @@ impl SceneProblem {
         wanted.extend(spec.constraints.iter().map(|c| c.response.clone()));
         let at_start = self.raw(&spec.start, &wanted, false)?;
         for (j, c) in spec.constraints.iter().enumerate() {
-            let bound = match c.upper {
-                Some(u) => u,
-                None => c.upper_relative.unwrap_or(1.0) * at_start.values[j + 1],
-            };
-            if !(bound.is_finite() && bound > 0.0) {
-                return Err(problem_error(
-                    study,
-                    format!("constraints[{j}].upper_relative"),
-                    c.upper_relative.unwrap_or(1.0),
-                    format!(
-                        "a bound > 0: {} at the start design is {bound:e}, so the constraint is degenerate",
-                        c.response
-                    ),
-                ));
-            }
-            self.constraints.push((c.response.clone(), bound));
+            let bounds = scene_bounds::resolve(study, j, c, at_start.values[j + 1])?;
+            self.constraints.extend(bounds);
         }
+        self.units = at_start.units.clone();
         if let Some(r) = &spec.objective.normalize_at {
             let v = if *r == spec.start {
                 at_start.values[0]
@@ -297,28 +285,28 @@ impl SceneProblem {
         self.objective.1
     }
 
-    /// The constraint bounds `c_j` (response units).
+    /// The constraint bounds `c_j` (response units), in the order of `g`.
     pub fn bounds(&self) -> Vec<f64> {
-        self.constraints.iter().map(|c| c.1).collect()
+        self.constraints.iter().map(|c| c.c).collect()
+    }
+
+    /// The constraints in the order of `g` (response, side, bound, scale).
+    pub fn constraint_bounds(&self) -> &[Bound] {
+        &self.constraints
     }
 
     /// The objective's response name and its SI unit (`J*s` for an
-    /// integral of energies, `J` for a peak or final value): the response
+    /// integral of energies, `s` for a crossing time, ..): the response
     /// is `f ×` [`SceneProblem::objective_scale`] in that unit.
-    pub fn objective_response(&self) -> (&str, &'static str) {
-        let name = self.objective.0.as_str();
-        (name, self.response_unit(name))
+    pub fn objective_response(&self) -> (&str, &str) {
+        let unit = self.units.first().map_or("-", |u| u.as_str());
+        (self.objective.0.as_str(), unit)
     }
 
-    /// The constraints' response names, in the order of `g`.
-    pub fn constraint_responses(&self) -> Vec<&str> {
-        self.constraints.iter().map(|c| c.0.as_str()).collect()
-    }
-
-    /// SI unit of the `[[scene.responses]]` entry `name` (from its kind).
-    pub fn response_unit(&self, name: &str) -> &'static str {
-        let kind = self.plan.spec().responses.iter().find(|r| r.name == name);
-        kind.map_or(ResponseKind::Peak.unit(), |r| r.kind.unit())
+    /// The constraints' labels, in the order of `g`: the response's name
+    /// (followed by `(lower bound)` for a lower bound).
+    pub fn constraint_responses(&self) -> Vec<String> {
+        self.constraints.iter().map(|c| c.label()).collect()
     }
 
     /// Simulate design `x` \[deg\] without sensitivities, with exactly the
@@ -356,6 +344,13 @@ impl SceneProblem {
             .collect()
     }
 
+    /// Whether `[[scene.responses]]` entry `name` is a frequency (no
+    /// integration needed).
+    fn is_frequency(&self, name: &str) -> bool {
+        let spec = self.plan.spec().responses.iter().find(|r| r.name == name);
+        spec.is_some_and(|r| r.kind == ResponseKind::Frequency)
+    }
+
     /// Simulate at `x` and return the named responses (gradients per
     /// degree of each variable when asked).
     fn raw(&self, x: &[f64], names: &[String], gradients: bool) -> Result<Raw> {
@@ -369,17 +364,25 @@ impl SceneProblem {
             .build_profiled(&laminates, lanes, false)
             .map_err(at)?;
         self.ties.apply_scene(&self.plan, &mut scene, x)?;
-        let sim = simulate(&scene).map_err(at)?.1;
+        // Frequencies alone need no integration.
+        let (responses, stats) = if names.iter().all(|n| self.is_frequency(n)) {
+            (frequencies(&scene).map_err(at)?, Default::default())
+        } else {
+            let sim = simulate(&scene).map_err(at)?.1;
+            (sim.responses, sim.stats)
+        };
         let find = |name: &str| -> Result<&ResponseValue> {
-            sim.responses
+            responses
                 .iter()
                 .find(|r| r.name == name)
                 .ok_or_else(|| Error::input("scene.responses", name, "a response of the scene"))
         };
         let mut values = Vec::new();
+        let mut units = Vec::new();
         let mut grads = Vec::new();
         for name in names {
             let r = find(name)?;
+            units.push(r.unit.clone());
             if !r.value.is_finite() {
                 return Err(Error::numerical(
                     format!("scene problem at [{}]", design()),
@@ -407,15 +410,16 @@ impl SceneProblem {
         let profile = EvalProfile {
             build,
             lanes: lanes.len(),
-            steps: sim.stats.steps,
-            rhs_calls: sim.stats.rhs_calls,
-            jvp_calls: sim.stats.jvp_calls,
-            integrate_seconds: sim.stats.wall,
-            outputs_seconds: sim.stats.observer_wall,
+            steps: stats.steps,
+            rhs_calls: stats.rhs_calls,
+            jvp_calls: stats.jvp_calls,
+            integrate_seconds: stats.wall,
+            outputs_seconds: stats.observer_wall,
             total_seconds: t0.elapsed().as_secs_f64(),
         };
         Ok(Raw {
             values,
+            units,
             gradients: gradients.then_some(grads),
             profile,
         })
@@ -449,12 +453,13 @@ impl SceneProblem {
             ));
         }
         let mut names = vec![self.objective.0.clone()];
-        names.extend(self.constraints.iter().map(|c| c.0.clone()));
+        names.extend(self.constraints.iter().map(|c| c.response.clone()));
         let own = names.len();
         names.extend(extra.iter().cloned());
         let raw = self.raw(x, &names, gradients)?;
         let extra = ExtraResponses {
             values: raw.values[own..].to_vec(),
+            units: raw.units[own..].to_vec(),
             gradients: (raw.gradients.as_ref()).map(|g| g[own..].to_vec()),
         };
         let s = self.objective.1;
@@ -463,7 +468,7 @@ impl SceneProblem {
             .constraints
             .iter()
             .zip(&raw.values[1..])
-            .map(|(c, v)| v / c.1 - 1.0)
+            .map(|(c, v)| c.g(*v))
             .collect();
         let (grad_f, grad_g) = match raw.gradients {
             None => (None, None),
@@ -473,7 +478,7 @@ impl SceneProblem {
                     .constraints
                     .iter()
                     .zip(&gr[1..])
-                    .map(|(c, row)| row.iter().map(|v| v / c.1).collect())
+                    .map(|(c, row)| row.iter().map(|v| c.dg(*v)).collect())
                     .collect();
                 (Some(gf), Some(gg))
             }
@@ -538,28 +543,8 @@ fn check_objective_and_constraints(
         check_design("objective.normalize_at", r)?;
     }
     for (j, c) in spec.constraints.iter().enumerate() {
-        let key = format!("constraints[{j}]");
-        check_response(format!("{key}.response"), &c.response)?;
-        let (v, k) = match (c.upper, c.upper_relative) {
-            (Some(u), None) => (u, "upper"),
-            (None, Some(u)) => (u, "upper_relative"),
-            _ => {
-                return Err(problem_error(
-                    study,
-                    key,
-                    "(table)",
-                    "exactly one of `upper` (absolute) and `upper_relative` (factor of the start value)".into(),
-                ))
-            }
-        };
-        if !(v.is_finite() && v > 0.0) {
-            return Err(problem_error(
-                study,
-                format!("{key}.{k}"),
-                v,
-                "a finite bound > 0".into(),
-            ));
-        }
+        check_response(format!("constraints[{j}].response"), &c.response)?;
+        scene_bounds::check(study, j, c)?;
     }
     Ok(())
 }

@@ -116,4 +116,5 @@ pub use model::{
 };
 pub use post::analysis::{Projection, Reaction};
 pub use post::responses;
+pub use post::series;
 pub use system::{System, Workspace};

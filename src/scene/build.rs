@@ -4,16 +4,15 @@
 //! the key below `scene` in its errors.
 
 use super::parts::{
-    finite3, flexible_body, make_marker, parse_energy, parse_param, parse_quantity, PanelBases,
-    ParamKind,
+    finite3, flexible_body, make_marker, parse_param, parse_quantity, PanelBases, ParamKind,
 };
 use super::quantity::{Columns, Quantity, Response};
+use super::responses::build_responses;
 use super::spec::{DriveSpec, Effect, JointSpec, JointType, SceneSpec};
 use crate::error::{Error, Result};
 use crate::integrate::{Options, SensitivityForm};
 use crate::mbs::math::{axis_angle, frame_from_axis};
-use crate::mbs::model::{Body, Drive, Harmonic, Integral, Joint, JointKind, Model, Param, Piece};
-use crate::mbs::responses::ResponseKind;
+use crate::mbs::model::{Body, Drive, Harmonic, Joint, JointKind, Model, Param, Piece};
 use nalgebra::{Matrix3, Vector3};
 
 /// A built scene: the system model, integrator options and outputs.
@@ -78,7 +77,7 @@ impl SceneSpec {
             .map(|b| b.name.as_str())
             .collect();
         let outputs = self.outputs(&model, &flex_names)?;
-        let responses = self.responses(&mut model, &flex_names)?;
+        let responses = build_responses(&self.responses, &mut model, &flex_names, &options.times)?;
         let params = self.params(&mut model, &force_index)?;
         Ok(Scene {
             model,
@@ -386,61 +385,6 @@ impl SceneSpec {
             params.push((name.clone(), p));
         }
         Ok(params)
-    }
-
-    /// Build `[[scene.responses]]` (integrals become model states).
-    fn responses(&self, model: &mut Model, flex_names: &[&str]) -> Result<Vec<Response>> {
-        let mut out: Vec<Response> = Vec::new();
-        for (k, r) in self.responses.iter().enumerate() {
-            let key = format!("responses[{k}]");
-            if r.name.is_empty() || out.iter().any(|o| o.name() == r.name) {
-                return Err(Error::input(
-                    format!("{key}.name"),
-                    &r.name,
-                    "a unique, non-empty name",
-                ));
-            }
-            if !r.scale.is_finite() {
-                return Err(Error::input(
-                    format!("{key}.scale"),
-                    r.scale,
-                    "a finite factor",
-                ));
-            }
-            let mut terms = Vec::new();
-            for (i, q) in r.of.iter().enumerate() {
-                terms.extend(parse_energy(model, flex_names, q).ok_or_else(|| {
-                    Error::input(
-                        format!("{key}.of[{i}]"),
-                        q,
-                        "kinetic_energy (all bodies), <body>.kinetic_energy or \
-                         <body>.strain_energy of a body with a `flexible` table",
-                    )
-                })?);
-            }
-            if r.of.is_empty() {
-                return Err(Error::input(
-                    format!("{key}.of"),
-                    "[]",
-                    "at least one energy",
-                ));
-            }
-            let integral = (r.kind == ResponseKind::Integral).then(|| {
-                model.integrals.push(Integral {
-                    terms: terms.clone(),
-                    scale: r.scale,
-                });
-                model.integrals.len() - 1
-            });
-            out.push(Response {
-                name: r.name.clone(),
-                kind: r.kind,
-                terms,
-                scale: r.scale,
-                integral,
-            });
-        }
-        Ok(out)
     }
 }
 

@@ -4,7 +4,8 @@
 //! The stages: [`spec`] (the section as parsed, plain data),
 //! [`build`] (data → [`Scene`]: a [`crate::mbs::Model`] with integrator
 //! options, output plan and sensitivity parameters; [`parts`] holds its
-//! pieces), [`quantity`] (the output plan), and [`load`] (a study →
+//! pieces), [`quantity`] (the output plan), [`responses`] (the
+//! response functionals), and [`load`] (a study →
 //! scene, with the panels' modal bases; [`ScenePlan`] keeps everything
 //! that does not depend on the ply angles and takes a design as numbers).
 //!
@@ -59,8 +60,14 @@
 //!                                "slide.displacement", "slide.velocity",
 //!                                "B4.kinetic_energy", "kinetic_energy"]
 //!                  plot = "R3.angle"; plot_file = "theta"   # theta.svg
-//! [[scene.responses]]  name = "G"; kind = "integral" | "peak" | "final"
+//! [[scene.responses]]  name = "G"; kind = "integral" | "peak" | "final" | "value_at" |
+//!                      "crossing" | "frequency"
 //!                      of = ["kinetic_energy", "B3.strain_energy", ..]; scale = 1.0
+//!                      # or one unit: "R3.angle", "B4.position_z", "tip.deflection_x", ..
+//!                      sense = "max" | "min"                  # peak
+//!                      time = 0.5                             # value_at (s)
+//!                      level = 1.2; direction = "up"          # crossing (time in s)
+//!                      mode = 1                               # frequency of of = ["B3"] (Hz)
 //! ```
 //! Rigid bodies start with their axes along the global axes, so `inertia`
 //! is both the global and the body-frame tensor at `t = 0`. A flexible
@@ -110,10 +117,11 @@ pub mod forces;
 pub mod load;
 pub mod parts;
 pub mod quantity;
+pub mod responses;
 pub mod spec;
 
 pub use build::Scene;
 pub use load::{load_scene, BuildProfile, ScenePlan};
 pub use parts::{PanelBases, Stiffening};
-pub use quantity::{Quantity, QuantityKind, Response};
+pub use quantity::{Quantity, QuantityKind, Response, ScalarOutput};
 pub use spec::{Effect, SceneSpec};

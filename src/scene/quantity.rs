@@ -8,27 +8,48 @@
 //! ([`Quantity::headers`]) and the choice of sensitivity columns follow
 //! from that table; adding an output is one variant, its row of the table
 //! and its evaluation in `crate::simulate`. Response kinds are
-//! [`ResponseKind`] (integral, peak, final), deserialized directly from
-//! `[[scene.responses]] kind`.
+//! [`ResponseKind`] (integral, peak, final, value_at, crossing,
+//! frequency), deserialized directly from `[[scene.responses]] kind`.
 
-use crate::mbs::responses::ResponseKind;
+use crate::mbs::responses::{Direction, ResponseKind, Sense};
 use crate::mbs::Energy;
 
-/// A built response: `scale · Σ terms` over the run, reduced by its kind
-/// (the time integral, the peak or the final value).
+/// A built response: `scale · Σ` outputs over the run, reduced by its
+/// kind, or a natural frequency of a flexible body.
+///
+/// Two forms: sums of energies reduced by `integral`, `peak` (largest) or
+/// `final` are evaluated as before this struct had [`Response::outputs`]
+/// (integrals as integrated states, `terms`); every other response is
+/// sampled at the output times from [`Response::outputs`] and reduced by
+/// `crate::mbs::series`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Response {
     /// The `[[scene.responses]] name`.
     pub name: String,
-    /// Integral over the run, peak or final value.
+    /// How the series is reduced (or `frequency`).
     pub kind: ResponseKind,
-    /// The energies summed.
+    /// The energies summed (energy form; empty in the sampled form).
     pub terms: Vec<Energy>,
     /// Dimensionless factor of the sum.
     pub scale: f64,
-    /// For [`ResponseKind::Integral`]: index of its integrated state in
-    /// [`crate::mbs::Model::integrals`] (`None` for the other kinds).
+    /// For [`ResponseKind::Integral`] of energies: index of its
+    /// integrated state in [`crate::mbs::Model::integrals`] (`None`
+    /// otherwise).
     pub integral: Option<usize>,
+    /// The outputs summed in the sampled form (empty in the energy form
+    /// and for frequencies).
+    pub outputs: Vec<ScalarOutput>,
+    /// `peak`: largest or smallest value.
+    pub sense: Sense,
+    /// `value_at`: the time (s).
+    pub time: f64,
+    /// `crossing`: the level and the direction.
+    pub level: (f64, Direction),
+    /// `frequency`: the body and the 0-based mode of its basis.
+    pub mode: (usize, usize),
+    /// SI unit of the response's value (`ResponseKind::unit_of` of the
+    /// outputs' unit).
+    pub unit: String,
 }
 
 impl Response {
@@ -36,6 +57,17 @@ impl Response {
     pub fn name(&self) -> &str {
         &self.name
     }
+}
+
+/// One scalar output of a response: a one-column [`Quantity`], or one
+/// component (0, 1, 2 for x, y, z) of a three-column one
+/// (`B3.position_z`, `tip.deflection_x`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScalarOutput {
+    /// The output.
+    pub quantity: Quantity,
+    /// The column of a [`Columns::Xyz`] output (0 otherwise).
+    pub component: usize,
 }
 
 /// What the head of an output name `<head>.<kind>` must name.

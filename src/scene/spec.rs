@@ -3,7 +3,7 @@
 //! [`super::build`].
 
 use crate::integrate::{Method, SensitivityForm};
-use crate::mbs::responses::ResponseKind;
+use crate::mbs::responses::{Direction, ResponseKind, Sense};
 use crate::modal::ModeUpdate;
 use serde::Deserialize;
 
@@ -145,27 +145,43 @@ pub struct SceneSpec {
 }
 
 /// `[[scene.responses]] name = "psi0"; kind = "integral" | "peak" |
-/// "final"; of = ["B2.strain_energy", "crank.kinetic_energy",
-/// "kinetic_energy", ..]; scale = 2.0`: the time integral (as an extra
-/// integrated state), the largest value over the run (located from dense
-/// output) or the value at the end time of `scale · Σ` the listed
-/// energies (strain energies of flexible bodies, kinetic energies of a
-/// body or of all bodies).
+/// "final" | "value_at" | "crossing" | "frequency"; of = [..]; scale =
+/// 2.0`: a functional of `scale · Σ` the listed outputs over the run —
+/// the time integral, the largest (or smallest) value located from dense
+/// output, the value at the end time or at a given time, the first time
+/// the sum crosses a level — or a natural frequency of a flexible body.
+/// Energies (`<body>.strain_energy`, `<body>.kinetic_energy`,
+/// `kinetic_energy`) are summed; any other output (`<joint>.angle`,
+/// `<body>.position_z`, `<marker>.deflection_x`, ..) is one of a sum of
+/// outputs with the same unit.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ResponseSpec {
     /// Unique, non-empty name (the `response` of an exploration, the
     /// column of `responses.csv`).
     pub name: String,
-    /// `integral` (∫ dt, J·s), `peak` (max over the run, J) or `final`
-    /// (at the end time, J).
+    /// `integral` (∫ dt), `peak` (extreme over the run), `final` (at the
+    /// end time), `value_at` (at `time`), `crossing` (first time the
+    /// output crosses `level`, s) or `frequency` (Hz).
     pub kind: ResponseKind,
-    /// The energies summed (at least one): `kinetic_energy` (all bodies),
-    /// `<body>.kinetic_energy`, `<body>.strain_energy` (a flexible body).
+    /// The outputs summed (at least one): energies, or scalar outputs of
+    /// one unit (`<joint>.angle|rate|displacement|velocity`,
+    /// `<body>.position_x|y|z`, `<marker>.deflection_x|y|z`); for
+    /// `frequency` one flexible body (`["B3"]`).
     pub of: Vec<String>,
     /// Dimensionless factor of the sum (finite; default 1).
     #[serde(default = "one")]
     pub scale: f64,
+    /// `peak`: `max` (default) or `min`.
+    pub sense: Option<Sense>,
+    /// `value_at`: the time (s), within the output times.
+    pub time: Option<f64>,
+    /// `crossing`: the level, in the unit of the outputs.
+    pub level: Option<f64>,
+    /// `crossing`: `up`, `down` or `either` (default).
+    pub direction: Option<Direction>,
+    /// `frequency`: the mode of the body's modal basis (1 = lowest).
+    pub mode: Option<usize>,
 }
 
 fn one() -> f64 {

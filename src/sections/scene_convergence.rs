@@ -65,7 +65,7 @@ pub struct Variant {
     /// `(name, value)` of each response.
     pub responses: Vec<(String, f64)>,
     /// SI unit of each response (`J*s`, `J`), in the same order.
-    pub units: Vec<&'static str>,
+    pub units: Vec<String>,
 }
 
 /// The scene study with `divisions` on every panel, `modes` on every
@@ -166,7 +166,7 @@ pub fn run_grid(
                     .iter()
                     .map(|r| (r.name.clone(), r.value))
                     .collect(),
-                units: sim.responses.iter().map(|r| r.kind.unit()).collect(),
+                units: sim.responses.iter().map(|r| r.unit.clone()).collect(),
             };
             report(&v);
             out.push(v);

@@ -14,6 +14,7 @@ use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Stats};
 use crate::mbs::post::energy::EnergyMonitor;
 use crate::mbs::responses::{energy_lanes, peak, ResponseKind, ResponseValue};
+use crate::mbs::series::Sample;
 use crate::mbs::Projection;
 use crate::mbs::{Energy, Param, Reaction, System, Workspace};
 use crate::report::csv::{sci, write_table};
@@ -23,6 +24,7 @@ use crate::scene::{Quantity, Scene};
 use num_dual::Dual64;
 use std::path::{Path, PathBuf};
 
+pub mod sampled;
 pub mod spin;
 
 /// Everything a simulation produced.
@@ -123,6 +125,7 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
     // sensitivities (for integral responses).
     let mut peaks: Vec<Vec<(f64, f64, Vec<f64>)>> = vec![Vec::new(); scene.responses.len()];
     let mut s_end = vec![0.0; n * scene.params.len()];
+    let mut sampler = sampled::Sampler::new(&scene.responses);
     let mut spin = spin::SpinWatch::new(&sys);
     let mut observe = |t: f64, y: &[f64], s: &[f64]| {
         spin.observe(&sys, t, y);
@@ -136,8 +139,9 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
                 .map(|(i, (_, p))| (&s[i * n..(i + 1) * n], *p))
                 .collect()
         };
+        sampler.observe(&sys, &scene.responses, (t, y), &lanes);
         for (r, series) in scene.responses.iter().zip(peaks.iter_mut()) {
-            if r.kind == ResponseKind::Peak {
+            if r.kind == ResponseKind::Peak && r.outputs.is_empty() {
                 let (v, g) = energy_lanes(&sys, (&r.terms, r.scale), y, &lanes);
                 series.push((t, v, g));
             }
@@ -221,7 +225,7 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
         Err(e) => return Err(e),
     };
     let responses = if failure.is_none() {
-        collect_responses(scene, &sys, &peaks, &y_end, &s_end)?
+        collect_responses(scene, &sys, (&peaks, &sampler), &y_end, &s_end)?
     } else {
         Vec::new()
     };
@@ -363,15 +367,24 @@ fn output_row(
 fn collect_responses(
     scene: &Scene,
     sys: &System,
-    peaks: &[Vec<(f64, f64, Vec<f64>)>],
+    (peaks, sampler): (&[Vec<Sample>], &sampled::Sampler),
     y_end: &[f64],
     s_end: &[f64],
 ) -> Result<Vec<ResponseValue>> {
     let n = y_end.len();
     let io = sys.integral_off();
     let mut responses = Vec::new();
-    for (r, series) in scene.responses.iter().zip(peaks) {
+    let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
+    for (k, (r, series)) in scene.responses.iter().zip(peaks).enumerate() {
         let name = r.name.clone();
+        if r.kind == ResponseKind::Frequency {
+            responses.push(sampled::frequency(sys, r, &params)?);
+            continue;
+        }
+        if !r.outputs.is_empty() {
+            responses.push(sampler.reduce(&scene.responses, k)?);
+            continue;
+        }
         responses.push(match r.kind {
             ResponseKind::Integral => {
                 let index = r.integral.ok_or_else(|| {
@@ -384,6 +397,7 @@ fn collect_responses(
                     name,
                     kind: r.kind,
                     value: y_end[io + index],
+                    unit: r.unit.clone(),
                     time: None,
                     gradient: (0..scene.params.len())
                         .map(|i| s_end[i * n + io + index])
@@ -402,9 +416,16 @@ fn collect_responses(
                     name,
                     kind: r.kind,
                     value,
+                    unit: r.unit.clone(),
                     time: scene.options.times.last().copied(),
                     gradient,
                 }
+            }
+            ResponseKind::ValueAt | ResponseKind::Crossing | ResponseKind::Frequency => {
+                return Err(Error::numerical(
+                    "simulate: responses",
+                    format!("{name}: a {} response of energies is sampled", r.kind),
+                ))
             }
             ResponseKind::Peak => {
                 let (t, value, gradient) = peak(series).ok_or_else(|| {
@@ -414,6 +435,7 @@ fn collect_responses(
                     name,
                     kind: r.kind,
                     value,
+                    unit: r.unit.clone(),
                     time: Some(t),
                     gradient,
                 }
@@ -584,7 +606,7 @@ pub fn write_results(scene: &Scene, sim: &Simulation, dir: &Path) -> Result<Vec<
                     r.name.clone(),
                     r.kind.to_string(),
                     sci(r.value, 12),
-                    r.kind.unit().to_string(),
+                    r.unit.clone(),
                     r.time.map_or(String::new(), |t| format!("{t:.6}")),
                 ];
                 rec.extend(r.gradient.iter().map(|g| sci(*g, 12)));

@@ -34,16 +34,27 @@ use crate::mbs::system::{System, Workspace};
 use num_dual::Dual64;
 
 /// The kind of a response functional (paper Eqs. 33–34), as written in
-/// `[[scene.responses]] kind`: `integral`, `peak` or `final`.
+/// `[[scene.responses]] kind`: `integral`, `peak`, `final`, `value_at`,
+/// `crossing` or `frequency`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ResponseKind {
-    /// `∫ scale·Σ E dt` over the run, an integrated state (Eq. 33).
+    /// `∫ scale·Σ y dt` over the run: an integrated state for energies
+    /// (Eq. 33), the trapezoidal rule over the output times otherwise.
     Integral,
-    /// `max_t scale·Σ E(t)` at its critical time point (Eq. 34).
+    /// `max_t` (or `min_t`, `sense = "min"`) of `scale·Σ y(t)` at its
+    /// critical time point (Eq. 34).
     Peak,
-    /// `scale·Σ E(t_end)`.
+    /// `scale·Σ y(t_end)`.
     Final,
+    /// `scale·Σ y(t)` at the given `time`, interpolated between output
+    /// times.
+    ValueAt,
+    /// The first time (s) at which `scale·Σ y` crosses `level`.
+    Crossing,
+    /// A natural frequency `√λ_k / (2π)` (Hz) of a flexible body's modal
+    /// basis; no time integration.
+    Frequency,
 }
 
 impl std::fmt::Display for ResponseKind {
@@ -53,19 +64,63 @@ impl std::fmt::Display for ResponseKind {
             ResponseKind::Integral => "integral",
             ResponseKind::Peak => "peak",
             ResponseKind::Final => "final",
+            ResponseKind::ValueAt => "value_at",
+            ResponseKind::Crossing => "crossing",
+            ResponseKind::Frequency => "frequency",
         })
     }
 }
 
 impl ResponseKind {
     /// SI unit of a response of this kind over energies (J) with a
-    /// dimensionless scale: `J*s` for an integral, `J` otherwise.
+    /// dimensionless scale: `J*s` for an integral, `s` for a crossing
+    /// time, `Hz` for a frequency, `J` otherwise.
     pub fn unit(&self) -> &'static str {
         match self {
             ResponseKind::Integral => "J*s",
-            ResponseKind::Peak | ResponseKind::Final => "J",
+            ResponseKind::Crossing => "s",
+            ResponseKind::Frequency => "Hz",
+            ResponseKind::Peak | ResponseKind::Final | ResponseKind::ValueAt => "J",
         }
     }
+
+    /// SI unit of a response of this kind over an output in unit `base`:
+    /// `<base>*s` for an integral, `s` for a crossing time, `Hz` for a
+    /// frequency, `base` otherwise (`J` gives [`ResponseKind::unit`]).
+    pub fn unit_of(&self, base: &str) -> String {
+        match self {
+            ResponseKind::Integral => format!("{base}*s"),
+            ResponseKind::Crossing => "s".into(),
+            ResponseKind::Frequency => "Hz".into(),
+            ResponseKind::Peak | ResponseKind::Final | ResponseKind::ValueAt => base.into(),
+        }
+    }
+}
+
+/// Which extreme a `peak` response takes: `sense = "max"` (default) or
+/// `"min"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Sense {
+    /// The largest value over the run.
+    #[default]
+    Max,
+    /// The smallest value over the run.
+    Min,
+}
+
+/// Which crossings of `level` a `crossing` response counts:
+/// `direction = "up"`, `"down"` or `"either"` (default).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// From below the level to at or above it.
+    Up,
+    /// From above the level to at or below it.
+    Down,
+    /// Either way.
+    #[default]
+    Either,
 }
 
 /// One evaluated response.
@@ -73,12 +128,15 @@ impl ResponseKind {
 pub struct ResponseValue {
     /// The `[[scene.responses]] name`.
     pub name: String,
-    /// Integral over the run, peak or final value.
+    /// The response's kind.
     pub kind: ResponseKind,
-    /// The response's value (J·s for an integral, J otherwise, times the
-    /// scale).
+    /// The response's value, in [`ResponseValue::unit`].
     pub value: f64,
-    /// Time of the peak or the end time (s); `None` for integrals.
+    /// SI unit of the value (`J*s` for an integral of energies, `rad` for
+    /// a peak of an angle, `s` for a crossing time, `Hz` for a frequency).
+    pub unit: String,
+    /// Time of the peak, of the value or of the crossing, or the end
+    /// time (s); `None` for integrals and frequencies.
     pub time: Option<f64>,
     /// `d value / d p` for each sensitivity parameter of the scene.
     pub gradient: Vec<f64>,

@@ -10,5 +10,6 @@ mod optimum_report;
 mod resume;
 mod robustness;
 mod scene;
+mod scene_bounds;
 mod scene_front;
 mod studies;

@@ -12,6 +12,8 @@ mod kernel;
 mod loads;
 mod mechanisms;
 mod prismatic;
+mod responses;
+mod responses_flex;
 mod robust;
 mod sar;
 mod sar_clamp;

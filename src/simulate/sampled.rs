@@ -1,0 +1,260 @@
+//! Responses in the sampled form and frequency responses.
+//!
+//! A sampled response `scale · Σ y_i` over scalar outputs
+//! ([`crate::scene::ScalarOutput`]) is evaluated at every output time
+//! with its derivative along each sensitivity lane `(∂y/∂p, p)`: one
+//! dual-number evaluation of each output at `y + ε ∂y/∂p` with the design
+//! seed of `p` (so `dX/dθ` and `dΛ/dθ` enter explicitly), as the columns
+//! of `sensitivities.csv`. Joint angles are unwrapped over the series as
+//! in `history.csv`. The series is then reduced by
+//! [`crate::mbs::series`] (integral, extreme, value at a time, crossing;
+//! the final value is the last sample).
+//!
+//! A frequency response is `f_k = scale · √λ_k / (2π)` of a flexible
+//! body's basis, with `df_k/dp = scale · (dλ_k/dp) / (4π √λ_k)` for a
+//! lane `p` that seeds one of the body's design variables (the basis's
+//! eigenvalue derivatives, `crate::modal::derivatives`, repeated
+//! eigenvalues included), zero for every other lane: it needs no
+//! integration.
+
+use crate::error::{Error, Result};
+use crate::mbs::responses::{ResponseKind, ResponseValue};
+use crate::mbs::series::{crossing, extreme, trapezoid, value_at, NoCrossing, Sample};
+use crate::mbs::{Energy, Param, System, Workspace};
+use crate::scene::{QuantityKind, Response, ScalarOutput, Scene};
+use num_dual::Dual64;
+
+/// One scalar output at the dual state `yd` with the parameter seeds.
+fn eval(sys: &System, out: &ScalarOutput, yd: &[Dual64], seeds: &[(Param, Dual64)]) -> Dual64 {
+    let (i, c) = (out.quantity.of, out.component);
+    let mut kin = Vec::new();
+    sys.body_kin(yd, seeds, &mut kin);
+    let kinetic = |terms: Vec<Energy>| {
+        let mut ws = Workspace::empty();
+        ws.params = seeds.to_vec();
+        sys.energy_sum(&terms, yd, &mut ws)
+    };
+    match out.quantity.kind {
+        QuantityKind::Angle => sys.joint_angle(&kin, i).0,
+        QuantityKind::Rate => sys.joint_angle(&kin, i).1,
+        QuantityKind::Displacement => sys.joint_slide(&kin, i).0,
+        QuantityKind::Velocity => sys.joint_slide(&kin, i).1,
+        QuantityKind::Position => match sys.slot[i] {
+            Some(k) => yd[sys.pos_off(k) + c],
+            None => Dual64::from(sys.model.bodies[i].r0[c]),
+        },
+        QuantityKind::StrainEnergy => match sys.slot[i] {
+            Some(k) => sys.strain_energy_dual(yd, k, &kin[k].design),
+            None => Dual64::from(0.0),
+        },
+        QuantityKind::KineticEnergy => kinetic(vec![Energy::Kinetic(i)]),
+        QuantityKind::TotalKineticEnergy => kinetic(Energy::kinetic_total(&sys.model)),
+        QuantityKind::Deflection => sys.deflection_kin(&kin, i)[c],
+        // Refused in a response when the scene is built
+        // (`scene::responses`).
+        QuantityKind::Reaction
+        | QuantityKind::Modal
+        | QuantityKind::Energy
+        | QuantityKind::Violation => Dual64::from(f64::NAN),
+    }
+}
+
+/// The value of one output at `y` and its derivative along each lane.
+fn output_lanes(
+    sys: &System,
+    out: &ScalarOutput,
+    y: &[f64],
+    lanes: &[(&[f64], Param)],
+) -> (f64, Vec<f64>) {
+    let y0: Vec<Dual64> = y.iter().map(|&a| Dual64::from(a)).collect();
+    let value = eval(sys, out, &y0, &[]).re;
+    let grad = lanes
+        .iter()
+        .map(|(lane, p)| {
+            let yd: Vec<Dual64> = y
+                .iter()
+                .zip(*lane)
+                .map(|(&a, &b)| Dual64::new(a, b))
+                .collect();
+            let seed = (*p, Dual64::new(p.value(&sys.model).unwrap_or(0.0), 1.0));
+            eval(sys, out, &yd, &[seed]).eps
+        })
+        .collect();
+    (value, grad)
+}
+
+/// The series of the scene's sampled responses, filled at the output
+/// times.
+#[derive(Debug, Default)]
+pub struct Sampler {
+    /// Per response of the scene: its samples (empty for the energy form
+    /// and frequencies).
+    series: Vec<Vec<Sample>>,
+    /// Per response and output: the previous value (angle unwrapping).
+    prev: Vec<Vec<Option<f64>>>,
+}
+
+impl Sampler {
+    /// An empty sampler for `responses`.
+    pub fn new(responses: &[Response]) -> Sampler {
+        Sampler {
+            series: vec![Vec::new(); responses.len()],
+            prev: responses
+                .iter()
+                .map(|r| vec![None; r.outputs.len()])
+                .collect(),
+        }
+    }
+
+    /// Sample every sampled response at `(t, y)` with its lanes.
+    pub fn observe(
+        &mut self,
+        sys: &System,
+        responses: &[Response],
+        (t, y): (f64, &[f64]),
+        lanes: &[(&[f64], Param)],
+    ) {
+        let turn = 2.0 * std::f64::consts::PI;
+        for (k, r) in responses.iter().enumerate() {
+            if r.outputs.is_empty() {
+                continue;
+            }
+            let mut value = 0.0;
+            let mut grad = vec![0.0; lanes.len()];
+            for (out, prev) in r.outputs.iter().zip(self.prev[k].iter_mut()) {
+                let (mut v, g) = output_lanes(sys, out, y, lanes);
+                if out.quantity.kind == QuantityKind::Angle {
+                    if let Some(p) = *prev {
+                        v += turn * ((p - v) / turn).round();
+                    }
+                }
+                *prev = Some(v);
+                value += v;
+                for (a, b) in grad.iter_mut().zip(&g) {
+                    *a += b;
+                }
+            }
+            let s = r.scale;
+            self.series[k].push((t, s * value, grad.iter().map(|g| s * g).collect()));
+        }
+    }
+
+    /// The value of sampled response `k` of `responses`: its series
+    /// reduced by its kind. A crossing that does not happen, or a series
+    /// without samples, is a numerical error naming the response.
+    pub fn reduce(&self, responses: &[Response], k: usize) -> Result<ResponseValue> {
+        let r = &responses[k];
+        let series = &self.series[k];
+        let fail = |detail: String| {
+            Error::numerical(
+                "simulate: responses",
+                format!("response {}: {detail}", r.name),
+            )
+        };
+        let none = || fail("no samples (no output times)".into());
+        let (time, value, gradient) = match r.kind {
+            ResponseKind::Integral => {
+                let (v, g) = trapezoid(series).ok_or_else(none)?;
+                (None, v, g)
+            }
+            ResponseKind::Peak => {
+                let (t, v, g) = extreme(series, r.sense).ok_or_else(none)?;
+                (Some(t), v, g)
+            }
+            ResponseKind::Final => {
+                let (t, v, g) = series.last().cloned().ok_or_else(none)?;
+                (Some(t), v, g)
+            }
+            ResponseKind::ValueAt => {
+                let (v, g) = value_at(series, r.time).ok_or_else(|| {
+                    fail(format!("time {} s is outside the output times", r.time))
+                })?;
+                (Some(r.time), v, g)
+            }
+            ResponseKind::Crossing => {
+                let (level, dir) = r.level;
+                let (t, g) = crossing(series, level, dir).map_err(|e| match e {
+                    NoCrossing::Never(lo, hi) => fail(format!(
+                        "does not cross level {level} ({dir:?}) between t = {} s and {} s: \
+                         its range over the run is [{lo:e}, {hi:e}] {}",
+                        series.first().map_or(0.0, |s| s.0),
+                        series.last().map_or(0.0, |s| s.0),
+                        r.outputs
+                            .first()
+                            .map_or("", |o| o.quantity.kind.info().unit)
+                    )),
+                    NoCrossing::Flat(t) => fail(format!(
+                        "touches level {level} at t = {t} s with zero slope: the crossing \
+                         time has no derivative there"
+                    )),
+                })?;
+                (Some(t), t, g)
+            }
+            ResponseKind::Frequency => return Err(fail("a frequency is not sampled".into())),
+        };
+        Ok(ResponseValue {
+            name: r.name.clone(),
+            kind: r.kind,
+            value,
+            unit: r.unit.clone(),
+            time,
+            gradient,
+        })
+    }
+}
+
+/// A frequency response of the built model (module doc), with its
+/// derivative along each sensitivity parameter.
+pub fn frequency(sys: &System, r: &Response, params: &[Param]) -> Result<ResponseValue> {
+    let (b, j) = r.mode;
+    let fail = |detail: String| {
+        Error::numerical(
+            "simulate: responses",
+            format!("response {}: {detail}", r.name),
+        )
+    };
+    let flex = sys.model.bodies[b]
+        .flex
+        .as_ref()
+        .ok_or_else(|| fail("the body has no modal basis".into()))?;
+    let lambda = flex.basis.eigenvalues[j];
+    if !(lambda > 0.0 && lambda.is_finite()) {
+        return Err(fail(format!(
+            "eigenvalue {lambda:e} 1/s² of mode {} is not positive",
+            j + 1
+        )));
+    }
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let value = r.scale * lambda.sqrt() / two_pi;
+    let gradient = params
+        .iter()
+        .map(|p| match p.design_of(&sys.model, b) {
+            Some(k) => {
+                let dl = flex.dinv.get(k).map_or(0.0, |d| d.lambda[j]);
+                r.scale * dl / (2.0 * two_pi * lambda.sqrt())
+            }
+            None => 0.0,
+        })
+        .collect();
+    Ok(ResponseValue {
+        name: r.name.clone(),
+        kind: r.kind,
+        value,
+        unit: r.unit.clone(),
+        time: None,
+        gradient,
+    })
+}
+
+/// The frequency responses of a built scene, without integrating it
+/// (the other responses are left out).
+pub fn frequencies(scene: &Scene) -> Result<Vec<ResponseValue>> {
+    let sys = System::new(scene.model.clone());
+    let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
+    scene
+        .responses
+        .iter()
+        .filter(|r| r.kind == ResponseKind::Frequency)
+        .map(|r| frequency(&sys, r, &params))
+        .collect()
+}
