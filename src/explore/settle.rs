@@ -154,9 +154,9 @@ pub fn settle(
     };
     // No polish from an infeasible end where descent on the violation
     // cannot go on: a stationary point of the violation, or an end where
-    // the solver's own restoration found no decrease or stalled (a kink of
-    // a peak constraint, which the gradient test cannot see); the polish
-    // would repeat that restoration.
+    // the solver's own restoration (Newton steps, then descent on the
+    // violation) found no decrease (a kink of a peak constraint, which the
+    // gradient test cannot see); the polish would repeat that restoration.
     let stuck = first.violation_stationary == Some(true)
         || (first.class == EndClass::Infeasible
             && outcome.termination == crate::optimize::Termination::Infeasible);

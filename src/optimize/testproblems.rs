@@ -322,6 +322,39 @@ pub fn disc() -> Analytic {
     }
 }
 
+/// A landscape of the violation with many local minima, as the SAR
+/// problem's peak-strain constraint has: on the torus `[−π, π)²`,
+/// `f = 2 − cos(a − 0.1) − cos(b − 0.1)` subject to
+/// `g = 1.2 − cos a cos b − 0.3 cos 5a cos 5b <= 0`. The feasible set is two
+/// small islands, around `(0, 0)` and `(π, π)` (where `cos a cos b = 1`;
+/// elsewhere `cos a cos b < 0.9` leaves `g > 0`), and the ripple of the
+/// second term gives the violation a local minimum in most cells of a
+/// 5 × 5 pattern. The unconstrained minimum `(0.1, 0.1)` lies inside the
+/// first island (`g = −0.021`), so `f* = 0` (closed form).
+pub fn ripple() -> Analytic {
+    fn k(x: &[f64]) -> (f64, Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+        let (a, b) = (x[0], x[1]);
+        let f = 2.0 - (a - 0.1).cos() - (b - 0.1).cos();
+        let g = 1.2 - a.cos() * b.cos() - 0.3 * (5.0 * a).cos() * (5.0 * b).cos();
+        let dg = vec![
+            a.sin() * b.cos() + 1.5 * (5.0 * a).sin() * (5.0 * b).cos(),
+            a.cos() * b.sin() + 1.5 * (5.0 * a).cos() * (5.0 * b).sin(),
+        ];
+        (f, vec![g], vec![(a - 0.1).sin(), (b - 0.1).sin()], vec![dg])
+    }
+    let pi = std::f64::consts::PI;
+    let angle = |name: &str| Variable::periodic(name, -pi, 2.0 * pi).expect("valid period");
+    Analytic {
+        name: "ripple".into(),
+        variables: vec![angle("a"), angle("b")],
+        n_constraints: 1,
+        kernel: k,
+        x0: vec![2.0, 1.5],
+        optima: vec![vec![0.1, 0.1]],
+        f_opt: 0.0,
+    }
+}
+
 /// Two ply-like angles in degrees, periodic on `[−90, 90)`:
 /// `f = 1 − cos 2(θ1 − 88°) + 1 − cos 2(θ2 + 85°) + 0.2 (1 − cos 2(θ1 − θ2 −
 /// 173°))`. Every term is >= 0 and vanishes only at `θ* = (88°, −85°)`

@@ -14,15 +14,16 @@
 //!    constraints (a non-periodic variable on its bound). CT starts at the
 //!    option `ct` (< 0) and shrinks by `ct_reduction` each iteration towards
 //!    `−ctmin`, as CONMIN does, so the active set sharpens near the optimum.
-//! 2. Infeasible design → feasibility-restoration move: the shortest step
-//!    `S` with `g_j + ∇g_jᵀS <= −ctmin/2` for the active and violated
-//!    constraints and inside the bounds (push-off past the limit by half the
-//!    tolerance), solved exactly by [`super::qp`], then shortened until the
-//!    largest violation decreases (quadratic backtracking with the known
-//!    slope, factors 0.1–0.5, down to a move of 1e-10 of the ranges).
-//!    The run ends `infeasible` when no shortening lowers the violation,
-//!    or when three restorations in a row lower it by less than 1 % each
-//!    (a stall: the violation's valley is a kink or a local minimum).
+//! 2. Infeasible design → feasibility-restoration move (`restore`): the
+//!    shortest step `S` with `g_j + ∇g_jᵀS <= −ctmin/2` for the active and
+//!    violated constraints and inside the bounds (push-off past the limit
+//!    by half the tolerance), solved exactly by [`super::qp`]. Near the
+//!    feasible set it is taken as a Newton step, shortened until the
+//!    largest violation decreases. When Newton steps stall (no shortening
+//!    lowers the violation, or three in a row lower it by less than 1 %
+//!    each), the restoration continues as a descent on the violation `½ Σ max(0, g_j +
+//!    ctmin/2)²` along `S` with moves of up to DX2 and Armijo's test; the
+//!    run ends `infeasible` only when that descent finds no decrease.
 //! 3. Feasible, nothing active → steepest descent, conjugated by
 //!    Fletcher–Reeves (`β = |∇f_k|²/|∇f_{k−1}|²`) while consecutive
 //!    iterations stay unconstrained, restarted every n iterations.
@@ -93,10 +94,12 @@ use argmin::core::{
 };
 use geometry::{dot, least_norm, norm};
 pub use options::{KtScale, MmfdOptions};
+use restore::Restoration;
 use search::Search;
 
 mod geometry;
 mod options;
+mod restore;
 mod search;
 
 /// A design with its scaled gradients of f and of the constraints.
@@ -142,9 +145,11 @@ pub struct Mmfd {
     abs_count: usize,
     rel_count: usize,
     failed_searches: usize,
-    /// Consecutive restorations that lowered the largest violation by
-    /// less than 1 % (three end the run as infeasible: a stall).
+    /// Consecutive Newton restorations that lowered the largest violation
+    /// by less than 1 % (three switch to descent on the violation).
     slow_restorations: usize,
+    /// How the next restoration chooses its length.
+    restoration: Restoration,
     iteration: usize,
     termination: Option<Termination>,
     /// The start's evaluation (made by `init`, used by the first
@@ -226,6 +231,7 @@ impl Mmfd {
             rel_count: 0,
             failed_searches: 0,
             slow_restorations: 0,
+            restoration: Restoration::Newton,
             iteration: 0,
             termination: None,
             start_evaluation: None,
@@ -305,79 +311,38 @@ impl Mmfd {
             .sqrt()
     }
 
-    /// Step 2: a feasibility-restoration move.
-    fn restore(
+    /// Step 2: the restoration move from the infeasible `base` (Newton,
+    /// or descent on the violation; see [`restore`]); `None` when neither
+    /// lowers the violation.
+    fn restoration_move(
         &mut self,
         problem: &mut Ap<'_>,
         base: &Point,
         gg: &[Vec<f64>],
     ) -> Result<Option<Point>> {
-        let o = self.options.clone();
-        let vars = variables(problem).to_vec();
-        let n = vars.len();
-        let mut rows = Vec::new();
-        let mut b = Vec::new();
-        for (j, gj) in base.g.iter().enumerate() {
-            if *gj >= self.ct_now {
-                rows.push(gg[j].clone());
-                b.push(-gj - 0.5 * o.ctmin);
-            }
-        }
-        for (i, v) in vars.iter().enumerate() {
-            if v.period.is_some() {
-                continue;
-            }
-            let y = (base.x[i] - v.lower) / self.range[i];
-            let mut e = vec![0.0; n];
-            e[i] = 1.0;
-            rows.push(e.clone());
-            b.push(1.0 - y);
-            e[i] = -1.0;
-            rows.push(e);
-            b.push(y);
-        }
-        let sol = qp::solve(&vec![0.0; n], &rows, &b)?;
-        if sol.s.iter().all(|&v| v == 0.0) {
-            return Ok(None);
-        }
-        // Backtrack until the largest violation decreases: the next length
-        // from the quadratic through v(0), its slope along S (the most
-        // violated constraint's ∇gᵀS) and the failed trial, kept within
-        // [0.1, 0.5] of it, down to a move of 1e-10 of the ranges (then no
-        // descent on the violation is left along S: a local minimum of the
-        // violation, often at a kink of a peak constraint).
-        let v0 = base.max_g();
-        let worst = (0..base.g.len())
-            .max_by(|&a, &b| base.g[a].total_cmp(&base.g[b]))
-            .unwrap_or(0);
-        let slope = dot(&gg[worst], &sol.s).min(0.0);
-        let length = norm(&sol.s);
-        let mut alpha = 1.0;
-        while alpha * length > 1e-10 {
-            let z: Vec<f64> = sol.s.iter().map(|s| alpha * s).collect();
-            let x = self.moved(problem, &base.x, &z);
-            if x == base.x {
-                break; // the bounds leave no move
-            }
-            let ev = evaluate(problem, &x, false)?;
-            let p = Point {
-                x,
-                f: ev.f,
-                g: ev.g,
-            };
-            let v = p.max_g();
-            if v < v0 {
+        if let (Restoration::Newton, Some(s)) = (
+            self.restoration,
+            self.restoration_direction(problem, base, gg)?,
+        ) {
+            if let Some(p) = self.newton_restoration(problem, base, gg, &s)? {
+                let slow = base.max_g() - p.max_g() < 0.01 * base.max_g();
+                self.slow_restorations = if slow { self.slow_restorations + 1 } else { 0 };
+                if self.slow_restorations >= 3 {
+                    self.restoration = Restoration::Descent(0.5 * self.options.dx2);
+                }
                 return Ok(Some(p));
             }
-            let curvature = v - v0 - slope * alpha;
-            let fit = if curvature > 0.0 && slope < 0.0 {
-                -slope * alpha * alpha / (2.0 * curvature)
-            } else {
-                0.5 * alpha
-            };
-            alpha = fit.clamp(0.1 * alpha, 0.5 * alpha);
         }
-        Ok(None)
+        let last = match self.restoration {
+            Restoration::Descent(last) => last,
+            Restoration::Newton => 0.5 * self.options.dx2,
+        };
+        let s = self.restoration_direction(problem, base, gg)?;
+        let moved = self.violation_descent(problem, base, gg, s.as_deref(), last)?;
+        Ok(moved.map(|(p, step)| {
+            self.restoration = Restoration::Descent(step);
+            p
+        }))
     }
 
     /// One MMFD iteration (steps 1–6 of the module doc).
@@ -429,15 +394,10 @@ impl Mmfd {
         if base.max_g() > o.ctmin {
             self.fr_prev = None;
             self.prev_step = None;
-            match self.restore(problem, &base, &gg)? {
+            match self.restoration_move(problem, &base, &gg)? {
                 Some(p) => {
-                    let slow = base.max_g() - p.max_g() < 0.01 * base.max_g();
-                    self.slow_restorations = if slow { self.slow_restorations + 1 } else { 0 };
                     let step = self.scaled_distance(problem, &p.x, &base.x);
                     self.finish_iteration(problem, &base, p, step);
-                    if self.slow_restorations >= 3 && self.termination.is_none() {
-                        self.termination = Some(Termination::Infeasible);
-                    }
                 }
                 None => {
                     self.current = Some(base.clone());
@@ -447,6 +407,8 @@ impl Mmfd {
             }
             return Ok(());
         }
+        self.restoration = Restoration::Newton;
+        self.slow_restorations = 0;
         // Step 1: active sets.
         let active: Vec<usize> = (0..base.g.len())
             .filter(|&j| base.g[j] >= self.ct_now)

@@ -433,3 +433,52 @@ fn sar_from_55_minus_55_in_16_function_and_5_gradient_calls() {
     assert!((o.f - 0.9089481415).abs() < 1e-6, "{o:?}");
     assert!(o.g[0] <= MmfdOptions::default().ctmin, "{o:?}");
 }
+
+/// The restoration on a violation with many local minima
+/// (`testproblems::ripple`, SAR-like): from a 12 × 12 grid of starts on the
+/// torus, every run that ends infeasible ends at a stationary point of the
+/// violation (its Kuhn–Tucker test, `optimize::kkt`), and MMFD reaches the
+/// feasible set from at least as many starts as a pure steepest descent on
+/// the violation (`explore::violation::descend`) from the same starts.
+/// Before restorations that stall switched to descent on the violation, a
+/// stall rule (three Newton restorations lowering the violation by less
+/// than 1 %) ended runs at non-stationary points here (residuals up to
+/// 1.8e-2). Measured: 44 and 32 of 144 starts reach the feasible set.
+#[test]
+fn restoration_ends_only_where_the_violation_is_stationary() {
+    use plyscape::explore::violation::descend;
+    use plyscape::optimize::kkt::{certify_at, KktTolerances};
+    let p = tp::ripple();
+    let d = MmfdOptions::default();
+    let n = 12;
+    let (mut feasible_mmfd, mut feasible_descent) = (0, 0);
+    let pi = std::f64::consts::PI;
+    for i in 0..n {
+        for j in 0..n {
+            let at = |k: usize| -pi + (k as f64 + 0.5) * 2.0 * pi / n as f64;
+            let x0 = [at(i), at(j)];
+            let o = mmfd::minimize(&p, &x0, &d, &mut plyscape::optimize::NoObserver).unwrap();
+            if o.g[0] <= d.ctmin {
+                feasible_mmfd += 1;
+            } else {
+                assert_eq!(o.termination, Termination::Infeasible, "{x0:?}");
+                let (_, c) = certify_at(&p, &o.x, &KktTolerances::default()).unwrap();
+                assert_eq!(
+                    c.violation_stationary,
+                    Some(true),
+                    "{x0:?} ends at {:?}, residual {:?}",
+                    o.x,
+                    c.violation_residual
+                );
+            }
+            if descend(&p, &x0, d.ctmin).unwrap().1 <= d.ctmin {
+                feasible_descent += 1;
+            }
+        }
+    }
+    assert!(
+        feasible_mmfd >= feasible_descent,
+        "{feasible_mmfd} vs {feasible_descent}"
+    );
+    assert_eq!((feasible_mmfd, feasible_descent), (44, 32));
+}
