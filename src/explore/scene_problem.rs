@@ -35,7 +35,7 @@
 //! ply); tying one variable to both panels is the paper's shared θ1/θ2.
 //! A variable may instead set scene parameters, `sets =
 //! ["scene:forces[0].damping"]` (any `[scene] sensitivities` name but a
-//! ply angle, in its SI unit; [`super::scene_vars`]), so that ply angles
+//! ply angle, in its SI unit; `super::scene_vars`), so that ply angles
 //! and mechanism parameters are designed together. The objective is `f = R₀(x) / R₀(x_ref)` (or
 //! `R₀(x)` without `normalize_at`), each constraint
 //! `g_j = R_j(x) / c_j − 1 <= 0` (Eq. 34 with `c_j` the bound) for an
