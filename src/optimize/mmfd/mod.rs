@@ -320,11 +320,9 @@ impl Mmfd {
         base: &Point,
         gg: &[Vec<f64>],
     ) -> Result<Option<Point>> {
-        if let (Restoration::Newton, Some(s)) = (
-            self.restoration,
-            self.restoration_direction(problem, base, gg)?,
-        ) {
-            if let Some(p) = self.newton_restoration(problem, base, gg, &s)? {
+        let s = self.restoration_direction(problem, base, gg)?;
+        if let (Restoration::Newton, Some(s)) = (self.restoration, &s) {
+            if let Some(p) = self.newton_restoration(problem, base, gg, s)? {
                 let slow = base.max_g() - p.max_g() < 0.01 * base.max_g();
                 self.slow_restorations = if slow { self.slow_restorations + 1 } else { 0 };
                 if self.slow_restorations >= 3 {
@@ -337,7 +335,6 @@ impl Mmfd {
             Restoration::Descent(last) => last,
             Restoration::Newton => 0.5 * self.options.dx2,
         };
-        let s = self.restoration_direction(problem, base, gg)?;
         let moved = self.violation_descent(problem, base, gg, s.as_deref(), last)?;
         Ok(moved.map(|(p, step)| {
             self.restoration = Restoration::Descent(step);
