@@ -23,8 +23,21 @@
 //! For an upper bound `c > 0` with `s = c` the constraint is written
 //! `R / c − 1`, the same number the relative bounds always gave. The
 //! upper bound comes before the lower one in `g` when both are given.
+//!
+//! A bound on a `peak` response may name `critical_points = K` (default
+//! 1): its side of the peak (`upper` for `sense = "max"`, `lower` for
+//! `"min"`) then gives `K` constraints, one per critical time point of the
+//! response, largest first (`crate::mbs::responses::critical_points`):
+//! `g_k = (R(t*_k) − c) / s`. Where the response has fewer than `K`
+//! local maxima the missing ones repeat the peak. The feasible set is the
+//! same as with the peak alone (every critical point is at most the
+//! peak), but where two local maxima in time are equal, the peak has a
+//! kink and its gradient jumps; with `K ≥ 2` the optimizer sees both
+//! branches as constraints of their own, so that its direction finding,
+//! its restoration and its Kuhn–Tucker test work at the kink.
 
 use crate::error::Result;
+use crate::mbs::responses::Sense;
 use crate::study::Study;
 use serde::Deserialize;
 
@@ -42,6 +55,10 @@ pub struct ConstraintSpec {
     pub upper_relative: Option<f64>,
     /// Normalization `s > 0` of `g` (the response's unit; default `|c|`).
     pub scale: Option<f64>,
+    /// For a `peak` response: how many of its critical time points (the
+    /// largest local extremes in time, in its sense) are constrained, each
+    /// as a constraint of its own (module doc); default 1, the peak.
+    pub critical_points: Option<usize>,
 }
 
 /// One constraint `g <= 0` on a response (module doc).
@@ -55,6 +72,9 @@ pub struct Bound {
     pub c: f64,
     /// The normalization `s > 0` (the response's unit).
     pub scale: f64,
+    /// Which critical time point of a peak response is bounded: 0 the
+    /// peak itself, `k` the `k+1`-th largest local extreme (module doc).
+    pub point: usize,
 }
 
 impl Bound {
@@ -81,10 +101,14 @@ impl Bound {
     /// The constraint's label in reports: the response's name, followed
     /// by `(lower bound)` for a lower bound.
     pub fn label(&self) -> String {
+        let point = match self.point {
+            0 => String::new(),
+            k => format!(" (critical point {})", k + 1),
+        };
         if self.lower {
-            format!("{} (lower bound)", self.response)
+            format!("{}{point} (lower bound)", self.response)
         } else {
-            self.response.clone()
+            format!("{}{point}", self.response)
         }
     }
 }
@@ -95,8 +119,10 @@ fn bad(study: &Study, j: usize, suffix: &str, v: impl std::fmt::Display, e: &str
 }
 
 /// Check entry `j` without evaluating anything: which bounds it has and
-/// that they are valid numbers.
-pub fn check(study: &Study, j: usize, c: &ConstraintSpec) -> Result<()> {
+/// that they are valid numbers. `peak` is the response's sense when it
+/// is a `peak` (`critical_points` needs one, and a bound on its side).
+pub fn check(study: &Study, j: usize, c: &ConstraintSpec, peak: Option<Sense>) -> Result<()> {
+    check_critical_points(study, j, c, peak)?;
     if c.upper.is_some() && c.upper_relative.is_some() {
         return Err(bad(
             study,
@@ -155,16 +181,63 @@ pub fn check(study: &Study, j: usize, c: &ConstraintSpec) -> Result<()> {
     Ok(())
 }
 
+/// `critical_points` is a count from 1 to [`MAX_CRITICAL_POINTS`] on a
+/// peak response with a bound on the peak's side.
+fn check_critical_points(
+    study: &Study,
+    j: usize,
+    c: &ConstraintSpec,
+    peak: Option<Sense>,
+) -> Result<()> {
+    let Some(k) = c.critical_points else {
+        return Ok(());
+    };
+    let key = ".critical_points";
+    if !(1..=MAX_CRITICAL_POINTS).contains(&k) {
+        let e = format!("a count from 1 to {MAX_CRITICAL_POINTS}");
+        return Err(bad(study, j, key, k, &e));
+    }
+    let side = match peak {
+        None => return Err(bad(study, j, key, k, "a `peak` response (it has none)")),
+        Some(Sense::Max) => c.upper.is_some() || c.upper_relative.is_some(),
+        Some(Sense::Min) => c.lower.is_some(),
+    };
+    if !side {
+        let e = "a bound on the peak's side (`upper` or `upper_relative` for a \
+                 maximum, `lower` for `sense = \"min\"`)";
+        return Err(bad(study, j, key, k, e));
+    }
+    Ok(())
+}
+
+/// The largest `critical_points` accepted.
+pub const MAX_CRITICAL_POINTS: usize = 16;
+
 /// The bounds of checked entry `j`, given the response's value at the
 /// start design (the reference of `upper_relative`): the upper bound
 /// first.
-pub fn resolve(study: &Study, j: usize, c: &ConstraintSpec, at_start: f64) -> Result<Vec<Bound>> {
+/// A bound on the peak's side gives one constraint per critical point
+/// (`peak` is the response's sense when it is a peak).
+pub fn resolve(
+    study: &Study,
+    j: usize,
+    c: &ConstraintSpec,
+    (at_start, peak): (f64, Option<Sense>),
+) -> Result<Vec<Bound>> {
     let mut out = Vec::new();
-    let bound = |lower: bool, c_: f64| Bound {
-        response: c.response.clone(),
-        lower,
-        c: c_,
-        scale: c.scale.unwrap_or(c_.abs()),
+    let k = c.critical_points.unwrap_or(1);
+    let mut bound = |lower: bool, c_: f64| {
+        let points = match (peak, lower) {
+            (Some(Sense::Max), false) | (Some(Sense::Min), true) => k,
+            _ => 1,
+        };
+        out.extend((0..points).map(|point| Bound {
+            response: c.response.clone(),
+            lower,
+            c: c_,
+            scale: c.scale.unwrap_or(c_.abs()),
+            point,
+        }))
     };
     if let Some(u) = c.upper_relative {
         let v = u * at_start;
@@ -180,13 +253,13 @@ pub fn resolve(study: &Study, j: usize, c: &ConstraintSpec, at_start: f64) -> Re
                 ),
             ));
         }
-        out.push(bound(false, v));
+        bound(false, v);
     }
     if let Some(u) = c.upper {
-        out.push(bound(false, u));
+        bound(false, u);
     }
     if let Some(l) = c.lower {
-        out.push(bound(true, l));
+        bound(true, l);
     }
     Ok(out)
 }
@@ -202,6 +275,7 @@ mod tests {
             lower,
             c,
             scale,
+            point: 0,
         };
         // Upper bound 2 with its own scale: the relative form R/c − 1.
         assert_eq!(b(false, 2.0, 2.0).g(3.0), 0.5);

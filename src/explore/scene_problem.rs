@@ -74,7 +74,7 @@ use super::scene_vars::{problem_error, Target, Ties};
 use crate::error::{Error, Result};
 use crate::integrate::SensitivityForm;
 use crate::laminate::Laminate;
-use crate::mbs::responses::{ResponseKind, ResponseValue};
+use crate::mbs::responses::{ResponseKind, ResponseValue, Sense};
 use crate::optimize::{Evaluation, Problem, Variable};
 use crate::scene::{BuildProfile, ScenePlan};
 use crate::simulate::sampled::frequencies;
@@ -224,11 +224,12 @@ impl SceneProblem {
     /// The constraint bounds and the objective's divisor from the start
     /// design (and the normalization design).
     fn set_references(&mut self, study: &Study, spec: &SceneProblemSpec) -> Result<()> {
-        let mut wanted = vec![spec.objective.response.clone()];
-        wanted.extend(spec.constraints.iter().map(|c| c.response.clone()));
+        let mut wanted = vec![(spec.objective.response.clone(), 0)];
+        wanted.extend(spec.constraints.iter().map(|c| (c.response.clone(), 0)));
         let at_start = self.raw(&spec.start, &wanted, false)?;
         for (j, c) in spec.constraints.iter().enumerate() {
-            let bounds = scene_bounds::resolve(study, j, c, at_start.values[j + 1])?;
+            let at = (at_start.values[j + 1], self.peak_sense(&c.response));
+            let bounds = scene_bounds::resolve(study, j, c, at)?;
             self.constraints.extend(bounds);
         }
         self.units = at_start.units.clone();
@@ -344,6 +345,11 @@ impl SceneProblem {
             .collect()
     }
 
+    /// The sense of `[[scene.responses]]` entry `name` when it is a peak.
+    fn peak_sense(&self, name: &str) -> Option<Sense> {
+        peak_sense(self.plan.spec(), name)
+    }
+
     /// Whether `[[scene.responses]]` entry `name` is a frequency (no
     /// integration needed).
     fn is_frequency(&self, name: &str) -> bool {
@@ -351,9 +357,11 @@ impl SceneProblem {
         spec.is_some_and(|r| r.kind == ResponseKind::Frequency)
     }
 
-    /// Simulate at `x` and return the named responses (gradients per
-    /// degree of each variable when asked).
-    fn raw(&self, x: &[f64], names: &[String], gradients: bool) -> Result<Raw> {
+    /// Simulate at `x` and return the named responses, each at its
+    /// critical point (0: the response itself; `k`: a peak's `k+1`-th
+    /// critical time point, [`Bound::point`]), with gradients per degree of
+    /// each variable when asked.
+    fn raw(&self, x: &[f64], names: &[(String, usize)], gradients: bool) -> Result<Raw> {
         let design = || design_label(&self.vars, x);
         let at = |e: Error| at_design(e, &self.vars, x);
         let t0 = std::time::Instant::now();
@@ -365,7 +373,7 @@ impl SceneProblem {
             .map_err(at)?;
         self.ties.apply_scene(&self.plan, &mut scene, x)?;
         // Frequencies alone need no integration.
-        let (responses, stats) = if names.iter().all(|n| self.is_frequency(n)) {
+        let (responses, stats) = if names.iter().all(|n| self.is_frequency(&n.0)) {
             (frequencies(&scene).map_err(at)?, Default::default())
         } else {
             let sim = simulate(&scene).map_err(at)?.1;
@@ -380,23 +388,24 @@ impl SceneProblem {
         let mut values = Vec::new();
         let mut units = Vec::new();
         let mut grads = Vec::new();
-        for name in names {
+        for (name, point) in names {
             let r = find(name)?;
+            let (value, gradient) = at_point(r, *point);
             units.push(r.unit.clone());
-            if !r.value.is_finite() {
+            if !value.is_finite() {
                 return Err(Error::numerical(
                     format!("scene problem at [{}]", design()),
-                    format!("response {name} = {}", r.value),
+                    format!("response {name} = {value}"),
                 ));
             }
-            values.push(r.value);
+            values.push(value);
             if gradients {
                 let g: Vec<f64> = self
                     .ties
                     .lanes_of
                     .iter()
                     .zip(&self.ties.scale)
-                    .map(|(l, s)| l.iter().map(|&k| r.gradient[k]).sum::<f64>() * s)
+                    .map(|(l, s)| l.iter().map(|&k| gradient[k]).sum::<f64>() * s)
                     .collect();
                 if g.iter().any(|v| !v.is_finite()) {
                     return Err(Error::numerical(
@@ -452,10 +461,14 @@ impl SceneProblem {
                 format!("{} finite angles [deg]", self.vars.len()),
             ));
         }
-        let mut names = vec![self.objective.0.clone()];
-        names.extend(self.constraints.iter().map(|c| c.response.clone()));
+        let mut names = vec![(self.objective.0.clone(), 0)];
+        names.extend(
+            self.constraints
+                .iter()
+                .map(|c| (c.response.clone(), c.point)),
+        );
         let own = names.len();
-        names.extend(extra.iter().cloned());
+        names.extend(extra.iter().map(|n| (n.clone(), 0)));
         let raw = self.raw(x, &names, gradients)?;
         let extra = ExtraResponses {
             values: raw.values[own..].to_vec(),
@@ -544,9 +557,25 @@ fn check_objective_and_constraints(
     }
     for (j, c) in spec.constraints.iter().enumerate() {
         check_response(format!("constraints[{j}].response"), &c.response)?;
-        scene_bounds::check(study, j, c)?;
+        scene_bounds::check(study, j, c, peak_sense(plan.spec(), &c.response))?;
     }
     Ok(())
+}
+
+/// The value and gradient of response `r` at its critical point `point`
+/// ([`Bound::point`]): a peak's `point+1`-th critical time point, the peak
+/// itself where it has fewer; the response itself for other kinds.
+fn at_point(r: &ResponseValue, point: usize) -> (f64, &[f64]) {
+    match r.critical.get(point) {
+        Some((_, v, g)) if point > 0 => (*v, g),
+        _ => (r.value, &r.gradient),
+    }
+}
+
+/// The sense of response `name` of `scene` when it is a `peak`.
+fn peak_sense(scene: &crate::scene::SceneSpec, name: &str) -> Option<Sense> {
+    let r = scene.responses.iter().find(|r| r.name == name)?;
+    (r.kind == ResponseKind::Peak).then(|| r.sense.unwrap_or_default())
 }
 
 /// `theta1_deg = 55, theta2_deg = -55`.

@@ -13,7 +13,7 @@
 use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Stats};
 use crate::mbs::post::energy::EnergyMonitor;
-use crate::mbs::responses::{energy_lanes, peak, ResponseKind, ResponseValue};
+use crate::mbs::responses::{critical_points, energy_lanes, ResponseKind, ResponseValue};
 use crate::mbs::series::Sample;
 use crate::mbs::Projection;
 use crate::mbs::{Energy, Param, Reaction, System, Workspace};
@@ -402,6 +402,7 @@ fn collect_responses(
                     gradient: (0..scene.params.len())
                         .map(|i| s_end[i * n + io + index])
                         .collect(),
+                    critical: Vec::new(),
                 }
             }
             ResponseKind::Final => {
@@ -419,6 +420,7 @@ fn collect_responses(
                     unit: r.unit.clone(),
                     time: scene.options.times.last().copied(),
                     gradient,
+                    critical: Vec::new(),
                 }
             }
             ResponseKind::ValueAt | ResponseKind::Crossing | ResponseKind::Frequency => {
@@ -428,7 +430,8 @@ fn collect_responses(
                 ))
             }
             ResponseKind::Peak => {
-                let (t, value, gradient) = peak(series).ok_or_else(|| {
+                let critical = critical_points(series);
+                let (t, value, gradient) = critical.first().cloned().ok_or_else(|| {
                     Error::numerical("simulate: responses", format!("no samples for {name}"))
                 })?;
                 ResponseValue {
@@ -438,6 +441,7 @@ fn collect_responses(
                     unit: r.unit.clone(),
                     time: Some(t),
                     gradient,
+                    critical,
                 }
             }
         });

@@ -18,7 +18,7 @@
 //! integration.
 
 use crate::error::{Error, Result};
-use crate::mbs::responses::{ResponseKind, ResponseValue};
+use crate::mbs::responses::{critical_extremes, ResponseKind, ResponseValue};
 use crate::mbs::series::{crossing, extreme, trapezoid, value_at, NoCrossing, Sample};
 use crate::mbs::{Energy, Param, System, Workspace};
 use crate::scene::{QuantityKind, Response, ScalarOutput, Scene};
@@ -199,6 +199,10 @@ impl Sampler {
             unit: r.unit.clone(),
             time,
             gradient,
+            critical: match r.kind {
+                ResponseKind::Peak => critical_extremes(series, r.sense),
+                _ => Vec::new(),
+            },
         })
     }
 }
@@ -243,6 +247,7 @@ pub fn frequency(sys: &System, r: &Response, params: &[Param]) -> Result<Respons
         unit: r.unit.clone(),
         time: None,
         gradient,
+        critical: Vec::new(),
     })
 }
 

@@ -140,6 +140,10 @@ pub struct ResponseValue {
     pub time: Option<f64>,
     /// `d value / d p` for each sensitivity parameter of the scene.
     pub gradient: Vec<f64>,
+    /// A peak's critical time points `(t*, value, gradient)`: every local
+    /// extreme in its sense ([`critical_points`]), this peak first; empty
+    /// for the other kinds.
+    pub critical: Vec<(f64, f64, Vec<f64>)>,
 }
 
 /// `scale · Σ terms` at state `y` and its derivatives along each
@@ -177,12 +181,66 @@ pub fn energy_lanes(
 /// `None` for an empty series.
 pub fn peak(series: &[(f64, f64, Vec<f64>)]) -> Option<(f64, f64, Vec<f64>)> {
     let k = (0..series.len()).max_by(|&a, &b| series[a].1.total_cmp(&series[b].1))?;
+    Some(refine(series, k))
+}
+
+/// Every critical time point of a sampled response: each local maximum
+/// of the samples (a sample at least its predecessor and above its
+/// successor; an end sample above its neighbour), refined as [`peak`]
+/// refines the largest. The largest ([`peak`]'s) comes first, then the
+/// others by decreasing value.
+///
+/// A constraint `max_t U ≤ c` is not differentiable where two local
+/// maxima in time are equal (a kink: the time of the peak jumps from one
+/// to the other). Taking the `K` largest critical points as `K`
+/// constraints `U(t*_k) ≤ c` (Haug & Arora, *Applied Optimal Design*,
+/// 1979, §5.2: point-wise constraints at the critical time points) keeps
+/// the feasible set and gives a linearisation of each branch, so that the
+/// optimizer's direction subproblem and its Kuhn–Tucker test see both
+/// sides of the kink.
+pub fn critical_points(series: &[(f64, f64, Vec<f64>)]) -> Vec<(f64, f64, Vec<f64>)> {
+    let Some(first) = (0..series.len()).max_by(|&a, &b| series[a].1.total_cmp(&series[b].1)) else {
+        return Vec::new();
+    };
+    let n = series.len();
+    let v = |k: usize| series[k].1;
+    let mut others: Vec<_> = (0..n)
+        .filter(|&k| k != first)
+        .filter(|&k| (k == 0 || v(k) >= v(k - 1)) && (k + 1 == n || v(k) > v(k + 1)))
+        .map(|k| refine(series, k))
+        .collect();
+    others.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let mut out = vec![refine(series, first)];
+    out.extend(others);
+    out
+}
+
+/// [`critical_points`] of the largest (`Sense::Max`) or of the smallest
+/// (`Sense::Min`, the critical points of `−y`) values: the extreme first.
+pub fn critical_extremes(
+    series: &[(f64, f64, Vec<f64>)],
+    sense: Sense,
+) -> Vec<(f64, f64, Vec<f64>)> {
+    let flip = |s: &(f64, f64, Vec<f64>)| (s.0, -s.1, s.2.iter().map(|x| -x).collect());
+    match sense {
+        Sense::Max => critical_points(series),
+        Sense::Min => {
+            let neg: Vec<_> = series.iter().map(flip).collect();
+            critical_points(&neg).iter().map(flip).collect()
+        }
+    }
+}
+
+/// Sample `k` of a series refined to the vertex of the parabola through
+/// it and its neighbours (the three end samples at an end; the module
+/// doc gives the rule).
+fn refine(series: &[(f64, f64, Vec<f64>)], k: usize) -> (f64, f64, Vec<f64>) {
     if series.len() < 3 {
         let (t, v, g) = &series[k];
-        return Some((*t, *v, g.clone()));
+        return (*t, *v, g.clone());
     }
-    // The three samples around the largest, the three end samples when
-    // it is an end.
+    // The three samples around sample k, the three end samples when it
+    // is an end.
     let c = k.clamp(1, series.len() - 2);
     let (t0, v0, g0) = &series[c - 1];
     let (t1, v1, g1) = &series[c];
@@ -211,7 +269,7 @@ pub fn peak(series: &[(f64, f64, Vec<f64>)]) -> Option<(f64, f64, Vec<f64>)> {
     let grad = (0..g1.len())
         .map(|i| w[0] * g0[i] + w[1] * g1[i] + w[2] * g2[i])
         .collect();
-    Some((ts, value, grad))
+    (ts, value, grad)
 }
 
 #[cfg(test)]
@@ -273,6 +331,36 @@ mod tests {
         let (below, above) = (at(0.95 - 1e-9), at(0.95 + 1e-9));
         assert!((below - above).abs() < 1e-12, "{below} {above}");
         assert!((above - 1.0).abs() < 1e-12);
+    }
+
+    /// U(t) = cos 3t + 0.1 t on [0, 4] (closed form): local maxima where
+    /// sin 3t = 1/30, at t₀ = asin(1/30)/3 and t₁ = t₀ + 2π/3, and a rising
+    /// end at t = 4. The critical points are the end first (the largest),
+    /// then t₁, then t₀, each with its value and the gradient dU/dp = t
+    /// interpolated to it.
+    #[test]
+    fn critical_points_are_every_local_maximum_largest_first() {
+        let u = |t: f64| (3.0 * t).cos() + 0.1 * t;
+        let series: Vec<(f64, f64, Vec<f64>)> = (0..=400)
+            .map(|k| {
+                let t = k as f64 * 0.01;
+                (t, u(t), vec![t])
+            })
+            .collect();
+        let t0 = (1.0f64 / 30.0).asin() / 3.0;
+        let t1 = t0 + 2.0 * std::f64::consts::PI / 3.0;
+        let c = critical_points(&series);
+        assert_eq!(c.len(), 3, "{c:?}");
+        assert_eq!(c[0], peak(&series).unwrap());
+        for ((t, v, g), want) in c.iter().zip([4.0, t1, t0]) {
+            assert!((t - want).abs() < 1e-3, "{t} {want}");
+            assert!((v - u(want)).abs() < 1e-5, "{v} {}", u(want));
+            assert!((g[0] - want).abs() < 1e-3);
+        }
+        // One sample, two samples, none.
+        assert_eq!(critical_points(&series[..1]).len(), 1);
+        assert_eq!(critical_points(&series[..2]).len(), 1);
+        assert!(critical_points(&[]).is_empty());
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Tests of `plyscape::explore`: optimization drivers, multistart, shards, reports.
 mod certified;
 mod compare;
+mod critical_points;
 mod design_vars;
 mod discrete;
 mod front;

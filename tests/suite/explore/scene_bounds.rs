@@ -154,6 +154,11 @@ fn bad_absolute_bounds_are_refused_with_their_key() {
         ),
         ("scale = 1.0", "scene_problem.constraints[0]", "a bound"),
         (
+            "lower = 1.0\ncritical_points = 2",
+            "scene_problem.constraints[0].critical_points",
+            "a `peak` response",
+        ),
+        (
             "upper = 1.0\nupper_relative = 1.0",
             "scene_problem.constraints[0]",
             "exactly one",

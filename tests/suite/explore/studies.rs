@@ -129,6 +129,19 @@ fn every_shipped_study_passes_the_upfront_check() {
     assert!(n >= 20, "{n} studies");
 }
 
+/// Table `key` of `s`, with the scene problem's constraints'
+/// `critical_points` left out (sar_explore bounds two critical points of
+/// peak U3: the same feasible set as the peak alone).
+fn section_without_critical_points(s: &Study, key: &str) -> toml::Value {
+    let mut t = s.table[key].clone();
+    if let Some(cs) = t.get_mut("constraints").and_then(|c| c.as_array_mut()) {
+        for c in cs.iter_mut().filter_map(|c| c.as_table_mut()) {
+            c.remove("critical_points");
+        }
+    }
+    t
+}
+
 /// `studies/sar_explore.toml` is the sar_optimize problem on the same
 /// scene, explored with the paper's start plus 63 Latin-hypercube starts,
 /// both CMA-ES schedules and a 19 x 19 map on two threads. (The study
@@ -139,7 +152,11 @@ fn sar_explore_is_sar_optimize_with_64_starts_and_both_schedules() {
     let s = Study::load("studies/sar_explore.toml").unwrap();
     let o = Study::load("studies/sar_optimize.toml").unwrap();
     for key in ["problem", "scene_problem", "scene", "panels"] {
-        assert_eq!(s.table[key], o.table[key], "{key}");
+        assert_eq!(
+            section_without_critical_points(&s, key),
+            o.table[key],
+            "{key}"
+        );
     }
     assert_eq!((s.meta.seed, s.meta.threads), (o.meta.seed, Some(2)));
     let ms = plyscape::explore::multistart_section(&s).unwrap();
@@ -169,7 +186,11 @@ fn sar_discrete_is_sar_explore_on_15_degree_steps() {
     let s = Study::load("studies/sar_discrete.toml").unwrap();
     let e = Study::load("studies/sar_explore.toml").unwrap();
     for key in ["problem", "scene_problem", "scene", "panels"] {
-        assert_eq!(s.table[key], e.table[key], "{key}");
+        assert_eq!(
+            s.table[key],
+            section_without_critical_points(&e, key),
+            "{key}"
+        );
     }
     let d = plyscape::explore::discrete::lattice::section(&s)
         .unwrap()
