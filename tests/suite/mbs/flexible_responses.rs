@@ -238,3 +238,16 @@ fn two_point_hinge_responses_match_to_the_hinges_floor() {
     println!("largest error {worst:.1e}");
     assert!(worst < 3e-4, "{worst:e}");
 }
+
+#[test]
+fn the_two_point_hinge_is_reported_as_nearly_dependent() {
+    // The pin's in-plane rows are kept (rank test) but nearly dependent
+    // on the revolute's (module doc): one warning naming pin rows; the
+    // revolute hinge alone gets none.
+    let sim = run(&panel(K, PLIES, true));
+    println!("{:?}", sim.warnings);
+    assert_eq!(sim.warnings.len(), 1, "{:?}", sim.warnings);
+    let w = &sim.warnings[0];
+    assert!(w.contains("nearly dependent") && w.contains("pin."), "{w}");
+    assert!(run(&panel(K, PLIES, false)).warnings.is_empty());
+}
