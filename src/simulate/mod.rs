@@ -26,6 +26,7 @@ use std::path::{Path, PathBuf};
 
 pub mod sampled;
 pub mod spin;
+pub mod weak;
 
 /// Everything a simulation produced.
 #[derive(Debug)]
@@ -70,8 +71,9 @@ pub struct Simulation {
     /// The numerical failure that ended the integration early
     /// ([`simulate_partial`]); the rows are those computed before it.
     pub failure: Option<Error>,
-    /// Warnings raised during the run: a flexible body turning fast
-    /// without geometric stiffening ([`spin`]).
+    /// Warnings raised during the run: constraint rows nearly dependent
+    /// at the start ([`weak`]), a flexible body turning fast without
+    /// geometric stiffening ([`spin`]).
     pub warnings: Vec<String>,
 }
 
@@ -101,6 +103,7 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
     let projection = sys.project(scene.options.t0, &mut y0)?;
     sys.drop_rows(&projection.dependent);
     sys.watch_rows(ROW_BOUND_ATOL * scene.options.atol);
+    let weak = weak::warning(&weak::weak_rows(&sys, scene.options.t0, &y0));
     let mut headers = vec!["t [s]".to_string()];
     for (label, q) in &scene.outputs {
         headers.extend(q.headers(label));
@@ -249,7 +252,7 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
         responses,
         row_events: sys.counters.row_events.get(),
         failure,
-        warnings: spin.warnings,
+        warnings: weak.into_iter().chain(spin.warnings).collect(),
     };
     Ok((sys, sim))
 }

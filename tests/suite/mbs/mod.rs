@@ -5,6 +5,7 @@ mod drives;
 mod energy;
 mod events;
 mod flex;
+mod flexible_responses;
 mod free;
 mod input;
 mod joint_prestress;
