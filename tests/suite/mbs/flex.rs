@@ -211,9 +211,10 @@ fn flexible_jacobian_vector_product_matches_central_differences() {
 #[test]
 fn multi_lane_evaluations_equal_one_lane_at_a_time() {
     // The fused sensitivity right-hand side (`rhs_lanes`: one multi-lane
-    // dual evaluation for 1, 2 or 4 lanes, chunks of 4 beyond) against
-    // the plain right-hand side and one single-lane `rhs_dir` per lane,
-    // for 1 to 5 lanes (parameters: the bodies' masses, each lane seeding
+    // dual evaluation of width 1, 2, 4 or 8 for up to 8 lanes, chunks of
+    // 8 beyond) against the plain right-hand side and one single-lane
+    // `rhs_dir` per lane, for 1 to 9 lanes (parameters: the bodies'
+    // masses, repeated when there are more lanes than bodies, each lane seeding
     // its own parameter and state direction).
     use plyscape::integrate::OdeModel;
     use plyscape::mbs::Param;
@@ -226,7 +227,7 @@ fn multi_lane_evaluations_equal_one_lane_at_a_time() {
     sys.project(0.0, &mut y).unwrap();
     let bodies: Vec<usize> = sys.moving.clone();
     let mut w = sys.work(n);
-    for np in 1..=5 {
+    for np in 1..=9 {
         let names: Vec<Param> = (0..np)
             .map(|i| Param::Mass(bodies[i % bodies.len()]))
             .collect();
@@ -234,7 +235,7 @@ fn multi_lane_evaluations_equal_one_lane_at_a_time() {
         let lanes: Vec<f64> = (0..n * np).map(|k| ((k as f64) * 0.71).cos()).collect();
         let (mut dy, mut dl) = (vec![0.0; n], vec![0.0; n * np]);
         let duals = sys.rhs_lanes(&mut w, 0.5, &y, (&names, &p), &lanes, &mut dy, &mut dl);
-        assert_eq!(duals, if np <= 2 { 1 } else { np.div_ceil(4) });
+        assert_eq!(duals, if np <= 4 { 1 } else { np.div_ceil(8) });
         let mut f = vec![0.0; n];
         OdeModel::rhs(&sys, &mut w, 0.5, &y, (&names, &p), &mut f);
         let scale = f.iter().fold(1.0f64, |m, v| m.max(v.abs()));
