@@ -257,10 +257,12 @@ fn main() -> plyscape::Result<()> {
             DesignDerivative {
                 dk: &dk0,
                 d2k: Some(&d2k0),
+                mass: None,
             },
             DesignDerivative {
                 dk: &dk1,
                 d2k: Some(&d2k1),
+                mass: None,
             },
         ];
         let mut opts = ModalOptions::new(14);

@@ -15,7 +15,7 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
 /// DOF per node: u, v, w, θx, θy, θz.
 pub const NODE_DOF: usize = 6;
-const NONE: usize = usize::MAX;
+pub(super) const NONE: usize = usize::MAX;
 /// Positions in the scatter map are u32 (half the memory traffic of usize).
 const MAX_STORED: usize = u32::MAX as usize;
 
@@ -217,22 +217,22 @@ impl PanelSystem {
 /// assemble as many laminates as needed.
 #[derive(Debug, Clone)]
 pub struct PanelModel {
-    mesh: Mesh,
+    pub(super) mesh: Mesh,
     support: Support,
-    tris: Vec<Triangle>,
-    ops: Vec<CompactOps>,
-    free: Vec<usize>,
+    pub(super) tris: Vec<Triangle>,
+    pub(super) ops: Vec<CompactOps>,
+    pub(super) free: Vec<usize>,
     dof_map: Vec<(usize, usize)>,
-    symbolic: SymbolicSparseColMat<usize>,
+    pub(super) symbolic: SymbolicSparseColMat<usize>,
     /// For each element, the stored entries it contributes to: position in
     /// the value array (sorted, for locality) ...
-    scatter: Vec<u32>,
+    pub(super) scatter: Vec<u32>,
     /// ... and the index of the contribution in the column-major 18×18
     /// element matrix (always a lower-triangle entry, so K is exactly
     /// symmetric although GᵀCG is symmetric only up to rounding).
-    local: Vec<u16>,
+    pub(super) local: Vec<u16>,
     /// Element e's entries are `offsets[e]..offsets[e + 1]`.
-    offsets: Vec<usize>,
+    pub(super) offsets: Vec<usize>,
 }
 
 impl PanelModel {

@@ -203,6 +203,19 @@ impl Triangle {
         h * h / (h * h + SHEAR_STABILISATION * self.longest_edge * self.longest_edge)
     }
 
+    /// The shear stabilisation factor `f(h) = h²/(h² + c)`, `c = α ℓ²`,
+    /// and its first two derivatives with respect to h:
+    /// `f' = 2hc/(h² + c)²`, `f'' = 2c(c − 3h²)/(h² + c)³`.
+    pub fn shear_factor_derivatives(&self, h: f64) -> [f64; 3] {
+        let c = SHEAR_STABILISATION * self.longest_edge * self.longest_edge;
+        let q = h * h + c;
+        [
+            self.shear_factor(h),
+            2.0 * h * c / (q * q),
+            2.0 * c * (c - 3.0 * h * h) / (q * q * q),
+        ]
+    }
+
     /// `A · Gᵀ C_e G` with C_e = C whose shear block is scaled by the
     /// stabilisation factor for thickness h, by dense 8×18 products. Used
     /// both for K (C = section matrix) and its ply-angle derivatives

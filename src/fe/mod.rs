@@ -66,6 +66,7 @@ pub mod assembly;
 pub mod element;
 pub mod mesh;
 pub mod spec;
+pub mod thickness;
 
 pub use assembly::{
     assemble, Derivatives, PanelModel, PanelSystem, Support, SupportKind, NODE_DOF,
@@ -73,3 +74,4 @@ pub use assembly::{
 pub use element::{section_matrix, Triangle};
 pub use mesh::{Mesh, MeshParams};
 pub use spec::{panels_from_study, Panel, PanelSpec};
+pub use thickness::ThicknessSystem;

@@ -68,6 +68,24 @@ use num_dual::DualNum;
 /// Shear correction factor κ applied to the transverse shear stiffness.
 pub const SHEAR_CORRECTION: f64 = 5.0 / 6.0;
 
+/// Derivatives with respect to the common thickness `s` \[m\] of a group
+/// of plies ([`Laminate::thickness_group_derivative`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ThicknessDerivative {
+    /// `∂(A, B, D, S)/∂s` \[per m\].
+    pub first: Stiffness,
+    /// `∂²(A, B, D, S)/∂s²` \[per m²\] (A and S are linear: zero).
+    pub second: Stiffness,
+    /// `∂(mass per area)/∂s` \[kg/m³\] (linear: no second derivative).
+    pub mass: f64,
+    /// `∂/∂s` and `∂²/∂s²` of the rotary inertia per area \[kg/m, kg/m²\].
+    pub rotary: [f64; 2],
+    /// `∂h/∂s`: the number of plies in the group.
+    pub thickness: f64,
+    /// `∂Ā/∂s` of [`Laminate::membrane_mean`] \[N/m²\] (linear).
+    pub membrane_mean: f64,
+}
+
 /// An orthotropic ply material (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Orthotropic {
@@ -372,6 +390,56 @@ impl Laminate {
         }
         inertia[0] = self.plies[k].material.rho;
         (st, inertia)
+    }
+
+    /// Exact first and second derivatives with respect to the common
+    /// thickness `s` of the plies of `group` (every ply of the group has
+    /// thickness `s`; module doc, "Ply thickness"). The interfaces move by
+    /// `∂zᵢ/∂s = Σ_{k∈group} ±½` (constant), so A, S, the mass per area
+    /// and the mean membrane stiffness are linear in `s`,
+    /// `B'' = Σᵢ Q̄ᵢ (∂zᵢ₊₁² − ∂zᵢ²)`, `D'' = Σᵢ Q̄ᵢ 2(zᵢ₊₁∂zᵢ₊₁² − zᵢ∂zᵢ²)`
+    /// and alike for the rotary inertia. As for the ply angles, B' and B''
+    /// are exactly zero on a symmetric stack whose group is closed under
+    /// the mid-plane mirror (they vanish up to rounding).
+    pub fn thickness_group_derivative(&self, group: &[usize]) -> ThicknessDerivative {
+        let z = self.interfaces();
+        let n = self.plies.len();
+        // ∂zᵢ/∂s: −½ per group ply at or above interface i, +½ per one below.
+        let dz: Vec<f64> = (0..=n)
+            .map(|i| {
+                group
+                    .iter()
+                    .filter(|&&k| k < n)
+                    .map(|&k| if i > k { 0.5 } else { -0.5 })
+                    .sum()
+            })
+            .collect();
+        let mut out = ThicknessDerivative::default();
+        for (i, p) in self.plies.iter().enumerate() {
+            let q = p.stiffness_derivative(0);
+            let (z0, z1, d0, d1) = (z[i], z[i + 1], dz[i], dz[i + 1]);
+            out.first.a += q.q * (d1 - d0);
+            out.first.b += q.q * (z1 * d1 - z0 * d0);
+            out.first.d += q.q * (z1 * z1 * d1 - z0 * z0 * d0);
+            out.first.s += q.g * (SHEAR_CORRECTION * (d1 - d0));
+            out.second.b += q.q * (d1 * d1 - d0 * d0);
+            out.second.d += q.q * (2.0 * (z1 * d1 * d1 - z0 * d0 * d0));
+            let rho = p.material.rho;
+            out.rotary[0] += rho * (z1 * z1 * d1 - z0 * z0 * d0);
+            out.rotary[1] += rho * 2.0 * (z1 * d1 * d1 - z0 * d0 * d0);
+        }
+        for &k in group.iter().filter(|&&k| k < n) {
+            let p = &self.plies[k];
+            out.mass += p.material.rho;
+            let u = p.material.invariants();
+            out.membrane_mean += (u[0] + u[4]) / 2.0;
+            out.thickness += 1.0;
+        }
+        if self.is_symmetric() && self.mirror_closed(group) {
+            out.first.b = Matrix3::zeros();
+            out.second.b = Matrix3::zeros();
+        }
+        out
     }
 
     /// Ply interface coordinates z₀ = −h/2 < z₁ < … < z_n = h/2.

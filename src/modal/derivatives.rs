@@ -37,6 +37,20 @@
 //! pivots are regularised and the refinement removes the rank-one error).
 //! One factorization per cluster serves every design variable.
 //!
+//! # Mass derivative (ply thickness)
+//! When the lumped mass depends on the variable (`M' ≠ 0`, a ply
+//! thickness; [`MassDerivative`]) the same steps hold with `K'` replaced
+//! by `K' − λ̄M'` where it multiplies eigenvectors (Haftka & Gürdal,
+//! *Elements of Structural Optimization*, §7.3; Nelson 1976):
+//! `λᵢ' = xᵢᵀ(K' − λᵢM')xᵢ`, `D = X_Cᵀ(K' − λ̄M')X_C`, right-hand sides
+//! `−(K' − λⱼ'M − λ̄M')ψⱼ`, and the normalisation `ψⱼᵀMψⱼ = 1` gives
+//! `cⱼⱼ = −½ψⱼᵀM'ψⱼ` (Nelson's `c = −½xᵀM'x − xᵀMv`, with `xᵀMv = 0`).
+//! The second derivative of the eigenproblem gives, for `l ≠ j` in a
+//! cluster, `cⱼₗ = (2ψₗᵀ(K' − λ̄M')vⱼ + ψₗᵀ(K'' − 2λⱼ'M' − λ̄M'')ψⱼ) /
+//! (2(λⱼ' − λₗ'))`, so repeated clusters need `M''` as well as `K''`.
+//! With `M' = 0` every formula is the one above, computed by the same
+//! operations (ply-angle results are unchanged to the bit).
+//!
 //! # What the caller gets
 //! Per variable a [`VariableDerivatives`]: `dlambda[i]`; in the updated-mode
 //! approach `dmodes` (`n × k`); and for each cluster of size ≥ 2 the
@@ -61,11 +75,14 @@ use faer::{Mat, MatRef};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 use super::blocks::Blocks;
+use super::mass::subtract_mass_term;
+pub use super::mass::MassDerivative;
 use super::modes::{sign_normalize, Modes};
 use super::sparse::{gmres_refine, spmv, sym_mul_block, Pencil, Refine};
 use crate::error::{Error, Result};
 
-/// Derivatives of the stiffness with respect to one design variable θ_v.
+/// Derivatives of the stiffness (and, for a ply thickness, of the lumped
+/// mass) with respect to one design variable θ_v.
 /// Both matrices are `n × n` in full symmetric storage on the reduced DOFs.
 /// First derivatives of modes need only the diagonal second derivative
 /// `∂²K/∂θ_v²`; the mixed `∂²K/∂θ_v∂θ_w` are not used.
@@ -76,6 +93,9 @@ pub struct DesignDerivative<'a> {
     /// `∂²K/∂θ_v²`; needed only for the eigenvector derivatives of repeated
     /// clusters (adjacent-eigenvector method).
     pub d2k: Option<&'a SparseColMat<usize, f64>>,
+    /// `∂M/∂θ_v` (and `∂²M/∂θ_v²`) of the lumped mass; `None` when the
+    /// mass does not depend on the variable (ply angles).
+    pub mass: Option<MassDerivative<'a>>,
 }
 
 /// Which approach of §3.1 (Haftka and Gürdal) is used; written `fixed` or
@@ -221,7 +241,8 @@ fn check_matrix(key: String, a: &SparseColMat<usize, f64>, n: usize) -> Result<(
 
 /// Per-variable eigenvalue derivatives and cluster rotations.
 struct VarSetup {
-    /// `K'X`, `n × k`.
+    /// `(K' − λ̄M')X`, `n × k` (λ̄ the mean eigenvalue of each column's
+    /// cluster; `K'X` when `M' = 0`).
     kpx: Mat<f64>,
     /// Rotation per cluster (identity 1×1 for singletons).
     gamma: Vec<DMatrix<f64>>,
@@ -230,17 +251,20 @@ struct VarSetup {
 
 fn setup_variable(
     modes: &Mat<f64>,
-    dk: &SparseColMat<usize, f64>,
+    (lambda, d): (&[f64], &DesignDerivative<'_>),
     clusters: &[(usize, usize)],
 ) -> VarSetup {
     let (n, k) = (modes.nrows(), modes.ncols());
     let mut kpx = Mat::<f64>::zeros(n, k);
-    let dkr = dk.as_ref();
+    let dkr = d.dk.as_ref();
     sym_mul_block(
         |j| (dkr.row_idx_of_col_raw(j), dkr.val_of_col(j)),
         modes.as_ref(),
         kpx.as_mut(),
     );
+    if let Some(m) = &d.mass {
+        subtract_mass_term(&mut kpx, modes, (lambda, m.dm), clusters);
+    }
     let mut dlambda = vec![0.0; k];
     let mut gamma = Vec::with_capacity(clusters.len());
     for &(first, r) in clusters {
@@ -647,6 +671,17 @@ pub(crate) fn compute(
         if let Some(d2) = d.d2k {
             check_matrix(format!("d2k[{v}]"), d2, n)?;
         }
+        if let Some(m) = &d.mass {
+            for (key, len) in [("dm", Some(m.dm.len())), ("d2m", m.d2m.map(<[f64]>::len))] {
+                if let Some(len) = len.filter(|&l| l != n) {
+                    return Err(Error::input(
+                        format!("{key}[{v}]"),
+                        format!("length {len}"),
+                        format!("a diagonal of length {n} (the reduced DOFs)"),
+                    ));
+                }
+            }
+        }
     }
     let clusters = find_clusters(&modes.lambda, modes.shift, opts.cluster_tol);
     if let (Some(next), Some(&last)) = (modes.next_lambda, modes.lambda.last()) {
@@ -665,7 +700,7 @@ pub(crate) fn compute(
     }
     let setups: Vec<VarSetup> = vars
         .iter()
-        .map(|d| setup_variable(&modes.modes, d.dk, &clusters))
+        .map(|d| setup_variable(&modes.modes, (&modes.lambda, d), &clusters))
         .collect();
     let mut out: Vec<VariableDerivatives> = setups
         .iter()
@@ -696,6 +731,20 @@ pub(crate) fn compute(
     let mut spares: Vec<Option<super::sparse::Factor<'_>>> = (0..=n_parts).map(|_| None).collect();
     for (ci, &(first, r)) in clusters.iter().enumerate() {
         if r > 1 {
+            if let Some(v) = vars
+                .iter()
+                .position(|d| d.mass.is_some_and(|m| m.d2m.is_none()))
+            {
+                return Err(Error::input(
+                    format!("d2m[{v}]"),
+                    "none",
+                    format!(
+                        "the second mass derivative: modes {first}..{} form a repeated \
+                         cluster, whose eigenvector derivatives need M''",
+                        first + r
+                    ),
+                ));
+            }
             if let Some(v) = vars.iter().position(|d| d.d2k.is_none()) {
                 return Err(Error::input(
                     format!("d2k[{v}]"),
@@ -766,6 +815,13 @@ pub(crate) fn compute(
                         *xi = psi[(i, j)];
                     }
                     spmv(d2k, &x, &mut y);
+                    if let Some(m) = &d.mass {
+                        // ψₗᵀ(K'' − 2λⱼ'M' − λ̄M'')ψⱼ (module doc).
+                        let d2m = m.d2m.expect("checked above");
+                        for i in 0..n {
+                            y[i] -= (2.0 * dl[j] * m.dm[i] + sys.lambda_bar * d2m[i]) * x[i];
+                        }
+                    }
                     for l in 0..r {
                         if l == j {
                             continue;
@@ -782,6 +838,13 @@ pub(crate) fn compute(
                         }
                         c[(j, l)] = (2.0 * t1 + t2) / (2.0 * gap);
                     }
+                }
+            }
+            if let Some(m) = &d.mass {
+                // Normalisation ψⱼᵀMψⱼ = 1: cⱼⱼ = −½ψⱼᵀM'ψⱼ (vⱼ is M-orthogonal
+                // to the cluster).
+                for j in 0..r {
+                    c[(j, j)] = -0.5 * (0..n).map(|i| m.dm[i] * psi[(i, j)].powi(2)).sum::<f64>();
                 }
             }
             let dm = out[v].dmodes.as_mut().expect("allocated above");

@@ -87,6 +87,7 @@ mod blocks;
 pub mod derivatives;
 mod export;
 mod lanczos;
+mod mass;
 mod modes;
 mod solver;
 mod sparse;
@@ -94,7 +95,7 @@ mod sparse;
 mod tests;
 
 pub use derivatives::{
-    Cluster, DerivativeOptions, DesignDerivative, ModeUpdate, VariableDerivatives,
+    Cluster, DerivativeOptions, DesignDerivative, MassDerivative, ModeUpdate, VariableDerivatives,
 };
 pub use export::{mode_shape_rows, DofLabel, ModeShapeRow};
 pub use modes::{sign_normalize, ModalOptions, ModalStats, Modes};

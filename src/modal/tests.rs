@@ -82,7 +82,11 @@ fn blocks_give_the_full_pencils_derivatives() {
         })
         .collect();
     assert!(held.contains(&0) && held.contains(&1), "{held:?}");
-    let var = [DesignDerivative { dk: &dk, d2k: None }];
+    let var = [DesignDerivative {
+        dk: &dk,
+        d2k: None,
+        mass: None,
+    }];
     let o = DerivativeOptions::default();
     let full = compute(&pencil, None, &modes, &var, &o).unwrap();
     let split = compute(&pencil, Some(&b), &modes, &var, &o).unwrap();
@@ -150,7 +154,11 @@ fn a_new_pattern_rebuilds_the_blocks() {
     t.extend([Triplet::new(0, 6, 0.0), Triplet::new(6, 0, 0.0)]);
     let k_b = SparseColMat::try_new_from_triplets(2 * m, 2 * m, &t).unwrap();
     let dk = chains(m, 0.0, alpha);
-    let var = [DesignDerivative { dk: &dk, d2k: None }];
+    let var = [DesignDerivative {
+        dk: &dk,
+        d2k: None,
+        mass: None,
+    }];
     let o = DerivativeOptions::default();
     let mut solver = ModalSolver::new(&k_a, &mass).unwrap();
     let modes = solver.solve(&ModalOptions::new(6)).unwrap();

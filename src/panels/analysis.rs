@@ -10,8 +10,8 @@ use super::rigid::RigidFrame;
 use crate::error::{Error, Result};
 use crate::fe::{Derivatives, Panel, PanelSystem};
 use crate::modal::{
-    DerivativeOptions, DesignDerivative, ModalOptions, ModalSolver, ModeUpdate, Modes,
-    VariableDerivatives,
+    DerivativeOptions, DesignDerivative, MassDerivative, ModalOptions, ModalSolver, ModeUpdate,
+    Modes, VariableDerivatives,
 };
 use std::collections::HashMap;
 use std::time::Instant;
@@ -31,7 +31,8 @@ pub struct PanelModes {
     pub labels: Vec<(&'static str, &'static str)>,
     /// Derivatives per design variable (empty unless asked for).
     pub derivatives: Vec<VariableDerivatives>,
-    /// Design-variable names: `theta_1_4` ties plies 1 and 4.
+    /// Design-variable names: `theta_1_4` ties plies 1 and 4;
+    /// `thickness_1_4` (after the angles) is their common thickness \[m\].
     pub variables: Vec<String>,
     /// Wall times \[s\]: assembly, modes, derivatives.
     pub seconds: [f64; 3],
@@ -78,6 +79,11 @@ pub struct PanelAnalysis {
     frame: Option<([f64; 2], RigidFrame)>,
     /// Wall time of the set-up \[s\].
     pub setup_seconds: f64,
+    /// Ply groups whose common thickness is a design variable after the
+    /// ply angles (`thickness_<plies>`; empty: none), and their assembled
+    /// derivatives (buffers reused across runs).
+    thickness: Vec<Vec<usize>>,
+    tsys: Option<crate::fe::ThicknessSystem>,
 }
 
 impl PanelAnalysis {
@@ -118,7 +124,38 @@ impl PanelAnalysis {
             mirrors,
             frame: None,
             setup_seconds: t0.elapsed().as_secs_f64(),
+            thickness: Vec::new(),
+            tsys: None,
         })
+    }
+
+    /// Differentiate later runs also with respect to the common thickness
+    /// \[m\] of each ply group of `groups` (0-based plies; variables named
+    /// `thickness_<plies>`, 1-based, after the ply angles), when the
+    /// analysis computes derivatives at all. Stiffness and lumped mass
+    /// both depend on a thickness ([`crate::fe::thickness`];
+    /// [`crate::modal::derivatives`], "Mass derivative"). Errors: a ply
+    /// outside the lay-up.
+    pub fn set_thickness_groups(&mut self, groups: &[Vec<usize>]) -> Result<()> {
+        let n = self.panel.laminate.plies().len();
+        if let Some(&k) = groups.iter().flatten().find(|&&k| k >= n) {
+            return Err(Error::input(
+                "thickness_groups",
+                k + 1,
+                format!("ply numbers within the lay-up (1..={n})"),
+            ));
+        }
+        if self.thickness != groups {
+            self.thickness = groups.to_vec();
+            self.tsys = None;
+        }
+        Ok(())
+    }
+
+    /// The ply groups whose thickness is differentiated
+    /// ([`PanelAnalysis::set_thickness_groups`]).
+    pub fn thickness_groups(&self) -> &[Vec<usize>] {
+        &self.thickness
     }
 
     /// Modes (and derivatives) for `laminate` (same ply count as the
@@ -164,15 +201,39 @@ impl PanelAnalysis {
             // solve, so the elastic derivatives are the same.
             remove_rigid_modes(&mut modes, &mut [], sys)?;
         }
+        if let (Some(update), false) = (self.want, self.thickness.is_empty()) {
+            let second = update == ModeUpdate::Updated;
+            match &mut self.tsys {
+                Some(t) => self.model.assemble_thickness_into(laminate, t)?,
+                None => {
+                    self.tsys = Some(self.model.assemble_thickness(
+                        laminate,
+                        &self.thickness,
+                        second,
+                    )?)
+                }
+            }
+        }
         let derivatives = match self.want {
             None => Vec::new(),
             Some(update) => {
-                let vars: Vec<DesignDerivative<'_>> = (0..sys.dk.len())
+                let mut vars: Vec<DesignDerivative<'_>> = (0..sys.dk.len())
                     .map(|v| DesignDerivative {
                         dk: &sys.dk[v],
                         d2k: sys.d2k.get(v),
+                        mass: None,
                     })
                     .collect();
+                if let Some(t) = &self.tsys {
+                    vars.extend((0..t.groups.len()).map(|v| DesignDerivative {
+                        dk: &t.dk[v],
+                        d2k: t.d2k.get(v),
+                        mass: Some(MassDerivative {
+                            dm: &t.dm[v],
+                            d2m: t.d2m.get(v).map(|m| &m[..]),
+                        }),
+                    }));
+                }
                 let opts = DerivativeOptions {
                     update,
                     ..DerivativeOptions::default()
@@ -184,16 +245,16 @@ impl PanelAnalysis {
         let labels = (0..modes.lambda.len())
             .map(|j| label_mode(sys, &self.mirrors, &modes, j))
             .collect();
-        let variables = self
+        let mut variables: Vec<String> = self
             .panel
             .design
             .groups()
             .iter()
-            .map(|g| {
-                let plies: Vec<String> = g.iter().map(|k| (k + 1).to_string()).collect();
-                format!("theta_{}", plies.join("_"))
-            })
+            .map(|g| group_name("theta", g))
             .collect();
+        if self.want.is_some() {
+            variables.extend(self.thickness.iter().map(|g| group_name("thickness", g)));
+        }
         let key = [laminate.mass_per_area(), laminate.rotary_inertia_per_area()];
         let frame = match &self.frame {
             Some((k, f)) if *k == key => f.clone(),
@@ -234,6 +295,13 @@ impl PanelAnalysis {
             frame,
         })
     }
+}
+
+/// The name of a ply group's variable: `<kind>_<1-based plies>`, e.g.
+/// `theta_1_4` or `thickness_2_3`.
+pub fn group_name(kind: &str, group: &[usize]) -> String {
+    let plies: Vec<String> = group.iter().map(|k| (k + 1).to_string()).collect();
+    format!("{kind}_{}", plies.join("_"))
 }
 
 /// Shift σ [rad²/s²] for free–free panels: K − σM must be positive

@@ -189,6 +189,23 @@ impl BasisBuilder {
         self.points = points.to_vec();
     }
 
+    /// Differentiate every later basis also with respect to the ply
+    /// thicknesses named in `names` (`thickness_<1-based plies>`, e.g.
+    /// `thickness_1_4`: the common thickness \[m\] of plies 1 and 4), after
+    /// the ply angles, when the builder computes derivatives. The node
+    /// masses move with a thickness: the basis's derivatives carry them
+    /// ([`BasisDerivative::node_mass`]). Errors: a name that is not
+    /// `thickness_` with distinct ply numbers of the lay-up (key
+    /// `thickness`).
+    pub fn set_thickness(&mut self, names: &[String]) -> Result<()> {
+        let n = self.analysis.panel.laminate.plies().len();
+        let groups = names
+            .iter()
+            .map(|name| thickness_group(name, n))
+            .collect::<Result<Vec<_>>>()?;
+        self.analysis.set_thickness_groups(&groups)
+    }
+
     /// The distinct mesh nodes at the joint points, in the order first met.
     fn joint_nodes(&self) -> Vec<usize> {
         let nodes = &self.analysis.panel.mesh.nodes;
@@ -251,6 +268,14 @@ impl BasisBuilder {
             out
         };
         let shapes = expand(x);
+        if self.geometric && self.update.is_some() && !self.analysis.thickness_groups().is_empty() {
+            return Err(Error::input(
+                "thickness_groups",
+                format!("{:?}", self.analysis.thickness_groups()),
+                "no ply-thickness variables with geometric stiffening (the geometric \
+                 stiffness's thickness derivatives are not implemented)",
+            ));
+        }
         let geometric = if self.geometric {
             let dmodes: Vec<Option<&faer::Mat<f64>>> = run
                 .derivatives
@@ -271,7 +296,9 @@ impl BasisBuilder {
             None
         };
         let mut derivatives = Vec::with_capacity(run.derivatives.len());
-        for (d, name) in run.derivatives.iter().zip(&run.variables) {
+        let n_angles = self.analysis.panel.design.len();
+        let mut thickness = self.analysis.thickness_groups().iter().peekable();
+        for (v, (d, name)) in run.derivatives.iter().zip(&run.variables).enumerate() {
             let dshapes = match (self.update, &d.dmodes) {
                 (Some(ModeUpdate::Updated), Some(dx)) => {
                     if let Some(c) = d.clusters.first() {
@@ -292,11 +319,15 @@ impl BasisBuilder {
                 }
                 _ => vec![0.0; shapes.len()],
             };
-            derivatives.push(BasisDerivative {
-                name: name.clone(),
-                eigenvalues: keep.iter().map(|&j| d.dlambda[j]).collect(),
-                shapes: dshapes,
-            });
+            let mut bd = BasisDerivative::modal(
+                name.clone(),
+                keep.iter().map(|&j| d.dlambda[j]).collect(),
+                dshapes,
+            );
+            if let Some(g) = thickness.next_if(|_| v >= n_angles) {
+                (bd.node_mass, bd.node_inertia) = node_mass_derivatives(laminate, g, &lumped);
+            }
+            derivatives.push(bd);
         }
         let nodes = self
             .analysis
@@ -345,6 +376,50 @@ impl BasisBuilder {
         }
         Ok(NodeMasses { mass, inertia })
     }
+}
+
+/// The 0-based plies of a thickness variable's name `thickness_<plies>`
+/// (1-based, distinct, within `1..=n`).
+pub fn thickness_group(name: &str, n: usize) -> Result<Vec<usize>> {
+    let bad = || {
+        Error::input(
+            "thickness",
+            format!("\"{name}\""),
+            format!("thickness_<ply>[_<ply>...] with distinct ply numbers in 1..={n}"),
+        )
+    };
+    let rest = name.strip_prefix("thickness_").ok_or_else(bad)?;
+    let mut g = Vec::new();
+    for p in rest.split('_') {
+        let k: usize = p.parse().map_err(|_| bad())?;
+        if k == 0 || k > n || g.contains(&(k - 1)) {
+            return Err(bad());
+        }
+        g.push(k - 1);
+    }
+    Ok(g)
+}
+
+/// `dm_k/ds`, `dJ_k/ds` of the HRZ node masses for the common thickness
+/// `s` of the plies of `group`: the lumped masses are linear in the mass
+/// and rotary inertia per area (`fe::element`: `m/3` and `J_z ∝ m` per
+/// node, `J_x = J_y ∝ I`), so each scales with its per-area quantity:
+/// `m_k' = m_k μ'/μ`, `J_kx' = J_kx I'/I`, `J_kz' = J_kz μ'/μ`.
+fn node_mass_derivatives(
+    laminate: &Laminate,
+    group: &[usize],
+    lumped: &NodeMasses,
+) -> (Vec<f64>, Vec<Vector3<f64>>) {
+    let td = laminate.thickness_group_derivative(group);
+    let rm = td.mass / laminate.mass_per_area();
+    let ri = td.rotary[0] / laminate.rotary_inertia_per_area();
+    let mass = lumped.mass.iter().map(|m| m * rm).collect();
+    let inertia = lumped
+        .inertia
+        .iter()
+        .map(|j| Vector3::new(j.x * ri, j.y * ri, j.z * rm))
+        .collect();
+    (mass, inertia)
 }
 
 /// Largest rigid-body content `c` a mode of a basis may have (module doc,
@@ -407,6 +482,19 @@ pub fn basis_for_study(
     derivatives: Option<ModeUpdate>,
     geometric: Option<&[Vector3<f64>]>,
 ) -> Result<ModalBasis> {
+    basis_for_study_thickness(study, name, n_modes, (derivatives, &[]), geometric)
+}
+
+/// [`basis_for_study`] whose derivatives (when `derivatives` is `Some`)
+/// include the ply thicknesses `thickness` (names as
+/// [`BasisBuilder::set_thickness`]) after the ply angles.
+pub fn basis_for_study_thickness(
+    study: &Study,
+    name: &str,
+    n_modes: usize,
+    (derivatives, thickness): (Option<ModeUpdate>, &[String]),
+    geometric: Option<&[Vector3<f64>]>,
+) -> Result<ModalBasis> {
     if n_modes == 0 {
         return Err(Error::input("n_modes", 0, "at least 1 mode"));
     }
@@ -414,7 +502,16 @@ pub fn basis_for_study(
     let Some(i) = panels.iter().position(|p| p.name == name) else {
         return Err(unknown_panel(study, name, &panels));
     };
-    panel_basis_geometric(&panels[i], n_modes, derivatives, geometric)
+    let panel = &panels[i];
+    let basis = || {
+        let mut builder = BasisBuilder::new(panel, derivatives)?;
+        builder.set_thickness(thickness)?;
+        builder.set_geometric(geometric.is_some());
+        builder.set_joint_points(geometric.unwrap_or(&[]));
+        builder.basis(&panel.laminate, n_modes)
+    };
+    basis()
+        .map_err(|e| in_panel(e, &panel.name))
         .map_err(|e| e.in_file(&study.path, &format!("panels[{i}]")))
 }
 

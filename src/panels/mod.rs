@@ -10,8 +10,11 @@ mod geometric;
 pub mod rigid;
 
 pub use analysis::{
-    analyse_panel, dfreq_hz_per_deg, in_panel, layup_label, PanelAnalysis, PanelModes,
+    analyse_panel, dfreq_hz_per_deg, group_name, in_panel, layup_label, PanelAnalysis, PanelModes,
     FREE_FREE_SHIFT,
 };
-pub use basis::{basis_for_study, panel_basis, panel_basis_geometric, unknown_panel, BasisBuilder};
+pub use basis::{
+    basis_for_study, basis_for_study_thickness, panel_basis, panel_basis_geometric,
+    thickness_group, unknown_panel, BasisBuilder,
+};
 pub use rigid::RigidFrame;

@@ -52,7 +52,14 @@ pub fn load_scene(study: &Study) -> Result<Scene> {
     let mut spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
     spec.prune_derivatives();
     let panels = |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: Stiffening| {
-        crate::panels::basis_for_study(study, name, modes, update, geometric)
+        let thickness = spec.thickness_variables(name);
+        crate::panels::basis_for_study_thickness(
+            study,
+            name,
+            modes,
+            (update, &thickness),
+            geometric,
+        )
     };
     spec.build_with(&panels).map_err(study.locate("scene"))
 }
@@ -191,7 +198,8 @@ impl ScenePlan {
         let bases =
             |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: Stiffening| {
                 let t = Instant::now();
-                let basis = self.basis(name, modes, (update, geometric), laminates);
+                let thickness = spec.thickness_variables(name);
+                let basis = self.basis(name, modes, (update, geometric), (laminates, &thickness));
                 let mut p = profile.get();
                 p.bases += 1;
                 p.derivative_bases += usize::from(update.is_some());
@@ -214,7 +222,7 @@ impl ScenePlan {
         name: &str,
         modes: usize,
         (update, geometric): (Option<ModeUpdate>, Stiffening),
-        laminates: &[Laminate],
+        (laminates, thickness): (&[Laminate], &[String]),
     ) -> Result<ModalBasis> {
         if modes == 0 {
             return Err(Error::input("n_modes", 0, "at least 1 mode"));
@@ -244,10 +252,11 @@ impl ScenePlan {
         };
         prepared.builder.set_geometric(geometric.is_some());
         prepared.builder.set_joint_points(geometric.unwrap_or(&[]));
-        let basis = prepared
-            .builder
-            .basis(&laminates[i], modes)
-            .map_err(located);
+        let basis = match prepared.builder.set_thickness(thickness) {
+            Ok(()) => prepared.builder.basis(&laminates[i], modes),
+            Err(e) => Err(e),
+        }
+        .map_err(located);
         self.pool
             .lock()
             .unwrap_or_else(|p| p.into_inner())

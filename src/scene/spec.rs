@@ -84,6 +84,34 @@ impl SceneSpec {
     }
 }
 
+impl SceneSpec {
+    /// The ply-thickness variables (`thickness_<plies>`) that
+    /// `sensitivities` differentiates on the bodies built from panel
+    /// `panel` (lanes `<body>.design.thickness_<plies>`, alone or tied),
+    /// in the order first met.
+    pub fn thickness_variables(&self, panel: &str) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for b in &self.bodies {
+            let of_panel = b
+                .flexible
+                .as_ref()
+                .is_some_and(|f| f.kind == FlexKind::Panel && f.panel.as_deref() == Some(panel));
+            if !of_panel {
+                continue;
+            }
+            let prefix = format!("{}.design.", b.name);
+            for lane in self.sensitivities.iter().flat_map(|l| l.split('+')) {
+                if let Some(v) = lane.trim().strip_prefix(&prefix) {
+                    if v.starts_with("thickness_") && !out.iter().any(|o| o == v) {
+                        out.push(v.to_string());
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
 /// The `[scene]` section: a multibody model with its integrator, outputs,
 /// sensitivity parameters and responses (module doc of [`crate::scene`]
 /// for an example of every key). Unknown keys are refused.

@@ -42,7 +42,11 @@
 //! from [`crate::modal`]); node masses do not depend on them. The
 //! invariants' derivatives follow exactly (they are linear or bilinear in
 //! `X`) from the same matrix products
-//! ([`Invariants::with_derivatives`]).
+//! ([`Invariants::with_derivatives`]). A ply thickness also moves the
+//! node masses `m_k`, `J_k` ([`BasisDerivative::node_mass`]); every sum is
+//! linear in them, so its derivative gains the same sum with `m_k'`,
+//! `J_k'` in place of `m_k`, `J_k` and the shapes unchanged (and `mass`,
+//! `s0`, `e0`, `j_rot` are no longer constant).
 
 use super::geometric::Geometric;
 use crate::error::{Error, Result};
@@ -59,6 +63,31 @@ pub struct BasisDerivative {
     pub eigenvalues: Vec<f64>,
     /// `dX/db` in the layout of [`ModalBasis::shapes`].
     pub shapes: Vec<f64>,
+    /// `dm_k/db` of the lumped node masses (kg per unit of b); empty when
+    /// the masses do not depend on b (ply angles). A ply thickness moves
+    /// them.
+    pub node_mass: Vec<f64>,
+    /// `dJ_k/db` of the node rotary inertias; empty alike.
+    pub node_inertia: Vec<Vector3<f64>>,
+}
+
+impl BasisDerivative {
+    /// A derivative of the eigenvalues and shapes only (node masses
+    /// independent of the variable).
+    pub fn modal(name: String, eigenvalues: Vec<f64>, shapes: Vec<f64>) -> BasisDerivative {
+        BasisDerivative {
+            name,
+            eigenvalues,
+            shapes,
+            node_mass: Vec::new(),
+            node_inertia: Vec::new(),
+        }
+    }
+
+    /// Does the variable move the node masses?
+    pub fn moves_mass(&self) -> bool {
+        !self.node_mass.is_empty()
+    }
 }
 
 /// A mode left out of a basis because it is almost a rigid motion of the
@@ -189,6 +218,24 @@ impl ModalBasis {
             ));
         }
         for d in &self.derivatives {
+            let masses_ok = !d.moves_mass()
+                || (d.node_mass.len() == nn
+                    && d.node_inertia.len() == nn
+                    && d.node_mass.iter().all(|v| v.is_finite())
+                    && d.node_inertia
+                        .iter()
+                        .all(|v| v.iter().all(|x| x.is_finite())));
+            if !masses_ok {
+                return Err(Error::input(
+                    format!("{key}.derivatives.{}.node_mass", d.name),
+                    format!(
+                        "{} mass and {} inertia derivatives",
+                        d.node_mass.len(),
+                        d.node_inertia.len()
+                    ),
+                    format!("none, or {nn} finite ones of each (one per node)"),
+                ));
+            }
             if d.eigenvalues.len() != n || d.shapes.len() != self.shapes.len() {
                 return Err(Error::input(
                     format!("{key}.derivatives.{}", d.name),
@@ -239,6 +286,8 @@ impl ModalBasis {
                     name: d.name.clone(),
                     eigenvalues: d.eigenvalues[..n].to_vec(),
                     shapes: pick(&d.shapes),
+                    node_mass: d.node_mass.clone(),
+                    node_inertia: d.node_inertia.clone(),
                 })
                 .collect(),
             rigid: RigidScreen {
@@ -306,6 +355,8 @@ impl ModalBasis {
                     name: d.name.clone(),
                     eigenvalues: keep.iter().map(|&j| d.eigenvalues[j]).collect(),
                     shapes: pick(&d.shapes),
+                    node_mass: d.node_mass.clone(),
+                    node_inertia: d.node_inertia.clone(),
                 })
                 .collect(),
             rigid: RigidScreen {
@@ -390,7 +441,8 @@ impl Invariants {
     /// The invariants of `basis` from its arranged shapes `sh`.
     fn of_shapes(basis: &ModalBasis, sh: &ShapeMatrices) -> Invariants {
         let (g, h) = (sh.gram(sh), sh.rot_gram(sh));
-        let v = flat_sums(basis, &basis.shapes, (&g, &h), true);
+        let masses = (&basis.node_mass[..], &basis.node_inertia[..]);
+        let v = flat_sums(basis, masses, &basis.shapes, (&g, &h), true);
         Invariants::from_flat(basis.n_modes, &v, basis.eigenvalues.clone())
     }
 
@@ -398,7 +450,8 @@ impl Invariants {
     /// each of its design variables, exact: the sums are linear in the
     /// shapes `X` or bilinear (`G = ΦᵀMΦ`, `H = ΨᵀJΨ`), so a derivative
     /// takes the linear sums of `X'` and `G' = S + Sᵀ`, `S = Φ'ᵀMΦ` (and
-    /// alike for `H`).
+    /// alike for `H`); a variable that moves the node masses adds the sums
+    /// with the mass derivatives and the shapes unchanged (module doc).
     pub fn with_derivatives(basis: &ModalBasis) -> (Invariants, Vec<Invariants>) {
         let n = basis.n_modes;
         let sh = ShapeMatrices::new(basis, &basis.shapes);
@@ -414,7 +467,15 @@ impl Invariants {
             .map(|(v, d)| {
                 let dsh = ShapeMatrices::new(basis, &d.shapes);
                 let (dg, dh) = (sym(dsh.gram(&sh)), sym(dsh.rot_gram(&sh)));
-                let dv = flat_sums(basis, &d.shapes, (&dg, &dh), false);
+                let masses = (&basis.node_mass[..], &basis.node_inertia[..]);
+                let mut dv = flat_sums(basis, masses, &d.shapes, (&dg, &dh), false);
+                if d.moves_mass() {
+                    let dmasses = (&d.node_mass[..], &d.node_inertia[..]);
+                    let msh = ShapeMatrices::with_masses(basis, &basis.shapes, dmasses);
+                    let (mg, mh) = (msh.gram(&msh), msh.rot_gram(&msh));
+                    let mv = flat_sums(basis, dmasses, &basis.shapes, (&mg, &mh), true);
+                    dv.iter_mut().zip(&mv).for_each(|(a, b)| *a += b);
+                }
                 let mut di = Invariants::from_flat(n, &dv, d.eigenvalues.clone());
                 di.kg = geometric.map_or(Vec::new(), |g| g.derivatives[v].clone());
                 di
@@ -480,6 +541,16 @@ struct ShapeMatrices {
 
 impl ShapeMatrices {
     fn new(basis: &ModalBasis, shapes: &[f64]) -> ShapeMatrices {
+        ShapeMatrices::with_masses(basis, shapes, (&basis.node_mass, &basis.node_inertia))
+    }
+
+    /// The arrangement with the node masses and inertias `(m, j)` in
+    /// place of the basis's (their design derivatives).
+    fn with_masses(
+        basis: &ModalBasis,
+        shapes: &[f64],
+        (mass, inertia): (&[f64], &[Vector3<f64>]),
+    ) -> ShapeMatrices {
         let (nn, n) = (basis.nodes.len(), basis.n_modes);
         let phi = Mat::<f64>::from_fn(nn, 3 * n, |k, col| {
             let (r, j) = (col / n, col % n);
@@ -489,9 +560,9 @@ impl ShapeMatrices {
             let (k, c) = (row / 3, row % 3);
             shapes[(k * 6 + 3 + c) * n + j]
         });
-        let mphi = Mat::<f64>::from_fn(nn, 3 * n, |k, col| basis.node_mass[k] * phi[(k, col)]);
+        let mphi = Mat::<f64>::from_fn(nn, 3 * n, |k, col| mass[k] * phi[(k, col)]);
         let jpsi = Mat::<f64>::from_fn(3 * nn, n, |row, j| {
-            basis.node_inertia[row / 3][row % 3] * psi[(row, j)]
+            inertia[row / 3][row % 3] * psi[(row, j)]
         });
         ShapeMatrices {
             phi,
@@ -536,10 +607,13 @@ impl ShapeMatrices {
 /// sums linear in `shapes` (`i3`, `ls`, `p`, `c_rot`) node by node, the
 /// bilinear ones read from `G` (`q_ij[r][c] = G[r·n+i, c·n+j]`, `v_ij`
 /// its antisymmetric part, `mww = Σ_r G_rr + H`) and, when `constant`,
-/// the design-independent `mass`, `s0`, `e0`, `j_rot` (zero otherwise:
-/// node masses and positions do not depend on the design).
+/// the sums without shapes `mass`, `s0`, `e0`, `j_rot` (zero otherwise:
+/// for the shape-derivative part of a derivative). `(node_mass,
+/// node_inertia)`: the masses of the sums (the basis's, or their
+/// derivatives).
 fn flat_sums(
     basis: &ModalBasis,
+    (node_mass, node_inertia): (&[f64], &[Vector3<f64>]),
     shapes: &[f64],
     (g, h): (&Mat<f64>, &Mat<f64>),
     constant: bool,
@@ -554,7 +628,7 @@ fn flat_sums(
     let mut p = vec![0.0; 9 * n];
     let mut c_rot = vec![0.0; 3 * n];
     for (k, s) in basis.nodes.iter().enumerate() {
-        let (m, jk) = (basis.node_mass[k], basis.node_inertia[k]);
+        let (m, jk) = (node_mass[k], node_inertia[k]);
         if constant {
             mass += m;
             s0 += s * m;
@@ -612,249 +686,5 @@ fn flat_sums(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::mbs::math::Scalar;
-    use num_dual::Dual64;
-
-    /// The definitions node by node (the table of the module doc), in any
-    /// scalar, flattened in the order of [`Invariants::from_flat`]: the
-    /// reference for the matrix-product sums.
-    fn sums<T: Scalar>(basis: &ModalBasis, x: &dyn Fn(usize) -> T) -> Vec<T> {
-        let n = basis.n_modes;
-        let mut mass = T::zero();
-        let mut s0 = Vector3::<T>::zeros();
-        let mut e0 = Matrix3::<T>::zeros();
-        let mut i3 = vec![T::zero(); 3 * n];
-        let mut ls = vec![T::zero(); 3 * n];
-        let mut p = vec![T::zero(); 9 * n];
-        let mut q = vec![T::zero(); 9 * n * n];
-        let mut vv = vec![T::zero(); 3 * n * n];
-        let mut j_rot = Matrix3::<T>::zeros();
-        let mut c_rot = vec![T::zero(); 3 * n];
-        let mut mww = vec![T::zero(); n * n];
-        let mut phi = vec![Vector3::<T>::zeros(); n];
-        let mut psi = vec![Vector3::<T>::zeros(); n];
-        for (k, s) in basis.nodes.iter().enumerate() {
-            let m = T::from_subset(&basis.node_mass[k]);
-            let jk = basis.node_inertia[k].map(|v| T::from_subset(&v));
-            let s = s.map(|v| T::from_subset(&v));
-            for j in 0..n {
-                for c in 0..3 {
-                    phi[j][c] = x((k * 6 + c) * n + j);
-                    psi[j][c] = x((k * 6 + 3 + c) * n + j);
-                }
-            }
-            mass += m;
-            s0 += s * m;
-            e0 += s * s.transpose() * m;
-            for c in 0..3 {
-                j_rot[(c, c)] += jk[c];
-            }
-            for j in 0..n {
-                let mp = phi[j] * m;
-                let sxp = s.cross(&phi[j]) * m;
-                for c in 0..3 {
-                    i3[c * n + j] += mp[c];
-                    ls[c * n + j] += sxp[c];
-                    c_rot[c * n + j] += jk[c] * psi[j][c];
-                    for r in 0..3 {
-                        p[j * 9 + 3 * r + c] += mp[r] * s[c];
-                    }
-                }
-                for i in 0..n {
-                    let pi = phi[i] * m;
-                    let o = (i * n + j) * 9;
-                    for r in 0..3 {
-                        for c in 0..3 {
-                            q[o + 3 * r + c] += pi[r] * phi[j][c];
-                        }
-                    }
-                    let cr = pi.cross(&phi[j]);
-                    for c in 0..3 {
-                        vv[(i * n + j) * 3 + c] += cr[c];
-                    }
-                    mww[i * n + j] += pi.dot(&phi[j]) + psi[i].component_mul(&jk).dot(&psi[j]);
-                }
-            }
-        }
-        let mut out = Vec::with_capacity(Invariants::len_flat(n));
-        out.push(mass);
-        out.extend(s0.iter().copied());
-        out.extend(e0.transpose().iter().copied()); // row-major
-        out.extend(i3);
-        out.extend(ls);
-        out.extend(p);
-        out.extend(q);
-        out.extend(vv);
-        out.extend(j_rot.transpose().iter().copied());
-        out.extend(c_rot);
-        out.extend(mww);
-        out
-    }
-
-    /// Two point masses on a massless spring along x, one mode (the
-    /// stretching mode), with a third rotary-inertia node.
-    fn dumbbell() -> ModalBasis {
-        let a = 0.5f64.sqrt();
-        // Mode: masses 1 kg at ±1 m move ∓a along x (mass-normalized:
-        // 2·a² = 1), plus a node with rotary inertia rotating 0.3 rad.
-        let mut shapes = vec![0.0; 18];
-        shapes[0] = -a;
-        shapes[6] = a;
-        shapes[12 + 5] = 0.3;
-        ModalBasis {
-            nodes: vec![
-                Vector3::new(-1.0, 0.0, 0.0),
-                Vector3::new(1.0, 0.0, 0.0),
-                Vector3::zeros(),
-            ],
-            node_mass: vec![1.0, 1.0, 0.0],
-            node_inertia: vec![
-                Vector3::zeros(),
-                Vector3::zeros(),
-                Vector3::new(0.0, 0.0, 0.2),
-            ],
-            n_modes: 1,
-            shapes,
-            eigenvalues: vec![4.0],
-            derivatives: vec![BasisDerivative {
-                name: "b".into(),
-                eigenvalues: vec![1.0],
-                shapes: {
-                    let mut d = vec![0.0; 18];
-                    d[6] = 2.0;
-                    d
-                },
-            }],
-            rigid: RigidScreen::default(),
-            geometric: None,
-        }
-    }
-
-    #[test]
-    fn dumbbell_invariants_by_hand() {
-        // Closed forms derived in this test from the definitions.
-        let b = dumbbell();
-        b.validate("b").unwrap();
-        let inv = Invariants::new(&b);
-        let a = 0.5f64.sqrt();
-        assert_eq!(inv.mass, 2.0);
-        assert!(inv.s0.norm() < 1e-15);
-        assert!((inv.e0[(0, 0)] - 2.0).abs() < 1e-15);
-        // i3 = Σ m Φ = −a + a = 0; ls = Σ m s × Φ = 0 (s ∥ Φ).
-        assert!(inv.i3.iter().all(|v| v.abs() < 1e-15));
-        assert!(inv.ls.iter().all(|v| v.abs() < 1e-15));
-        // p = Σ m Φ sᵀ: (−a)(−1) + a·1 = 2a in entry (x, x).
-        assert!((inv.p[0] - 2.0 * a).abs() < 1e-15);
-        // q = Σ m Φ Φᵀ: 2a² = 1 in (x, x); v = 0.
-        assert!((inv.q[0] - 1.0).abs() < 1e-15);
-        // Rotary: c_rot z = 0.2·0.3, mww = 1 + 0.3²·0.2.
-        assert!((inv.c_rot[2] - 0.06).abs() < 1e-15);
-        assert!((inv.mww[0] - (1.0 + 0.018)).abs() < 1e-15);
-        assert!((inv.j_rot[(2, 2)] - 0.2).abs() < 1e-15);
-    }
-
-    /// A basis of 7 nodes and 3 modes with deterministic pseudo-random
-    /// positions, masses, inertias, shapes and shape derivatives.
-    fn scrambled() -> ModalBasis {
-        let r = |k: usize| ((k as f64 * 0.618_034 + 0.1).fract() - 0.5) * 2.0;
-        let (nn, n) = (7, 3);
-        ModalBasis {
-            nodes: (0..nn)
-                .map(|k| Vector3::new(r(3 * k), r(3 * k + 1), r(3 * k + 2)))
-                .collect(),
-            node_mass: (0..nn).map(|k| 1.0 + r(50 + k).abs()).collect(),
-            node_inertia: (0..nn)
-                .map(|k| Vector3::new(r(60 + k).abs(), r(70 + k).abs(), r(80 + k).abs()))
-                .collect(),
-            n_modes: n,
-            shapes: (0..6 * nn * n).map(|i| r(100 + i)).collect(),
-            eigenvalues: vec![1.0, 2.0, 3.0],
-            derivatives: vec![BasisDerivative {
-                name: "b".into(),
-                eigenvalues: vec![0.1, 0.2, 0.3],
-                shapes: (0..6 * nn * n).map(|i| r(400 + i)).collect(),
-            }],
-            rigid: RigidScreen::default(),
-            geometric: None,
-        }
-    }
-
-    #[test]
-    fn matrix_product_sums_equal_the_node_by_node_definitions() {
-        // Values from f64 sums, derivatives from dual-number sums of the
-        // definitions, both node by node; the products agree to round-off.
-        let b = scrambled();
-        let (inv, d) = Invariants::with_derivatives(&b);
-        let n = b.n_modes;
-        let want =
-            Invariants::from_flat(n, &sums::<f64>(&b, &|i| b.shapes[i]), b.eigenvalues.clone());
-        let dual = sums::<Dual64>(&b, &|i| {
-            Dual64::new(b.shapes[i], b.derivatives[0].shapes[i])
-        });
-        let eps: Vec<f64> = dual.iter().map(|x| x.eps).collect();
-        let dwant = Invariants::from_flat(n, &eps, vec![0.1, 0.2, 0.3]);
-        let close = |a: &Invariants, b: &Invariants, what: &str| {
-            for (name, x, y) in [
-                ("i3", &a.i3, &b.i3),
-                ("ls", &a.ls, &b.ls),
-                ("p", &a.p, &b.p),
-                ("q", &a.q, &b.q),
-                ("v", &a.v, &b.v),
-                ("c_rot", &a.c_rot, &b.c_rot),
-                ("mww", &a.mww, &b.mww),
-            ] {
-                for (u, v) in x.iter().zip(y) {
-                    assert!((u - v).abs() < 1e-13, "{what} {name}: {u} vs {v}");
-                }
-            }
-            assert!((a.e0 - b.e0).norm() < 1e-13 && (a.s0 - b.s0).norm() < 1e-13);
-            assert!((a.j_rot - b.j_rot).norm() < 1e-13 && (a.mass - b.mass).abs() < 1e-13);
-        };
-        close(&inv, &want, "value");
-        close(&d[0], &dwant, "derivative");
-        assert_eq!(d[0].mass, 0.0);
-    }
-
-    #[test]
-    fn invariant_derivatives_match_finite_differences() {
-        // Central finite differences of the invariants along dX.
-        let b = dumbbell();
-        let (_, d) = Invariants::with_derivatives(&b);
-        let h = 1e-6;
-        let at = |t: f64| {
-            let mut x = b.clone();
-            for (s, ds) in x.shapes.iter_mut().zip(&b.derivatives[0].shapes) {
-                *s += t * ds;
-            }
-            Invariants::new(&x)
-        };
-        let (ip, im) = (at(h), at(-h));
-        let fd = |a: &[f64], b: &[f64]| -> Vec<f64> {
-            a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * h)).collect()
-        };
-        for (an, num) in [
-            (&d[0].p, fd(&ip.p, &im.p)),
-            (&d[0].q, fd(&ip.q, &im.q)),
-            (&d[0].mww, fd(&ip.mww, &im.mww)),
-            (&d[0].i3, fd(&ip.i3, &im.i3)),
-        ] {
-            for (x, y) in an.iter().zip(&num) {
-                assert!((x - y).abs() < 1e-8, "{x} vs {y}");
-            }
-        }
-        assert_eq!(d[0].lambda, vec![1.0]);
-        assert_eq!(d[0].mass, 0.0);
-    }
-
-    #[test]
-    fn truncation_and_bad_input() {
-        let mut b = dumbbell();
-        b.n_modes = 1;
-        assert_eq!(b.truncated(5).n_modes, 1);
-        b.eigenvalues[0] = -1.0;
-        let e = b.validate("scene.bodies[0].modal").unwrap_err().to_string();
-        assert!(e.contains("eigenvalues[0]"), "{e}");
-    }
-}
+#[path = "flex_tests.rs"]
+mod tests;

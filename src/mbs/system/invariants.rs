@@ -69,8 +69,22 @@ impl<T: Scalar> InvT<T> {
         };
         InvT {
             n: inv.n,
-            mass: cst::<T>(inv.mass),
-            s0: inv.s0.map(cst::<T>),
+            // Constant unless a variable moves the node masses (a ply
+            // thickness): then lifted like the others.
+            mass: d.iter().fold(cst::<T>(inv.mass), |acc, (di, t)| {
+                if di.mass == 0.0 {
+                    acc
+                } else {
+                    acc + cst::<T>(di.mass) * *t
+                }
+            }),
+            s0: d.iter().fold(inv.s0.map(cst::<T>), |acc, (di, t)| {
+                if di.s0 == Vector3::zeros() {
+                    acc
+                } else {
+                    acc + di.s0.map(cst::<T>) * *t
+                }
+            }),
             e0: m3(&|i| i.e0),
             i3: vec(&|i| &i.i3),
             ls: vec(&|i| &i.ls),

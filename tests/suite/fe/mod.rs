@@ -3,3 +3,4 @@ mod element;
 mod modes;
 mod plate;
 mod spec;
+mod thickness;

@@ -25,4 +25,5 @@ mod sens;
 mod slider_crank;
 mod stiffening;
 mod studies;
+mod thickness;
 mod torsion;

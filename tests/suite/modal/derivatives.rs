@@ -141,6 +141,7 @@ fn distinct_modes_match_finite_differences_and_modal_expansion() {
         .map(|(a, b)| DesignDerivative {
             dk: a,
             d2k: Some(b),
+            mass: None,
         })
         .collect();
     let der = solver
@@ -251,6 +252,7 @@ fn repeated_eigenvalue_adjacent_eigenvectors_exact() {
     let var = [DesignDerivative {
         dk: &dk,
         d2k: Some(&d2k),
+        mass: None,
     }];
     let der = solver
         .derivatives(&modes, &var, &DerivativeOptions::default())
@@ -335,7 +337,11 @@ fn repeated_eigenvalue_adjacent_eigenvectors_exact() {
         "X {e_vec:e}, X' {e_dvec:e}"
     );
     // Without K'' the repeated cluster cannot be differentiated.
-    let no_d2 = [DesignDerivative { dk: &dk, d2k: None }];
+    let no_d2 = [DesignDerivative {
+        dk: &dk,
+        d2k: None,
+        mass: None,
+    }];
     assert!(matches!(
         solver.derivatives(&modes, &no_d2, &DerivativeOptions::default()),
         Err(Error::Input { .. })
@@ -397,6 +403,7 @@ fn near_crossing_stays_bounded_and_matches_smooth_branch() {
     let var = [DesignDerivative {
         dk: &dk,
         d2k: Some(&d2k),
+        mass: None,
     }];
     for delta in [1e-2, 1e-4, 1e-7, 1e-10, 0.0] {
         let p = 0.5 + delta;
@@ -471,6 +478,7 @@ fn wrong_derivative_size_is_input_error() {
     let var = [DesignDerivative {
         dk: &bad,
         d2k: None,
+        mass: None,
     }];
     match solver.derivatives(&modes, &var, &DerivativeOptions::default()) {
         Err(Error::Input { key, .. }) => assert_eq!(key, "dk[0]"),
@@ -542,6 +550,7 @@ fn repeated_eigenvalue_generic_perturbation_matches_branch_fd() {
     let var = [DesignDerivative {
         dk: &dk,
         d2k: Some(&d2k),
+        mass: None,
     }];
     let kk = k_at(0.0);
     let mut solver = ModalSolver::new(&kk, &mass).unwrap();
@@ -646,6 +655,7 @@ fn derivatives_bitwise_deterministic() {
     let var = [DesignDerivative {
         dk: &dk,
         d2k: Some(&d2k),
+        mass: None,
     }];
     let mass = vec![1.0; n];
     let run = || {

@@ -1,3 +1,4 @@
 //! Tests of `plyscape::modal`: sparse eigen-solutions and their derivatives.
 mod derivatives;
 mod eigen;
+mod thickness;

@@ -2,3 +2,4 @@
 mod basis;
 mod geometric;
 mod modes;
+mod thickness;
