@@ -404,15 +404,9 @@ impl PanelModel {
             }
         }
         for (m, val) in vals.iter().enumerate() {
-            if let Some(i) = val.iter().position(|v| !v.is_finite()) {
-                return Err(Error::numerical(
-                    "fe::PanelModel::assemble",
-                    format!(
-                        "non-finite entry {i} of matrix {m} (0 = K, then dK, d2K): {}",
-                        val[i]
-                    ),
-                ));
-            }
+            all_finite(val, "fe::PanelModel::assemble", || {
+                format!("matrix {m} (0 = K, then dK, d2K)")
+            })?;
         }
         Ok(())
     }
@@ -590,4 +584,16 @@ pub fn assemble(
     want: Derivatives,
 ) -> Result<PanelSystem> {
     PanelModel::new(mesh.clone(), support)?.assemble(lam, design, want)
+}
+
+/// `Ok` when every entry of `val` is finite; else a numerical error at
+/// `place` naming the first non-finite entry of `what()` and its value.
+pub(super) fn all_finite(val: &[f64], place: &str, what: impl FnOnce() -> String) -> Result<()> {
+    match val.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(Error::numerical(
+            place,
+            format!("non-finite entry {i} of {}: {}", what(), val[i]),
+        )),
+        None => Ok(()),
+    }
 }

@@ -20,7 +20,7 @@
 //! inertia per area ([`super::Triangle::lumped_mass`]), so
 //! `M' = lumped(μ', I')` and `M'' = lumped(0, I'')` (μ is linear in `s`).
 
-use super::assembly::{PanelModel, NONE};
+use super::assembly::{all_finite, PanelModel, NONE};
 use super::element::{section_matrix, Mat18, Mat8, DRILLING_PENALTY};
 use super::NODE_DOF;
 use crate::error::{Error, Result};
@@ -150,16 +150,9 @@ impl PanelModel {
             }
         }
         for (m, val) in vals.iter().enumerate() {
-            if let Some(i) = val.iter().position(|v| !v.is_finite()) {
-                return Err(Error::numerical(
-                    "fe::PanelModel::assemble_thickness",
-                    format!(
-                        "non-finite entry {i} of the thickness derivative {} of K: {}",
-                        m + 1,
-                        val[i]
-                    ),
-                ));
-            }
+            all_finite(val, PLACE, || {
+                format!("the thickness derivative {} of K", m + 1)
+            })?;
         }
         Ok(())
     }
@@ -181,14 +174,8 @@ impl PanelModel {
 }
 
 fn check_finite(m: &[f64], what: &str, v: usize) -> Result<()> {
-    match m.iter().position(|x| !x.is_finite()) {
-        Some(i) => Err(Error::numerical(
-            "fe::PanelModel::assemble_thickness",
-            format!(
-                "non-finite entry {i} of {what} for thickness group {v}: {}",
-                m[i]
-            ),
-        )),
-        None => Ok(()),
-    }
+    all_finite(m, PLACE, || format!("{what} for thickness group {v}"))
 }
+
+/// Where the thickness assembly's numerical errors happen.
+const PLACE: &str = "fe::PanelModel::assemble_thickness";

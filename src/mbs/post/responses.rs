@@ -180,8 +180,12 @@ pub fn energy_lanes(
 /// `(t*, value, gradient)` at the refined maximum (see the module doc).
 /// `None` for an empty series.
 pub fn peak(series: &[(f64, f64, Vec<f64>)]) -> Option<(f64, f64, Vec<f64>)> {
-    let k = (0..series.len()).max_by(|&a, &b| series[a].1.total_cmp(&series[b].1))?;
-    Some(refine(series, k))
+    Some(refine(series, largest(series)?))
+}
+
+/// The index of the largest sample (the last of equal ones).
+fn largest(series: &[(f64, f64, Vec<f64>)]) -> Option<usize> {
+    (0..series.len()).max_by(|&a, &b| series[a].1.total_cmp(&series[b].1))
 }
 
 /// Every critical time point of a sampled response: each local maximum
@@ -199,7 +203,7 @@ pub fn peak(series: &[(f64, f64, Vec<f64>)]) -> Option<(f64, f64, Vec<f64>)> {
 /// optimizer's direction subproblem and its Kuhn–Tucker test see both
 /// sides of the kink.
 pub fn critical_points(series: &[(f64, f64, Vec<f64>)]) -> Vec<(f64, f64, Vec<f64>)> {
-    let Some(first) = (0..series.len()).max_by(|&a, &b| series[a].1.total_cmp(&series[b].1)) else {
+    let Some(first) = largest(series) else {
         return Vec::new();
     };
     let n = series.len();
