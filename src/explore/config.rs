@@ -74,6 +74,11 @@ pub struct MultistartSection {
     /// [`super::settle`]).
     #[serde(default = "default_polish")]
     pub polish: bool,
+    /// Rescue every run that ends infeasible by the pure descent on the
+    /// violation from its start, then settle its end when it reaches the
+    /// feasible set (default true; see [`super::settle`]).
+    #[serde(default = "default_polish")]
+    pub rescue: bool,
     /// Infeasible runs checked by a pure descent on the violation from
     /// their starts (default 0; see [`super::violation`]).
     #[serde(default)]
@@ -103,6 +108,7 @@ impl MultistartSection {
         super::settle::EndPolicy {
             tolerances: self.kkt_tolerances(),
             polish: self.polish,
+            rescue: self.rescue,
         }
     }
 }

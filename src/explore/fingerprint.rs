@@ -72,7 +72,9 @@ use std::path::Path;
 /// MMFD's CTMIN the study's feasibility tolerance (default 1e-6). 3:
 /// MMFD's first trial from a BFGS curvature model; a peak whose largest
 /// sample is at an end of the run located by the end samples' parabola.
-pub const EVALUATION_VERSION: u32 = 3;
+/// 4: infeasible ends rescued by the pure descent on the violation from the
+/// run's start (`[multistart] rescue`).
+pub const EVALUATION_VERSION: u32 = 4;
 
 /// Relative tolerance of the spot check (see the module doc).
 pub const RECHECK_RTOL: f64 = 1e-9;

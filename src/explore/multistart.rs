@@ -147,7 +147,7 @@ pub fn one_run(
     // A panic inside one run (a solver bug) becomes that run's error
     // instead of ending a long campaign.
     let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        solver(&counted, x0, observer).map(|o| settle(&counted, o, end, observer))
+        solver(&counted, x0, observer).map(|o| settle(&counted, Some(x0), o, end, observer))
     }))
     .unwrap_or_else(|p| {
         let msg = p
@@ -499,6 +499,7 @@ mod tests {
         let end = crate::explore::settle::EndPolicy {
             tolerances: Default::default(),
             polish: true,
+            rescue: true,
         };
         let row = one_run(&p, fails, &end, 3, &[0.0, 1.0], &mut NoObserver);
         assert!(row.result.is_none() && row.exit.contains("singular"));

@@ -16,7 +16,22 @@
 //!    stationary point of the violation is not polished: descent on the
 //!    violation cannot leave it, which is the answer for that start.
 //!    The polish's result replaces the solver's unless it is worse
-//!    (feasible before and not after, or higher f at equal feasibility).
+//!    (feasible before and not after, or higher f at equal feasibility by
+//!    more than the polish's noise allowance, 1e-6 of `max(|f|, 1)`).
+//! 3. When the end is still infeasible and the rescue is on
+//!    (`[multistart] rescue`, default true): the pure descent on the
+//!    violation from the run's start ([`violation::descend`], the
+//!    objective playing no part, the descent that `violation_checks.csv`
+//!    runs on a sample). Where it reaches the feasible set, its end is
+//!    settled by steps 1–2 (certified, polished from there) and becomes the
+//!    run's result; else the run stays infeasible, now with the answer that
+//!    neither the solver's feasibility moves nor the pure descent reach the
+//!    feasible set from that start. A solver's feasibility phase trades the
+//!    violation against the objective and may descend into another basin
+//!    of the violation than the pure descent (on the SAR problem, 2 of 4
+//!    sampled infeasible ends of the first sweep were such starts), so
+//!    with the rescue every run reaches the feasible set wherever the pure
+//!    descent from its start does. The descent's calls count with the run.
 //!
 //! Every evaluation goes through the caller's problem, so a counting
 //! wrapper counts the certificate and the polish with the run.
@@ -26,6 +41,7 @@
 //! stands on the tolerance (`0 < max g <= feasibility`), so that every
 //! method is compared at `max g <= 0`.
 
+use super::violation;
 use crate::error::Result;
 use crate::optimize::kkt::{self, Certificate, EndClass, KktTolerances};
 use crate::optimize::mmfd::{self, MmfdOptions};
@@ -39,6 +55,9 @@ pub struct EndPolicy {
     pub tolerances: KktTolerances,
     /// Polish the ends that are not converged (`[multistart] polish`).
     pub polish: bool,
+    /// Rescue infeasible ends by the pure descent on the violation from
+    /// the run's start (`[multistart] rescue`; step 3 of the module doc).
+    pub rescue: bool,
 }
 
 /// A settled run end.
@@ -80,15 +99,17 @@ impl Observer for Continued<'_> {
 }
 
 /// Is outcome `b` no worse than `a`: feasible (to `tol`) beats infeasible,
-/// then lower f among feasible ends, lower largest violation among
-/// infeasible ones.
-fn no_worse(b: &LocalOutcome, a: &LocalOutcome, tol: f64) -> bool {
+/// then lower f among feasible ends, up to `noise` of `max(|f|, 1)` (the
+/// polish's noise allowance: its certified end may sit that much above an
+/// uncertified one that a jump of the evaluation's noise put lower), lower
+/// largest violation among infeasible ones.
+fn no_worse(b: &LocalOutcome, a: &LocalOutcome, tol: f64, noise: f64) -> bool {
     let max_g = |o: &LocalOutcome| o.g.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let (fa, fb) = (max_g(a) <= tol, max_g(b) <= tol);
     match (fa, fb) {
         (true, false) => false,
         (false, true) => true,
-        (true, true) => b.f <= a.f,
+        (true, true) => b.f <= a.f + noise * a.f.abs().max(1.0),
         (false, false) => max_g(b) <= max_g(a),
     }
 }
@@ -125,11 +146,108 @@ fn certify_recorded(
     Ok((c, calls))
 }
 
-/// Settle the solver's `outcome` (see the module doc). Each certificate is
+/// Settle the solver's `outcome` of a run from `start` (see the module
+/// doc; `None` when there is no start to rescue from). Each certificate is
 /// recorded to `observer` as a final check of the run, and the polish's
 /// iterations as continuations of it; the returned outcome's counts
-/// include both.
+/// include the certificates, the polish and the rescue.
 pub fn settle(
+    problem: &dyn Problem,
+    start: Option<&[f64]>,
+    outcome: LocalOutcome,
+    policy: &EndPolicy,
+    observer: &mut dyn Observer,
+) -> Settled {
+    let settled = settle_end(problem, outcome, policy, observer);
+    let infeasible = settled
+        .certificate
+        .as_ref()
+        .is_some_and(|c| c.class == EndClass::Infeasible);
+    match start {
+        Some(x0) if policy.rescue && infeasible => rescue(problem, x0, settled, policy, observer),
+        _ => settled,
+    }
+}
+
+/// Step 3 of the module doc: the pure descent on the violation from the
+/// run's start ([`violation::descend`]); where it reaches the feasible set
+/// its end is settled (certified, polished) and replaces the infeasible
+/// end. The calls of the descent count with the run's; `polish` says what
+/// the rescue did.
+fn rescue(
+    problem: &dyn Problem,
+    x0: &[f64],
+    settled: Settled,
+    policy: &EndPolicy,
+    observer: &mut dyn Observer,
+) -> Settled {
+    let counted = Counted::new(problem);
+    let tol = policy.tolerances.feasibility;
+    let descent = violation::descend(&counted, x0, tol);
+    let calls = (counted.function_calls(), counted.gradient_calls());
+    let said = |s: &str| match settled.polish.as_str() {
+        "" => s.to_string(),
+        p => format!("{p}; {s}"),
+    };
+    let (x, e, iterations) = match descent {
+        Ok(d) => d,
+        Err(e) => {
+            return Settled {
+                polish: said(&format!("rescue: error: {e}")),
+                ..settled
+            }
+        }
+    };
+    let max_g = e.max_g();
+    let o = &settled.outcome;
+    let (f_calls, g_calls) = (
+        o.function_calls + counted.function_calls(),
+        o.gradient_calls + counted.gradient_calls(),
+    );
+    if max_g > tol {
+        let note = format!(
+            "rescue: the descent on the violation from the start ended infeasible too \
+             (max g = {max_g:.3e}, {} f + {} g)",
+            calls.0, calls.1
+        );
+        return Settled {
+            polish: said(&note),
+            outcome: LocalOutcome {
+                function_calls: f_calls,
+                gradient_calls: g_calls,
+                ..settled.outcome
+            },
+            ..settled
+        };
+    }
+    let reached = LocalOutcome {
+        x,
+        f: e.f,
+        g: e.g,
+        iterations: o.iterations + iterations,
+        function_calls: f_calls,
+        gradient_calls: g_calls,
+        active_constraints: 0,
+        active_side_constraints: 0,
+        termination: o.termination.clone(),
+    };
+    let again = settle_end(problem, reached, policy, observer);
+    let then = match again.polish.as_str() {
+        "" => String::new(),
+        p => format!("; then {p}"),
+    };
+    Settled {
+        polish: said(&format!(
+            "rescued: the descent on the violation from the start reached the feasible set \
+             ({} f + {} g){then}",
+            calls.0, calls.1
+        )),
+        ..again
+    }
+}
+
+/// [`settle`] without the rescue.
+fn settle_end(
     problem: &dyn Problem,
     outcome: LocalOutcome,
     policy: &EndPolicy,
@@ -179,12 +297,8 @@ pub fn settle(
         gradient_calls: calls.1,
         last: outcome.iterations,
     };
-    let polished = mmfd::minimize(
-        &counted,
-        &outcome.x,
-        &MmfdOptions::polish_for(tol),
-        &mut continued,
-    );
+    let options = MmfdOptions::polish_for(tol);
+    let polished = mmfd::minimize(&counted, &outcome.x, &options, &mut continued);
     let last = continued.last;
     let polished = polished.and_then(|p| {
         let o = LocalOutcome {
@@ -199,7 +313,7 @@ pub fn settle(
         Ok((p.termination, o, c, after))
     });
     let (polish, c) = match polished {
-        Ok((t, o, c, after)) if no_worse(&o, &outcome, tol.feasibility) => {
+        Ok((t, o, c, after)) if no_worse(&o, &outcome, tol.feasibility, options.noise) => {
             return Settled {
                 polish: t.to_string(),
                 outcome: LocalOutcome {
@@ -262,7 +376,7 @@ pub fn strictly_feasible(
         active_side_constraints: 0,
         termination: crate::optimize::Termination::MaxIterations,
     };
-    let s = settle(problem, outcome, policy, &mut NoObserver);
+    let s = settle_end(problem, outcome, policy, &mut NoObserver);
     let end = s.outcome;
     let max_g = end.g.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     if max_g <= 0.0 {
@@ -305,6 +419,7 @@ mod tests {
         EndPolicy {
             tolerances: KktTolerances::default(),
             polish,
+            rescue: false,
         }
     }
 
@@ -313,13 +428,13 @@ mod tests {
         let p = islands();
         assert!((0.5 + X_STAR * X_STAR - 0.25 * X_STAR.powi(4)).abs() < 1e-12);
         // Without the polish: feasible, not stationary.
-        let s = settle(&p, end(&p, 2.5), &policy(false), &mut NoObserver);
+        let s = settle(&p, None, end(&p, 2.5), &policy(false), &mut NoObserver);
         let c = s.certificate.unwrap();
         assert_eq!(c.class, EndClass::Stopped);
         assert_eq!(c.kt_residual, Some(1.0), "all of ∇f is left: {c:?}");
         assert!(s.polish.is_empty());
         // With it: on the constraint, certified, the multiplier 1/|g'(x*)|.
-        let s = settle(&p, end(&p, 2.5), &policy(true), &mut NoObserver);
+        let s = settle(&p, None, end(&p, 2.5), &policy(true), &mut NoObserver);
         let c = s.certificate.as_ref().unwrap();
         assert_eq!(c.class, EndClass::Converged, "{s:?}");
         assert!((s.outcome.x[0] - X_STAR).abs() < 1e-6, "{s:?}");
@@ -342,16 +457,16 @@ mod tests {
     #[test]
     fn an_end_at_a_local_minimum_of_the_violation_is_infeasible_and_stationary() {
         let p = islands();
-        let s = settle(&p, end(&p, 0.0), &policy(true), &mut NoObserver);
+        let s = settle(&p, None, end(&p, 0.0), &policy(true), &mut NoObserver);
         let c = s.certificate.unwrap();
         assert_eq!(c.class, EndClass::Infeasible);
         assert_eq!(c.violation_stationary, Some(true));
         assert!(s.polish.is_empty(), "no polish from a stationary violation");
         // Off the minimum of the violation: not stationary, and the polish
         // (MMFD's feasibility moves) reaches the feasible set.
-        let s = settle(&p, end(&p, 1.9), &policy(false), &mut NoObserver);
+        let s = settle(&p, None, end(&p, 1.9), &policy(false), &mut NoObserver);
         assert_eq!(s.certificate.unwrap().violation_stationary, Some(false));
-        let s = settle(&p, end(&p, 1.9), &policy(true), &mut NoObserver);
+        let s = settle(&p, None, end(&p, 1.9), &policy(true), &mut NoObserver);
         assert_eq!(
             s.certificate.unwrap().class,
             EndClass::Converged,
@@ -359,6 +474,40 @@ mod tests {
             s.polish
         );
         assert!((s.outcome.x[0] - X_STAR).abs() < 1e-6);
+    }
+
+    #[test]
+    fn an_infeasible_end_is_rescued_by_the_descent_from_its_start() {
+        let p = islands();
+        let rescuing = EndPolicy {
+            rescue: true,
+            ..policy(true)
+        };
+        // The solver ended at the violation's local minimum x = 0 (g = 0.5),
+        // but its start 1.9 lies beyond the violation's maximum at √2: the
+        // pure descent from there reaches the feasible island x >= x*, and
+        // the polish from its end the constrained minimum x*.
+        let s = settle(&p, Some(&[1.9]), end(&p, 0.0), &rescuing, &mut NoObserver);
+        let c = s.certificate.as_ref().unwrap();
+        assert_eq!(c.class, EndClass::Converged, "{s:?}");
+        assert!((s.outcome.x[0] - X_STAR).abs() < 1e-6, "{s:?}");
+        assert!(s.polish.starts_with("rescued"), "{}", s.polish);
+        // The descent's and the polish's calls count with the run's 10 + 3.
+        assert!(s.outcome.function_calls > 10 && s.outcome.gradient_calls > 3);
+        // From 0.3 the descent ends at x = 0 too: still infeasible, said so.
+        let s = settle(&p, Some(&[0.3]), end(&p, 0.0), &rescuing, &mut NoObserver);
+        assert_eq!(s.certificate.as_ref().unwrap().class, EndClass::Infeasible);
+        assert_eq!(s.outcome.x, vec![0.0]);
+        assert!(s.polish.contains("ended infeasible too"), "{}", s.polish);
+        // Without the rescue the end stays as the solver left it.
+        let s = settle(
+            &p,
+            Some(&[1.9]),
+            end(&p, 0.0),
+            &policy(true),
+            &mut NoObserver,
+        );
+        assert_eq!(s.certificate.unwrap().class, EndClass::Infeasible);
     }
 
     #[test]

@@ -22,7 +22,7 @@
 
 use super::tables::{num, RunRecord};
 use crate::error::Result;
-use crate::optimize::{Counted, Problem};
+use crate::optimize::{Counted, Evaluation, Problem};
 
 /// Iteration limit of the pure descent on the violation.
 pub const MAX_ITERATIONS: usize = 60;
@@ -55,12 +55,14 @@ fn violation(g: &[f64]) -> f64 {
     0.5 * g.iter().map(|v| v.max(0.0).powi(2)).sum::<f64>()
 }
 
-/// Pure descent on the violation from `x0` (see the module doc).
+/// Pure descent on the violation from `x0` (see the module doc): the end
+/// design, its evaluation (with gradients unless the iteration limit
+/// ended the descent) and the iterations taken.
 pub fn descend(
     problem: &dyn Problem,
     x0: &[f64],
     tolerance: f64,
-) -> Result<(Vec<f64>, f64, usize)> {
+) -> Result<(Vec<f64>, Evaluation, usize)> {
     let vars = problem.variables();
     let r: Vec<f64> = vars
         .iter()
@@ -76,12 +78,11 @@ pub fn descend(
     let mut alpha: f64 = 0.1;
     for it in 0..MAX_ITERATIONS {
         let e = problem.evaluate(&x, true)?;
-        let max_g = e.max_g();
-        if max_g <= tolerance {
-            return Ok((x, max_g, it));
+        if e.max_g() <= tolerance {
+            return Ok((x, e, it));
         }
         let v0 = violation(&e.g);
-        let gg = e.grad_g.unwrap_or_default();
+        let gg = e.grad_g.clone().unwrap_or_default();
         let mut d = vec![0.0; x.len()];
         for (gj, row) in e.g.iter().zip(&gg) {
             for (di, (dg, ri)) in d.iter_mut().zip(row.iter().zip(&r)) {
@@ -91,7 +92,7 @@ pub fn descend(
         let dd: f64 = d.iter().map(|v| v * v).sum();
         let length = dd.sqrt();
         if length == 0.0 {
-            return Ok((x, max_g, it));
+            return Ok((x, e, it));
         }
         alpha = (2.0 * alpha).min(0.2 / length);
         let mut accepted = None;
@@ -112,11 +113,11 @@ pub fn descend(
         }
         match accepted {
             Some(xt) => x = xt,
-            None => return Ok((x, max_g, it)),
+            None => return Ok((x, e, it)),
         }
     }
-    let max_g = problem.evaluate(&x, false)?.max_g();
-    Ok((x, max_g, MAX_ITERATIONS))
+    let e = problem.evaluate(&x, false)?;
+    Ok((x, e, MAX_ITERATIONS))
 }
 
 /// The infeasible runs to check: `count` of them spread evenly by start
@@ -140,7 +141,8 @@ pub fn check(problem: &dyn Problem, runs: &[&RunRecord], tolerance: f64) -> Resu
     runs.iter()
         .map(|r| {
             let counted = Counted::new(problem);
-            let (x, max_g, iterations) = descend(&counted, &r.x0, tolerance)?;
+            let (x, e, iterations) = descend(&counted, &r.x0, tolerance)?;
+            let max_g = e.max_g();
             Ok(Check {
                 start: r.start,
                 run_max_g: r.result.as_ref().map_or(f64::INFINITY, |res| res.max_g()),
@@ -190,13 +192,15 @@ mod tests {
     fn pure_descent_on_the_violation_finds_its_basin() {
         let p = islands();
         // From 0.3 the violation's descent goes to its minimum at 0.
-        let (x, max_g, _) = descend(&p, &[0.3], 1e-6).unwrap();
+        let (x, e, _) = descend(&p, &[0.3], 1e-6).unwrap();
+        let max_g = e.max_g();
         assert!(
             x[0].abs() < 1e-3 && (max_g - 0.5).abs() < 1e-6,
             "{x:?} {max_g}"
         );
         // From 1.5 it climbs out to the feasible set at |x| >= 2.10938.
-        let (x, max_g, _) = descend(&p, &[1.5], 1e-6).unwrap();
+        let (x, e, _) = descend(&p, &[1.5], 1e-6).unwrap();
+        let max_g = e.max_g();
         assert!(max_g <= 1e-6 && x[0] >= 2.1093, "{x:?} {max_g}");
     }
 }

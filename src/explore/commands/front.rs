@@ -312,6 +312,7 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
         end: EndPolicy {
             tolerances,
             polish: true,
+            rescue: true,
         },
         anchor_starts: section.anchor_starts,
         seed: study.meta.seed,

@@ -79,6 +79,15 @@ pub struct MmfdOptions {
     /// Constraint following stops when every binding |g_j| is below this:
     /// 3e-5 (CTMIN/100, so the final f is not biased by a violation).
     pub follow_tolerance: f64,
+    /// When the line search finds no decrease of f, search along `S` by
+    /// the slope `∇fᵀS` of the exact gradients instead (module doc of
+    /// [`super`], step 5b): off in DOT's settings, on in the polish, where
+    /// the decreases left near an optimum fall below the evaluation's noise.
+    pub slope_search: bool,
+    /// The relative noise of f that the slope search tolerates as a rise
+    /// (of `max(|f|, 1)`): 1e-6 in the polish, the relative tolerance at
+    /// which the scenes integrate their motion; 0 in DOT's settings.
+    pub noise: f64,
 }
 
 impl Default for MmfdOptions {
@@ -100,6 +109,8 @@ impl Default for MmfdOptions {
             max_line_evaluations: 6,
             max_corrections: 3,
             follow_tolerance: 3e-5,
+            slope_search: false,
+            noise: 0.0,
         }
     }
 }
@@ -136,7 +147,8 @@ impl MmfdOptions {
     /// that the certificate at the end passes), the change exits at
     /// round-off level (DELOBJ 1e-12 for 3 iterations, no DABOBJ), a first
     /// step that seeks 1 % of |f| and moves each variable at most 5 % of
-    /// its range per trial, and 200 iterations.
+    /// its range per trial, 200 iterations, and the slope search where f's
+    /// decrease is lost in its noise.
     pub fn polish_for(tol: &KktTolerances) -> MmfdOptions {
         MmfdOptions {
             ct: -tol.active.max(1e-12),
@@ -149,6 +161,8 @@ impl MmfdOptions {
             dx2: 0.05,
             kt_tolerance: 0.5 * tol.stationarity,
             kt_scale: KtScale::Gradient,
+            slope_search: true,
+            noise: 1e-6,
             ..MmfdOptions::default()
         }
         .with_feasibility(tol.feasibility)
@@ -187,6 +201,9 @@ impl MmfdOptions {
             if !(v > 0.0 && v.is_finite()) {
                 return bad(k, v, "a finite value > 0");
             }
+        }
+        if !(self.noise >= 0.0 && self.noise.is_finite()) {
+            return bad("noise", self.noise, "a finite relative noise >= 0");
         }
         if let Some(d) = self.dabobj {
             if !(d > 0.0 && d.is_finite()) {

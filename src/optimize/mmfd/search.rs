@@ -1,7 +1,8 @@
 //! Step 5 of the module doc of [`super`]: the line search along
 //! `x(α) = x + c₀ + αS` with constraint following, its first trial, the
 //! Armijo phase and the fitted step (evaluated with gradients for the
-//! next iteration when it ends the search).
+//! next iteration when it ends the search); and step 5b, the slope search
+//! of the polish.
 
 use super::geometry::{dot, first_root, least_norm, norm};
 use super::{evaluate, variables, Ap, Mmfd, Point};
@@ -311,5 +312,70 @@ impl Mmfd {
             }
         }
         Ok(Some((bp, ba, stash)))
+    }
+
+    /// Step 5b of the module doc: the slope search, tried (with
+    /// `slope_search` on) when the line search found no decrease of f.
+    /// Every trial is evaluated with gradients and judged by the slope
+    /// `d(α) = ∇f(x(α))ᵀS` instead of by f: a feasible trial whose slope is
+    /// still negative, or at most half the start's `|d(0)|`, is accepted;
+    /// a steeper positive slope (the 1-D minimum passed) moves the trial to
+    /// the secant root between the last negative slope and it. f may rise
+    /// by at most its noise, `max(|d(0)| α, noise·max(|f|, 1))`: an
+    /// infeasible trial or a larger rise is shortened tenfold. `None` when
+    /// no trial is accepted within twice `max_line_evaluations`.
+    pub(super) fn slope_search(
+        &self,
+        problem: &mut Ap<'_>,
+        sr: &Search<'_>,
+    ) -> Result<Option<Searched>> {
+        let o = &self.options;
+        let d0 = dot(sr.gf, sr.s);
+        let snorm = sr.s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if snorm == 0.0 || d0.is_nan() || d0 >= 0.0 {
+            return Ok(None);
+        }
+        // The line search's pull-back extrapolation is for its own trials.
+        *sr.learned.borrow_mut() = None;
+        let f_ref = sr.base.f.max(sr.base.f + dot(sr.gf, sr.c0));
+        let noise = o.noise * sr.base.f.abs().max(1.0);
+        let model = match sr.curvature {
+            Some(k) => -d0 / (k * dot(sr.s, sr.s)),
+            None => o.dx1 / snorm,
+        };
+        let mut alpha = model.min(o.dx2 / snorm).min(self.alpha_max(problem, sr));
+        let (mut lo, mut d_lo) = (0.0, d0);
+        for _ in 0..2 * o.max_line_evaluations {
+            if !(alpha > lo && alpha.is_finite()) {
+                break;
+            }
+            let (t, ev) = self.trial_with(problem, sr, alpha, true)?;
+            let ev = match ev {
+                Some(ev) => ev,
+                None => evaluate(problem, &t.x, true)?,
+            };
+            let slope = ev.grad_f.as_ref().map(|g| {
+                g.iter()
+                    .zip(&self.range)
+                    .zip(sr.s)
+                    .map(|((g, r), s)| g * r * s)
+                    .sum::<f64>()
+            });
+            let Some(d1) = slope.filter(|d| d.is_finite()) else {
+                break;
+            };
+            if t.max_g() > o.ctmin || t.f > f_ref + noise.max(d0.abs() * alpha) {
+                alpha = lo + 0.1 * (alpha - lo);
+                continue;
+            }
+            if d1 <= 0.5 * d0.abs() {
+                return Ok(Some((t, alpha, Some(ev))));
+            }
+            if d1 < 0.0 {
+                (lo, d_lo) = (alpha, d1);
+            }
+            alpha = lo + (alpha - lo) * d_lo / (d_lo - d1);
+        }
+        Ok(None)
     }
 }
