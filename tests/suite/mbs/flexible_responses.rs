@@ -9,7 +9,7 @@
 //!
 //! Two hinges. With a revolute joint alone, the exact gradients match the
 //! differences to the differences' own truncation error. With the
-//! two-point hinge of `studies/deploy_panel.toml` (a spherical joint at
+//! two-point hinge `studies/deploy_panel.toml` had before (a spherical joint at
 //! the other corner) they match to a floor set by that hinge, not by a
 //! missing term: the bending modes of the free–free basis move the pin
 //! corner in plane only through their small membrane content (about 1e-3

@@ -1,6 +1,7 @@
 //! Tests of `plyscape::mbs` and the scenes built on it: kernel, joints, loads, flexible bodies, sensitivities, the SAR scenes and the shipped studies.
 mod andrews;
 mod convergence;
+mod deploy_hinge;
 mod drives;
 mod energy;
 mod events;
