@@ -70,7 +70,7 @@
 
 use super::scene_bounds::{self, Bound};
 pub use super::scene_vars::VariableSpec;
-use super::scene_vars::{problem_error, Target, Ties};
+use super::scene_vars::{problem_error, Ties};
 use crate::error::{Error, Result};
 use crate::integrate::SensitivityForm;
 use crate::laminate::Laminate;
@@ -323,26 +323,11 @@ impl SceneProblem {
         Ok(simulate(&scene).map_err(at)?.1)
     }
 
-    /// The panels' lay-ups at design `x` \[deg\]: each variable's angle
-    /// (in rad) in every ply of its targets, the other plies as in the
-    /// study.
+    /// The panels' lay-ups at design `x`: ply angles in degrees, ply
+    /// thicknesses in millimetres, the other plies as in the study
+    /// ([`super::scene_vars::Ties::laminates_at`]).
     pub fn laminates_at(&self, x: &[f64]) -> Result<Vec<Laminate>> {
-        let panels = self.plan.panels();
-        let mut angles: Vec<Vec<f64>> = panels.iter().map(|p| p.laminate.angles()).collect();
-        for (xi, targets) in x.iter().zip(&self.ties.targets) {
-            for t in targets {
-                if let Target::Plies { panel, plies } = t {
-                    for &k in plies {
-                        angles[*panel][k] = xi.to_radians();
-                    }
-                }
-            }
-        }
-        panels
-            .iter()
-            .zip(&angles)
-            .map(|(p, a)| p.laminate.with_angles(a))
-            .collect()
+        self.ties.laminates_at(self.plan.panels(), x)
     }
 
     /// The sense of `[[scene.responses]]` entry `name` when it is a peak.
@@ -608,18 +593,11 @@ impl Problem for SceneProblem {
     fn name(&self) -> &str {
         &self.study
     }
-    /// Ply angles in degrees: `theta1_deg` is `θ1 [deg]`; a scene
-    /// parameter is its name in SI units: `damping [SI]`.
+    /// Ply angles in degrees (`theta1_deg` is `θ1 [deg]`), ply
+    /// thicknesses in millimetres, scene parameters in SI units
+    /// ([`super::scene_vars::Ties::variable_label`]).
     fn variable_label(&self, i: usize) -> String {
-        let name = &self.vars[i].name;
-        if self.ties.is_scene(i) {
-            return format!("{name} [SI]");
-        }
-        let name = name.strip_suffix("_deg").unwrap_or(name);
-        match name.strip_prefix("theta") {
-            Some(rest) => format!("θ{rest} [deg]"),
-            None => format!("{name} [deg]"),
-        }
+        self.ties.variable_label(i, &self.vars[i].name)
     }
     fn objective_label(&self) -> String {
         let (response, divisor) = &self.objective;

@@ -13,6 +13,18 @@
 //!   body built from that panel, per radian, so the variable's derivative
 //!   is their sum times `π/180`. With `tied_lanes` the lanes of one
 //!   variable are joined into one (`"B3.design.theta_1_4+B2.design.theta_1_4"`).
+//! - **Ply thicknesses** `"<panel>:thickness_<plies>"`, e.g.
+//!   `"panel3:thickness_1_4"`: the common thickness of those plies (any
+//!   distinct 1-based plies, not only a design group; each ply set by at
+//!   most one variable). The variable is in **millimetres** (its label
+//!   `t_1_4 [mm]`), bounds > 0; the laminate gets metres. Stiffness and
+//!   mass both move: the lanes `<body>.design.thickness_<plies>` (per
+//!   metre) carry the derivatives of the eigenvalues, mode shapes and node
+//!   masses ([`crate::panels::BasisBuilder::set_thickness`]), so the
+//!   variable's derivative is their sum times 1e-3. A thickness ply that
+//!   breaks the stack's mirror symmetry couples membrane and bending
+//!   (B' ≠ 0): exact, but the mode derivatives are then solved on the
+//!   whole pencil instead of the bending block.
 //! - **Scene parameters** `"scene:<parameter>"`, e.g.
 //!   `"scene:forces[0].damping"`, `"scene:forces[0].segments[2].slope"`,
 //!   `"scene:B5.mass"`: any parameter `[scene] sensitivities` accepts
@@ -62,6 +74,14 @@ pub(crate) enum Target {
         /// 0-based plies of its design group.
         plies: Vec<usize>,
     },
+    /// The common thickness (variable in mm) of these 0-based plies of
+    /// `[[panels]]` entry `panel`.
+    Thickness {
+        /// Index of the `[[panels]]` entry.
+        panel: usize,
+        /// 0-based plies.
+        plies: Vec<usize>,
+    },
     /// A scene parameter, by its `[scene] sensitivities` name.
     Scene(String),
 }
@@ -78,8 +98,34 @@ pub(crate) struct Ties {
     /// Per variable: indices into `lanes`.
     pub lanes_of: Vec<Vec<usize>>,
     /// Per variable: its derivative per lane unit (`π/180` for a ply angle
-    /// in degrees against lanes per radian, 1 for a scene parameter).
+    /// in degrees against lanes per radian, 1e-3 for a ply thickness in mm
+    /// against lanes per metre, 1 for a scene parameter).
     pub scale: Vec<f64>,
+}
+
+/// Metres per unit of a ply-thickness variable (mm).
+pub(crate) const THICKNESS_UNIT: f64 = 1e-3;
+
+/// The kind of a `sets` entry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Angle,
+    Thickness,
+    Scene,
+}
+
+/// The kind of a `sets` entry by its spelling.
+fn kind_of(entry: &str) -> Kind {
+    if entry.starts_with(SCENE) {
+        Kind::Scene
+    } else if entry
+        .split_once(':')
+        .is_some_and(|(_, v)| v.starts_with("thickness_"))
+    {
+        Kind::Thickness
+    } else {
+        Kind::Angle
+    }
 }
 
 /// An input error on `scene_problem.<key>`.
@@ -118,6 +164,7 @@ impl Ties {
             scale: Vec::new(),
         };
         let mut used: Vec<(usize, usize)> = Vec::new();
+        let mut used_plies: Vec<(usize, usize)> = Vec::new();
         let mut used_scene: Vec<&str> = Vec::new();
         for (i, v) in variables.iter().enumerate() {
             let key = format!("variables[{i}]");
@@ -129,23 +176,34 @@ impl Ties {
                     "at least one \"<panel>:<design variable>\" or \"scene:<parameter>\"".into(),
                 ));
             }
-            let scene = v.sets[0].starts_with(SCENE);
-            if let Some(k) = v.sets.iter().position(|e| e.starts_with(SCENE) != scene) {
+            let kind = kind_of(&v.sets[0]);
+            let scene = kind == Kind::Scene;
+            if let Some(k) = v.sets.iter().position(|e| kind_of(e) != kind) {
                 return Err(problem_error(
                     study,
                     format!("{key}.sets[{k}]"),
                     format!("\"{}\"", v.sets[k]),
-                    "entries of one kind per variable: ply angles \"<panel>:<design variable>\" \
-                     or scene parameters \"scene:<parameter>\""
+                    "entries of one kind per variable: ply angles \"<panel>:<design variable>\", \
+                     ply thicknesses \"<panel>:thickness_<plies>\" or scene parameters \
+                     \"scene:<parameter>\""
                         .into(),
                 ));
             }
-            if scene && v.periodic {
+            if kind != Kind::Angle && v.periodic {
                 return Err(problem_error(
                     study,
                     format!("{key}.periodic"),
                     true,
-                    "false for a scene parameter (only ply angles repeat)".into(),
+                    "false for a scene parameter or a ply thickness (only ply angles repeat)"
+                        .into(),
+                ));
+            }
+            if kind == Kind::Thickness && !(v.bounds[0] > 0.0 && v.bounds[0].is_finite()) {
+                return Err(problem_error(
+                    study,
+                    format!("{key}.bounds"),
+                    format!("{:?}", v.bounds),
+                    "a finite lower bound > 0 mm for a ply thickness".into(),
                 ));
             }
             ties.vars.push(variable(study, &key, v)?);
@@ -156,6 +214,10 @@ impl Ties {
                     let name = scene_entry(study, plan, &key, entry, &mut used_scene)?;
                     names.push(name.to_string());
                     t.push(Target::Scene(name.to_string()));
+                } else if kind == Kind::Thickness {
+                    let (target, lanes) = thickness(study, plan, &key, entry, &mut used_plies)?;
+                    t.push(target);
+                    names.extend(lanes);
                 } else {
                     let (target, lanes) = tie(study, plan, &key, entry, &mut used)?;
                     t.push(target);
@@ -169,10 +231,10 @@ impl Ties {
             ties.lanes.extend(names);
             ties.targets.push(t);
             ties.lanes_of.push(l);
-            ties.scale.push(if scene {
-                1.0
-            } else {
-                std::f64::consts::PI / 180.0
+            ties.scale.push(match kind {
+                Kind::Scene => 1.0,
+                Kind::Thickness => THICKNESS_UNIT,
+                Kind::Angle => std::f64::consts::PI / 180.0,
             });
         }
         Ok(ties)
@@ -181,6 +243,69 @@ impl Ties {
     /// Is variable `i` a scene parameter (not a ply angle in degrees)?
     pub fn is_scene(&self, i: usize) -> bool {
         matches!(self.targets[i].first(), Some(Target::Scene(_)))
+    }
+
+    /// Is variable `i` a ply thickness (in mm)?
+    pub fn is_thickness(&self, i: usize) -> bool {
+        matches!(self.targets[i].first(), Some(Target::Thickness { .. }))
+    }
+
+    /// The label of variable `i` named `name` in tables and plots: ply
+    /// angles in degrees (`theta1_deg` → `θ1 [deg]`), ply thicknesses in
+    /// millimetres (`t_1_4 [mm]`), scene parameters in SI units
+    /// (`damping [SI]`).
+    pub fn variable_label(&self, i: usize, name: &str) -> String {
+        if self.is_scene(i) {
+            return format!("{name} [SI]");
+        }
+        if self.is_thickness(i) {
+            let name = name.strip_suffix("_mm").unwrap_or(name);
+            return format!("{name} [mm]");
+        }
+        let name = name.strip_suffix("_deg").unwrap_or(name);
+        match name.strip_prefix("theta") {
+            Some(rest) => format!("θ{rest} [deg]"),
+            None => format!("{name} [deg]"),
+        }
+    }
+
+    /// The panels' lay-ups at design `x`: each angle variable (degrees)
+    /// in every ply of its targets (radians), each thickness variable (mm)
+    /// in every ply of its targets (metres), the other plies as in the
+    /// study (`panels`, the plan's). Errors: a thickness ≤ 0 or not
+    /// finite (input error naming the ply).
+    pub fn laminates_at(
+        &self,
+        panels: &[crate::fe::Panel],
+        x: &[f64],
+    ) -> Result<Vec<crate::laminate::Laminate>> {
+        let mut angles: Vec<Vec<f64>> = panels.iter().map(|p| p.laminate.angles()).collect();
+        let mut thick: Vec<Vec<f64>> = panels
+            .iter()
+            .map(|p| p.laminate.plies().iter().map(|q| q.thickness).collect())
+            .collect();
+        for (xi, targets) in x.iter().zip(&self.targets) {
+            for t in targets {
+                match t {
+                    Target::Plies { panel, plies } => {
+                        for &k in plies {
+                            angles[*panel][k] = xi.to_radians();
+                        }
+                    }
+                    Target::Thickness { panel, plies } => {
+                        for &k in plies {
+                            thick[*panel][k] = xi * THICKNESS_UNIT;
+                        }
+                    }
+                    Target::Scene(_) => {}
+                }
+            }
+        }
+        panels
+            .iter()
+            .zip(angles.iter().zip(&thick))
+            .map(|(p, (a, t))| p.laminate.with_angles(a)?.with_thicknesses(t))
+            .collect()
     }
 
     /// Write the scene parameters of design `x` into `scene` (built from
@@ -326,6 +451,67 @@ fn tie(
         plies: panels[p].design.groups()[d].clone(),
     };
     Ok((target, lanes))
+}
+
+/// One `"<panel>:thickness_<plies>"` entry: the plies whose common
+/// thickness it sets and the scene's sensitivity lanes
+/// `<body>.design.thickness_<plies>` of the bodies built from that panel
+/// (each listed in `[scene] sensitivities`). `used`: (panel, ply) pairs
+/// already set by a thickness variable.
+fn thickness(
+    study: &Study,
+    plan: &ScenePlan,
+    key: &str,
+    entry: &str,
+    used: &mut Vec<(usize, usize)>,
+) -> Result<(Target, Vec<String>)> {
+    let bad =
+        |expected: String| problem_error(study, key.to_string(), format!("\"{entry}\""), expected);
+    let panels = plan.panels();
+    let (pname, dname) = entry
+        .split_once(':')
+        .ok_or_else(|| bad("\"<panel>:thickness_<plies>\"".into()))?;
+    let Some(p) = panels.iter().position(|p| p.name == pname) else {
+        let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
+        return Err(bad(format!(
+            "a [[panels]] name before ':' ({})",
+            names.join(", ")
+        )));
+    };
+    let n = panels[p].laminate.plies().len();
+    let plies = crate::panels::thickness_group(dname, n).map_err(|_| {
+        bad(format!(
+            "thickness_<ply>[_<ply>...] after ':' with distinct ply numbers in 1..={n}"
+        ))
+    })?;
+    if let Some(&k) = plies.iter().find(|&&k| used.contains(&(p, k))) {
+        return Err(bad(format!(
+            "each ply's thickness set by one problem variable (ply {} of panel {pname} is \
+             set twice)",
+            k + 1
+        )));
+    }
+    used.extend(plies.iter().map(|&k| (p, k)));
+    let bodies = plan.bodies_of_panel(pname);
+    if bodies.is_empty() {
+        return Err(bad(format!(
+            "a panel of a flexible scene body (no [[scene.bodies]] uses panel {pname})"
+        )));
+    }
+    let listed = &plan.spec().sensitivities;
+    let mut lanes = Vec::new();
+    for b in bodies {
+        let lane = format!("{b}.design.{dname}");
+        if !listed.contains(&lane) {
+            return Err(study.error(
+                "scene.sensitivities",
+                format!("{listed:?}"),
+                format!("a list containing \"{lane}\" (the gradient of scene_problem.{key})"),
+            ));
+        }
+        lanes.push(lane);
+    }
+    Ok((Target::Thickness { panel: p, plies }, lanes))
 }
 
 /// Names of a panel's design variables (`theta_1_4` for plies 1 and 4),

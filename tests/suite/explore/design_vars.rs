@@ -93,6 +93,37 @@ fn ply_angles_with_scene_parameters_have_exact_gradients() {
 }
 
 #[test]
+fn ply_thickness_variables_have_exact_gradients() {
+    // sar_codesign with the actuator's damping replaced by the common
+    // thickness of the outer plies 1 and 4 of both panels, in mm (the
+    // study's plies are 0.5 mm, so the start 0.5 is the study's design):
+    // stiffness and mass both move, through the lanes
+    // `<body>.design.thickness_1_4` (per metre) of both panel bodies.
+    let text = replace(
+        &coarse_sar(CODESIGN, 8, 4),
+        "name = \"damping\"\nbounds = [0.1, 2.0]\nsets = [\"scene:forces[0].damping\"]",
+        "name = \"t_1_4_mm\"\nbounds = [0.1, 2.0]\nsets = [\"panel2:thickness_1_4\", \"panel3:thickness_1_4\"]",
+        1,
+    );
+    let text = replace(
+        &text,
+        "\"forces[0].damping\"",
+        "\"B2.design.thickness_1_4\", \"B3.design.thickness_1_4\"",
+        1,
+    );
+    let p = build(&text).unwrap();
+    assert_eq!(p.variable_label(2), "t_1_4 [mm]");
+    // At the start the lay-up is the study's: normalized values 1 and 0.
+    let e0 = p.evaluate(&[55.0, -55.0, 0.5, 9.0], false).unwrap();
+    assert!((e0.f - 1.0).abs() < 1e-12 && e0.g[0].abs() < 1e-12);
+    let x = [40.0, -25.0, 0.6, 12.0];
+    check_gradients(p.as_ref(), &x, &[0.01, 0.01, 1e-4, 1e-3], 1e-5);
+    // Thicker outer plies change Ψ₀ (the variable reaches the laminate).
+    let e = p.evaluate(&x, true).unwrap();
+    assert!(e.grad_f.unwrap()[2].abs() > 1e-3, "df/dt");
+}
+
+#[test]
 fn bad_scene_entries_name_the_key() {
     let base = coarse_sar(CODESIGN, 8, 4);
     let err = |from: &str, to: &str| -> String {
