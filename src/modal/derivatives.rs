@@ -181,6 +181,16 @@ impl VariableDerivatives {
     }
 }
 
+/// Whether the modes hold a cluster of repeated or nearly repeated
+/// eigenvalues (relative gap below `cluster_tol`, module doc): only then
+/// do the updated-mode derivatives read the second derivatives `K''`
+/// (and `M''`), so a caller may assemble them on demand.
+pub fn has_repeated(modes: &Modes, cluster_tol: f64) -> bool {
+    find_clusters(&modes.lambda, modes.shift, cluster_tol)
+        .iter()
+        .any(|&(_, r)| r > 1)
+}
+
 /// Group consecutive eigenvalues into clusters: `(first, len)`.
 fn find_clusters(lambda: &[f64], shift: f64, tol: f64) -> Vec<(usize, usize)> {
     let mut out = Vec::new();

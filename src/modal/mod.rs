@@ -95,7 +95,8 @@ mod sparse;
 mod tests;
 
 pub use derivatives::{
-    Cluster, DerivativeOptions, DesignDerivative, MassDerivative, ModeUpdate, VariableDerivatives,
+    has_repeated, Cluster, DerivativeOptions, DesignDerivative, MassDerivative, ModeUpdate,
+    VariableDerivatives,
 };
 pub use export::{mode_shape_rows, DofLabel, ModeShapeRow};
 pub use modes::{sign_normalize, ModalOptions, ModalStats, Modes};

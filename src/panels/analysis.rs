@@ -10,8 +10,8 @@ use super::rigid::RigidFrame;
 use crate::error::{Error, Result};
 use crate::fe::{Derivatives, Panel, PanelSystem};
 use crate::modal::{
-    DerivativeOptions, DesignDerivative, MassDerivative, ModalOptions, ModalSolver, ModeUpdate,
-    Modes, VariableDerivatives,
+    has_repeated, DerivativeOptions, DesignDerivative, MassDerivative, ModalOptions, ModalSolver,
+    ModeUpdate, Modes, VariableDerivatives,
 };
 use std::collections::HashMap;
 use std::time::Instant;
@@ -84,6 +84,11 @@ pub struct PanelAnalysis {
     /// derivatives (buffers reused across runs).
     thickness: Vec<Vec<usize>>,
     tsys: Option<crate::fe::ThicknessSystem>,
+    /// The system with the second derivatives `K''` of the ply angles,
+    /// assembled only for a run whose modes hold a cluster of repeated
+    /// eigenvalues (the only case in which the updated-mode derivatives
+    /// read them); buffers reused across such runs.
+    second: Option<PanelSystem>,
 }
 
 impl PanelAnalysis {
@@ -106,7 +111,8 @@ impl PanelAnalysis {
         let level = match want {
             None => Derivatives::None,
             Some(ModeUpdate::Fixed) => Derivatives::First,
-            Some(ModeUpdate::Updated) => Derivatives::Second,
+            // K'' only on demand (`run`: clusters of repeated eigenvalues).
+            Some(ModeUpdate::Updated) => Derivatives::First,
         };
         let model = panel.model()?;
         let sys = model.assemble(&panel.laminate, &panel.design, level)?;
@@ -126,6 +132,7 @@ impl PanelAnalysis {
             setup_seconds: t0.elapsed().as_secs_f64(),
             thickness: Vec::new(),
             tsys: None,
+            second: None,
         })
     }
 
@@ -217,10 +224,30 @@ impl PanelAnalysis {
         let derivatives = match self.want {
             None => Vec::new(),
             Some(update) => {
+                let repeated = update == ModeUpdate::Updated
+                    && has_repeated(&modes, DerivativeOptions::default().cluster_tol);
+                if repeated {
+                    match &mut self.second {
+                        Some(s) => self.model.assemble_into(laminate, &self.panel.design, s)?,
+                        None => {
+                            self.second = Some(self.model.assemble(
+                                laminate,
+                                &self.panel.design,
+                                Derivatives::Second,
+                            )?)
+                        }
+                    }
+                }
+                let d2k = |v: usize| {
+                    self.second
+                        .as_ref()
+                        .filter(|_| repeated)
+                        .and_then(|s| s.d2k.get(v))
+                };
                 let mut vars: Vec<DesignDerivative<'_>> = (0..sys.dk.len())
                     .map(|v| DesignDerivative {
                         dk: &sys.dk[v],
-                        d2k: sys.d2k.get(v),
+                        d2k: d2k(v),
                         mass: None,
                     })
                     .collect();

@@ -25,7 +25,8 @@
 use super::prestress::{PRESTRESS_ITERATIONS, PRESTRESS_STALL, PRESTRESS_TOL};
 use crate::mbs::math::Factored;
 use crate::mbs::math::{
-    fdot, gram, min_degree_order, spd_factor, spd_solve, sym_times, CholPattern, Scalar, MAX_LANES,
+    fdot, gram, min_degree_order, spd_factor, spd_solve, spd_solve_many, sym_times, CholPattern,
+    Scalar, MAX_LANES,
 };
 use crate::mbs::model::Param;
 use crate::mbs::system::{
@@ -341,99 +342,151 @@ impl System {
     /// `sol.dacc`, from the real solution in `sol` and the lanes of the
     /// rows, forces and masses in `ws`, with the real constraint-space
     /// factor `f`.
+    ///
+    /// All lanes in one pass: each flexible body's dual mass matrix is
+    /// read once for every lane's `M'v̇` and `w_iᵀM'w_i`
+    /// ([`mass_lane_terms`]), and the lanes' right-hand sides for λ' are
+    /// the columns of one multi-column solve with the shared factor
+    /// ([`spd_solve_many`]). Each lane gets the operations, in the order,
+    /// of a lane-by-lane tangent, so the results do not depend on how many
+    /// lanes ride together. Lane-interleaved buffers (`x[i * nl + l]`):
+    /// the right-hand sides, `D'` and λ'; lane-major (`x[l * d + i]`): a
+    /// body's `r₁` and `u`, and `sol.dlam`, `sol.dacc`.
     fn tangent<T: Scalar>(&self, ws: &mut Workspace<T>, sol: &mut SolveScratch, f: Factored) {
         let (m, nv, nl) = (ws.rows.len(), self.nvel(), T::NL);
-        sol.dlam.clear();
-        sol.dlam.resize(nl * m, 0.0);
         sol.dacc.clear();
         sol.dacc.resize(nl * nv, 0.0);
         let take = std::mem::take::<Vec<f64>>;
         let (mut rhs, mut dd) = (take(&mut sol.lane_rhs), take(&mut sol.dd));
         let (mut dlam, mut mp) = (take(&mut sol.lane_lam), take(&mut sol.mp));
-        rhs.resize(m, 0.0);
-        dd.resize(m, 0.0);
+        rhs.clear();
+        dd.clear();
+        dd.resize(m * nl, 0.0);
+        // r₂ = γ' − G'v̇ starts as γ'.
+        for row in &ws.rows {
+            rhs.extend((0..nl).map(|l| row.gamma.lane_part(l)));
+        }
+        // B'λ of the joint-load prestress, lane-major (`nl × nvel`).
         let prestress = !ws.pcols.is_empty();
         let mut bl = take(&mut sol.bz);
-        for l in 0..nl {
-            // B'λ of the joint-load prestress (lane l of the columns).
-            if prestress {
-                self.prestress_force(ws, &sol.lam, Some(l), &mut bl);
+        bl.clear();
+        if prestress {
+            let mut one = Vec::new();
+            for l in 0..nl {
+                self.prestress_force(ws, &sol.lam, Some(l), &mut one);
+                bl.extend_from_slice(&one);
             }
-            // r₂ = γ' − G'v̇ and, per body, r₁ = Q' − M'v̇ + G'ᵀλ, u = M⁻¹r₁;
-            // the right-hand side r₂ − G u − εD'λ.
-            for (r, row) in ws.rows.iter().enumerate() {
-                rhs[r] = row.gamma.lane_part(l);
+        }
+        let mut dm = [0.0; MAX_LANES];
+        for (s, bb) in ws.blocks.iter().enumerate() {
+            let (o, d) = (self.vel_local(s), self.dof(s));
+            let k = bb.rows.len();
+            let a = &sol.acc[o..o + d];
+            let stride = (k + 1) * d;
+            // r₁ starts as Q' − M'v̇ (a rigid body's M' is diag(m'I, 0)).
+            sol.r1.clear();
+            for l in 0..nl {
+                let q = &bb.lanes[l * stride + k * d..(l + 1) * stride];
+                sol.r1.extend_from_slice(q);
             }
-            dd.fill(0.0);
-            for (s, bb) in ws.blocks.iter().enumerate() {
-                let (o, d) = (self.vel_local(s), self.dof(s));
-                let k = bb.rows.len();
-                let a = &sol.acc[o..o + d];
-                let lane = &bb.lanes[l * (k + 1) * d..(l + 1) * (k + 1) * d];
-                let dm = self.mass_lane(ws, s, l, &mut mp);
-                // r₁ starts as Q' − M'v̇ (a rigid body's M' is diag(m'I, 0)).
-                sol.r1.clear();
-                sol.r1.extend_from_slice(&lane[k * d..(k + 1) * d]);
-                if d > 6 {
-                    sol.tmp.resize(d, 0.0);
-                    sym_times(&mp, d, a, &mut sol.tmp);
-                    for (x, y) in sol.r1.iter_mut().zip(&sol.tmp) {
-                        *x -= y;
+            if d > 6 {
+                mass_lane_terms(&ws.mfac[s], a, &bb.w[..k * d], d, (&mut mp, &mut sol.quad));
+                for l in 0..nl {
+                    let r1 = &mut sol.r1[l * d..(l + 1) * d];
+                    for (i, x) in r1.iter_mut().enumerate() {
+                        *x -= mp[i * nl + l];
                     }
-                    quad_forms(&mp, &bb.w[..k * d], d, &mut sol.quad);
-                } else {
-                    for (x, v) in sol.r1.iter_mut().zip(&a[..3]) {
+                    if prestress {
+                        let b = &bl[l * nv + o + 6..l * nv + o + d];
+                        for (x, b) in r1[6..].iter_mut().zip(b) {
+                            *x -= b;
+                        }
+                    }
+                }
+            } else {
+                let b = self.moving[s];
+                let mass = pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass);
+                for (l, v) in dm[..nl].iter_mut().enumerate() {
+                    *v = mass.lane_part(l);
+                }
+                for (r1, dm) in sol.r1.chunks_exact_mut(d).zip(&dm[..nl]) {
+                    for (x, v) in r1[..3].iter_mut().zip(&a[..3]) {
                         *x -= dm * v;
                     }
                 }
-                if prestress && d > 6 {
-                    for (x, b) in sol.r1[6..].iter_mut().zip(&bl[o + 6..o + d]) {
-                        *x -= b;
-                    }
-                }
-                for (i, &r) in bb.rows.iter().enumerate() {
-                    let di = &lane[i * d..(i + 1) * d];
-                    let wi = &bb.w[i * d..(i + 1) * d];
-                    rhs[r] -= fdot(di, a);
-                    for (x, y) in sol.r1.iter_mut().zip(di) {
-                        *x += y * sol.lam[r];
+            }
+            for (i, &r) in bb.rows.iter().enumerate() {
+                let wi = &bb.w[i * d..(i + 1) * d];
+                for l in 0..nl {
+                    let di = &bb.lanes[l * stride + i * d..l * stride + (i + 1) * d];
+                    rhs[r * nl + l] -= fdot(di, a);
+                    let lam = sol.lam[r];
+                    for (x, y) in sol.r1[l * d..(l + 1) * d].iter_mut().zip(di) {
+                        *x += y * lam;
                     }
                     // D'_rr: 2 d'·w − wᵀM'w of this side.
                     let quad = if d > 6 {
-                        sol.quad[i]
+                        sol.quad[i * nl + l]
                     } else {
-                        dm * (wi[0] * wi[0] + wi[1] * wi[1] + wi[2] * wi[2])
+                        dm[l] * (wi[0] * wi[0] + wi[1] * wi[1] + wi[2] * wi[2])
                     };
-                    dd[r] += 2.0 * fdot(di, wi) - quad;
+                    dd[r * nl + l] += 2.0 * fdot(di, wi) - quad;
                 }
-                sol.u.resize(d, 0.0);
-                self.minv_times(bb, s, &sol.r1, &mut sol.u);
+            }
+            // u = M⁻¹r₁ (straight into v̇'), and the right-hand side − G u.
+            for l in 0..nl {
+                let r1 = &sol.r1[l * d..(l + 1) * d];
+                let u = &mut sol.dacc[l * nv + o..l * nv + o + d];
+                self.minv_times(bb, s, r1, u);
                 for (i, &r) in bb.rows.iter().enumerate() {
-                    rhs[r] -= fdot(&bb.w[i * d..(i + 1) * d], &sol.r1);
+                    rhs[r * nl + l] -= fdot(&bb.w[i * d..(i + 1) * d], r1);
                 }
-                sol.dacc[l * nv + o..l * nv + o + d].copy_from_slice(&sol.u);
             }
-            for r in 0..m {
+        }
+        for r in 0..m {
+            for l in 0..nl {
+                let x = r * nl + l;
                 if sol.dropped[r] {
-                    rhs[r] = 0.0;
+                    rhs[x] = 0.0;
                 } else {
-                    rhs[r] -= RANK_REG * dd[r] * sol.lam[r];
+                    rhs[x] -= RANK_REG * dd[x] * sol.lam[r];
                 }
             }
-            Self::solve_factored(ws, f, &rhs, &mut dlam);
-            if prestress {
-                // λ' by the same iteration; then v̇' −= M⁻¹ B λ'.
-                let (mut z, mut r) = (take(&mut sol.prhs), take(&mut sol.plam));
-                let mut next = take(&mut sol.tmp);
+        }
+        // λ' of every lane from one multi-column solve (the fill-reducing
+        // permutation applied and undone, as in solve_factored).
+        dlam.clear();
+        dlam.resize(m * nl, 0.0);
+        for (r, &p) in ws.inv_order.iter().enumerate() {
+            dlam[p * nl..(p + 1) * nl].copy_from_slice(&rhs[r * nl..(r + 1) * nl]);
+        }
+        spd_solve_many(&ws.a, m, &ws.scale, f, nl, &mut dlam, &mut ws.spd);
+        sol.dlam.clear();
+        sol.dlam.resize(nl * m, 0.0);
+        for (r, &p) in ws.inv_order.iter().enumerate() {
+            for l in 0..nl {
+                sol.dlam[l * m + r] = dlam[p * nl + l];
+            }
+        }
+        if prestress {
+            // λ' by the same iteration, lane by lane; then v̇' −= M⁻¹ B λ'.
+            let (mut z, mut r) = (take(&mut sol.prhs), take(&mut sol.plam));
+            let mut next = take(&mut sol.tmp);
+            let (mut lane_rhs, mut lane_lam) = (Vec::with_capacity(m), Vec::with_capacity(m));
+            for l in 0..nl {
+                lane_rhs.clear();
+                lane_rhs.extend((0..m).map(|x| rhs[x * nl + l]));
+                lane_lam.clear();
+                lane_lam.extend_from_slice(&sol.dlam[l * m..(l + 1) * m]);
                 let ok = self.prestress_iterate(
                     ws,
                     f,
-                    (&rhs, &sol.dropped),
-                    &mut dlam,
+                    (&lane_rhs, &sol.dropped),
+                    &mut lane_lam,
                     (&mut z, &mut r, &mut next),
                 );
                 if !ok {
-                    dlam.fill(f64::NAN);
+                    lane_lam.fill(f64::NAN);
                 }
                 for (s, bb) in ws.blocks.iter().enumerate() {
                     let (o, d) = (self.vel_local(s), self.dof(s));
@@ -445,42 +498,98 @@ impl System {
                         }
                     }
                 }
-                (sol.prhs, sol.plam, sol.tmp) = (z, r, next);
+                sol.dlam[l * m..(l + 1) * m].copy_from_slice(&lane_lam);
             }
-            // v̇' = u + Σ_rows w λ'.
+            (sol.prhs, sol.plam, sol.tmp) = (z, r, next);
+        }
+        // v̇' = u + Σ_rows w λ'.
+        for l in 0..nl {
+            let lam = &sol.dlam[l * m..(l + 1) * m];
             for (s, bb) in ws.blocks.iter().enumerate() {
                 let (o, d) = (self.vel_local(s), self.dof(s));
                 let out = &mut sol.dacc[l * nv + o..l * nv + o + d];
                 for (i, r) in bb.rows.iter().enumerate() {
+                    let lr = lam[*r];
                     for (x, w) in out.iter_mut().zip(&bb.w[i * d..(i + 1) * d]) {
-                        *x += w * dlam[*r];
+                        *x += w * lr;
                     }
                 }
             }
-            sol.dlam[l * m..(l + 1) * m].copy_from_slice(&dlam);
         }
         (sol.lane_rhs, sol.dd, sol.lane_lam, sol.mp) = (rhs, dd, dlam, mp);
         sol.bz = bl;
     }
+}
 
-    /// Lane `l` of slot `s`'s mass matrix: a flexible body's `M'_l` into
-    /// `mp` (row-major, from the lanes kept by [`Scalar::dense_factor`]);
-    /// a rigid body's is `diag(m' I, 0)`, and `m'` (the lane of its mass
-    /// parameter) is returned.
-    fn mass_lane<T: Scalar>(
-        &self,
-        ws: &Workspace<T>,
-        s: usize,
-        l: usize,
-        mp: &mut Vec<f64>,
-    ) -> f64 {
-        if self.modes[s] > 0 {
-            mp.clear();
-            mp.extend(ws.mfac[s].iter().map(|v| v.lane_part(l)));
-            return 0.0;
+/// Every lane's `M'_l v` and `w_iᵀ M'_l w_i` from one pass over a
+/// flexible body's dual mass matrix `s` (row-major `d × d`, symmetric;
+/// the lanes of each entry are `M'`, [`Scalar::dense_factor`]) for the
+/// `k` rows `w_i` of `w` (row-major `k × d`). Outputs lane-interleaved:
+/// `mv[i * nl + l]`, `q[i * nl + l]`.
+///
+/// The operations per lane are those of [`sym_times`] (`M'v`, zero
+/// entries of `v` skipped) and of [`quad_forms`] (`Y = M' Wᵀ` by fused
+/// multiply-adds in the order of the inner index, then one [`fdot`] per
+/// row), so every lane's numbers are those of the lane-by-lane products.
+fn mass_lane_terms<T: Scalar>(
+    s: &[T],
+    v: &[f64],
+    w: &[f64],
+    d: usize,
+    (mv, q): (&mut Vec<f64>, &mut Vec<f64>),
+) {
+    let nl = T::NL;
+    let k = w.len() / d;
+    mv.clear();
+    mv.resize(d * nl, 0.0);
+    for (j, &vj) in v.iter().enumerate() {
+        if vj != 0.0 {
+            for (i, e) in s[j * d..(j + 1) * d].iter().enumerate() {
+                for (l, o) in mv[i * nl..(i + 1) * nl].iter_mut().enumerate() {
+                    *o += vj * e.lane_part(l);
+                }
+            }
         }
-        let b = self.moving[s];
-        pval(&ws.params, Param::Mass(b), self.model.bodies[b].mass).lane_part(l)
+    }
+    q.clear();
+    q.resize(k * nl, 0.0);
+    if k == 1 {
+        // One row: faer's product takes its matrix-vector path, whose sums
+        // are ordered otherwise; take that path lane by lane.
+        let (mut mp, mut one) = (Vec::with_capacity(d * d), Vec::new());
+        for (l, ql) in q.iter_mut().enumerate() {
+            mp.clear();
+            mp.extend(s.iter().map(|e| e.lane_part(l)));
+            quad_forms(&mp, w, d, &mut one);
+            *ql = one[0];
+        }
+        return;
+    }
+    // Y, lane-major: column c of lane l at y[(l * k + c) * d..].
+    let mut y = vec![0.0; nl * k * d];
+    let mut acc = [0.0; MAX_LANES];
+    for x in 0..d {
+        let row = &s[x * d..(x + 1) * d];
+        for c in 0..k {
+            let acc = &mut acc[..nl];
+            acc.fill(0.0);
+            for (e, &wj) in row.iter().zip(&w[c * d..(c + 1) * d]) {
+                for (l, a) in acc.iter_mut().enumerate() {
+                    *a = e.lane_part(l).mul_add(wj, *a);
+                }
+            }
+            for (l, a) in acc.iter().enumerate() {
+                y[(l * k + c) * d + x] = *a;
+            }
+        }
+    }
+    for c in 0..k {
+        for l in 0..nl {
+            q[c * nl + l] = fdot(
+                &y[(l * k + c) * d..(l * k + c + 1) * d],
+                &w[c * d..(c + 1) * d],
+            );
+        }
     }
 }
 
@@ -514,6 +623,54 @@ fn quad_forms(s: &[f64], w: &[f64], d: usize, q: &mut Vec<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mbs::math::DualN;
+
+    #[test]
+    fn all_lane_mass_terms_are_the_lane_by_lane_products_to_the_bit() {
+        // A symmetric dual matrix whose 8 lanes are 8 symmetric matrices
+        // M'_l, a vector v with zero entries and k rows w_i: the one-pass
+        // kernel must give, per lane, the numbers of sym_times (M'_l v)
+        // and quad_forms (w_iᵀ M'_l w_i), which the lane-by-lane tangent
+        // used. Sizes of the SAR panels (6 + 14) and others.
+        let f = |k: usize| ((k as f64 * 0.618_033_988_7 + 0.1).fract() - 0.5) * 7.0;
+        let mut bad = Vec::new();
+        for (d, k) in [6, 8, 9, 12, 16, 20, 26, 34]
+            .into_iter()
+            .flat_map(|d| (1..=24).map(move |k| (d, k)))
+        {
+            let mut s = vec![DualN::<8>::cst(0.0); d * d];
+            for i in 0..d {
+                for j in 0..=i {
+                    let lanes = std::array::from_fn(|l| f(1000 * (l + 1) + i * d + j));
+                    let e = DualN::<8>::new(f(i * d + j), lanes);
+                    s[i * d + j] = e;
+                    s[j * d + i] = e;
+                }
+            }
+            let v: Vec<f64> = (0..d)
+                .map(|j| if j % 5 == 3 { 0.0 } else { f(50_000 + j) })
+                .collect();
+            let w: Vec<f64> = (0..k * d).map(|x| f(70_000 + x)).collect();
+            let (mut mv, mut q) = (Vec::new(), Vec::new());
+            mass_lane_terms(&s, &v, &w, d, (&mut mv, &mut q));
+            for l in 0..8 {
+                let mp: Vec<f64> = s.iter().map(|e| e.eps[l]).collect();
+                let mut want = vec![0.0; d];
+                sym_times(&mp, d, &v, &mut want);
+                let mut wq = Vec::new();
+                quad_forms(&mp, &w, d, &mut wq);
+                let same_mv = (0..d).all(|i| mv[i * 8 + l].to_bits() == want[i].to_bits());
+                let same_q = (0..k).all(|i| q[i * 8 + l].to_bits() == wq[i].to_bits());
+                if !(same_mv && same_q) {
+                    bad.push((d, k, l, same_mv, same_q));
+                }
+            }
+        }
+        assert!(
+            bad.is_empty(),
+            "(d, k, lane, M'v equal, quad equal): {bad:?}"
+        );
+    }
 
     #[test]
     fn quadratic_forms_of_rows_match_the_definition() {

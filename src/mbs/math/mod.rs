@@ -24,6 +24,6 @@ pub use rotation::{
 };
 pub use scalar::{cst, Scalar, MAX_LANES};
 pub use sparse::{
-    cholesky_solve, min_degree_order, ordered_cholesky, spd_factor, spd_solve, CholPattern,
-    Factored, SpdScratch,
+    cholesky_solve, min_degree_order, ordered_cholesky, spd_factor, spd_solve, spd_solve_many,
+    CholPattern, Factored, SpdScratch,
 };

@@ -177,13 +177,13 @@ pub struct SolveScratch {
     /// Per lane: λ' (`lanes × m`) and v̇' (`lanes × nvel`).
     pub(crate) dlam: Vec<f64>,
     pub(crate) dacc: Vec<f64>,
-    /// One body's `r₁` and `M⁻¹r₁`.
+    /// One body's `r₁` of every lane (lane-major, `lanes × dof`).
     pub(crate) r1: Vec<f64>,
-    pub(crate) u: Vec<f64>,
-    /// One body's `w_iᵀ M' w_i` per row.
+    /// One body's `w_iᵀ M' w_i` per row and lane (lane-interleaved).
     pub(crate) quad: Vec<f64>,
-    /// One lane's right-hand side for λ', `D'` diagonal and λ' (`m`
-    /// each), and a flexible body's `M'` (`dof²`).
+    /// Every lane's right-hand side for λ', `D'` diagonal and λ'
+    /// (lane-interleaved, `m × lanes` each), and a flexible body's `M'v̇`
+    /// (`dof × lanes`).
     pub(crate) lane_rhs: Vec<f64>,
     pub(crate) dd: Vec<f64>,
     pub(crate) lane_lam: Vec<f64>,
