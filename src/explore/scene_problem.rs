@@ -325,7 +325,7 @@ impl SceneProblem {
 
     /// The panels' lay-ups at design `x`: ply angles in degrees, ply
     /// thicknesses in millimetres, the other plies as in the study
-    /// ([`super::scene_vars::Ties::laminates_at`]).
+    /// (`Ties::laminates_at` in `scene_vars`).
     pub fn laminates_at(&self, x: &[f64]) -> Result<Vec<Laminate>> {
         self.ties.laminates_at(self.plan.panels(), x)
     }
@@ -595,7 +595,7 @@ impl Problem for SceneProblem {
     }
     /// Ply angles in degrees (`theta1_deg` is `θ1 [deg]`), ply
     /// thicknesses in millimetres, scene parameters in SI units
-    /// ([`super::scene_vars::Ties::variable_label`]).
+    /// (`Ties::variable_label` in `scene_vars`).
     fn variable_label(&self, i: usize) -> String {
         self.ties.variable_label(i, &self.vars[i].name)
     }
