@@ -42,12 +42,16 @@ pub struct Check {
     pub iterations: usize,
     /// Function and gradient calls of the pure descent.
     pub calls: (usize, usize),
+    /// The numerical failure that stopped the descent (then `x` is its
+    /// start and `max_g` the run's): one failed check does not end the
+    /// others or the study.
+    pub error: Option<String>,
 }
 
 impl Check {
     /// Did the pure descent reach the feasible set?
     pub fn reached(&self, tolerance: f64) -> bool {
-        self.max_g <= tolerance
+        self.error.is_none() && self.max_g <= tolerance
     }
 }
 
@@ -136,21 +140,26 @@ pub fn sample(runs: &[RunRecord], count: usize) -> Vec<&RunRecord> {
         .collect()
 }
 
-/// Check the sampled infeasible runs from their starts.
-pub fn check(problem: &dyn Problem, runs: &[&RunRecord], tolerance: f64) -> Result<Vec<Check>> {
+/// Check the sampled infeasible runs from their starts. A descent that
+/// fails (an evaluation's numerical error) is recorded with its error.
+pub fn check(problem: &dyn Problem, runs: &[&RunRecord], tolerance: f64) -> Vec<Check> {
     runs.iter()
         .map(|r| {
             let counted = Counted::new(problem);
-            let (x, e, iterations) = descend(&counted, &r.x0, tolerance)?;
-            let max_g = e.max_g();
-            Ok(Check {
+            let run_max_g = r.result.as_ref().map_or(f64::INFINITY, |res| res.max_g());
+            let (x, max_g, iterations, error) = match descend(&counted, &r.x0, tolerance) {
+                Ok((x, e, it)) => (x, e.max_g(), it, None),
+                Err(e) => (r.x0.clone(), run_max_g, 0, Some(e.to_string())),
+            };
+            Check {
                 start: r.start,
-                run_max_g: r.result.as_ref().map_or(f64::INFINITY, |res| res.max_g()),
+                run_max_g,
                 x,
                 max_g,
                 iterations,
                 calls: (counted.function_calls(), counted.gradient_calls()),
-            })
+                error,
+            }
         })
         .collect()
 }
@@ -174,7 +183,10 @@ pub fn table(problem: &dyn Problem, checks: &[Check], tolerance: f64) -> Vec<Vec
         let mut row = vec![c.start.to_string(), num(c.run_max_g)];
         row.extend(c.x.iter().map(|&v| num(v)));
         row.push(num(c.max_g));
-        row.push(c.reached(tolerance).to_string());
+        row.push(match &c.error {
+            Some(e) => format!("error: {e}"),
+            None => c.reached(tolerance).to_string(),
+        });
         row.push(c.iterations.to_string());
         row.push(c.calls.0.to_string());
         row.push(c.calls.1.to_string());
@@ -202,5 +214,60 @@ mod tests {
         let (x, e, _) = descend(&p, &[1.5], 1e-6).unwrap();
         let max_g = e.max_g();
         assert!(max_g <= 1e-6 && x[0] >= 2.1093, "{x:?} {max_g}");
+    }
+
+    /// Islands whose evaluation fails right of x = 1 (as a basis fails at
+    /// a design with repeated eigenvalues).
+    struct Failing(crate::optimize::testproblems::Analytic);
+
+    impl Problem for Failing {
+        fn variables(&self) -> &[crate::optimize::Variable] {
+            self.0.variables()
+        }
+        fn n_constraints(&self) -> usize {
+            1
+        }
+        fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
+            if x[0] > 1.0 {
+                return Err(crate::error::Error::numerical("test", "no basis here"));
+            }
+            self.0.evaluate(x, gradients)
+        }
+    }
+
+    #[test]
+    fn a_failed_descent_is_a_row_with_its_error_not_the_end_of_the_checks() {
+        let p = Failing(islands());
+        let rec = |start: usize, x0: f64| RunRecord {
+            certificate: None,
+            polish: String::new(),
+            start,
+            x0: vec![x0],
+            result: Some(crate::explore::tables::RunResult {
+                x: vec![0.0],
+                f: 0.0,
+                g: vec![0.5],
+            }),
+            exit: "infeasible".into(),
+            iterations: 1,
+            function_calls: 1,
+            gradient_calls: 1,
+            wall_seconds: 0.0,
+            optimum: None,
+        };
+        // From 1.5 the evaluation fails; from 0.3 the descent ends at 0.
+        let runs = [rec(0, 1.5), rec(1, 0.3)];
+        let checks = check(&p, &runs.iter().collect::<Vec<_>>(), 1e-6);
+        assert!(checks[0]
+            .error
+            .as_deref()
+            .is_some_and(|e| e.contains("no basis")));
+        assert!(!checks[0].reached(1e-6) && checks[0].max_g == 0.5);
+        assert!(checks[1].error.is_none() && (checks[1].max_g - 0.5).abs() < 1e-6);
+        let t = table(&p, &checks, 1e-6);
+        assert!(
+            t[1][4].starts_with("error: ") && t[2][4] == "false",
+            "{t:?}"
+        );
     }
 }

@@ -108,7 +108,7 @@ fn violation_checks(
         return Ok((0, 0));
     }
     let tol = report.tolerances.feasibility;
-    let checks = violation::check(problem, &sample, tol)?;
+    let checks = violation::check(problem, &sample, tol);
     let table = violation::table(problem, &checks, tol);
     crate::explore::tables::write_atomic(&dir.join("violation_checks.csv"), &table)?;
     let reached = checks.iter().filter(|c| c.reached(tol)).count();
