@@ -427,25 +427,7 @@ fn tie(
         ));
     }
     used.push((p, d));
-    let bodies = plan.bodies_of_panel(pname);
-    if bodies.is_empty() {
-        return Err(bad(format!(
-            "a panel of a flexible scene body (no [[scene.bodies]] uses panel {pname})"
-        )));
-    }
-    let listed = &plan.spec().sensitivities;
-    let mut lanes = Vec::new();
-    for b in bodies {
-        let lane = format!("{b}.design.{dname}");
-        if !listed.contains(&lane) {
-            return Err(study.error(
-                "scene.sensitivities",
-                format!("{listed:?}"),
-                format!("a list containing \"{lane}\" (the gradient of scene_problem.{key})"),
-            ));
-        }
-        lanes.push(lane);
-    }
+    let lanes = panel_lanes(study, plan, key, entry, pname, dname)?;
     let target = Target::Plies {
         panel: p,
         plies: panels[p].design.groups()[d].clone(),
@@ -492,26 +474,47 @@ fn thickness(
         )));
     }
     used.extend(plies.iter().map(|&k| (p, k)));
+    let lanes = panel_lanes(study, plan, key, entry, pname, dname)?;
+    Ok((Target::Thickness { panel: p, plies }, lanes))
+}
+
+/// The sensitivity lanes `<body>.design.<dname>` of every scene body built
+/// from panel `pname`, for the `sets` entry `entry` of variable `key`:
+/// errors when no flexible body uses the panel or a lane is not listed in
+/// `[scene] sensitivities`.
+fn panel_lanes(
+    study: &Study,
+    plan: &ScenePlan,
+    key: &str,
+    entry: &str,
+    pname: &str,
+    dname: &str,
+) -> Result<Vec<String>> {
     let bodies = plan.bodies_of_panel(pname);
     if bodies.is_empty() {
-        return Err(bad(format!(
-            "a panel of a flexible scene body (no [[scene.bodies]] uses panel {pname})"
-        )));
+        return Err(problem_error(
+            study,
+            key.to_string(),
+            format!("\"{entry}\""),
+            format!("a panel of a flexible scene body (no [[scene.bodies]] uses panel {pname})"),
+        ));
     }
     let listed = &plan.spec().sensitivities;
-    let mut lanes = Vec::new();
-    for b in bodies {
-        let lane = format!("{b}.design.{dname}");
-        if !listed.contains(&lane) {
-            return Err(study.error(
-                "scene.sensitivities",
-                format!("{listed:?}"),
-                format!("a list containing \"{lane}\" (the gradient of scene_problem.{key})"),
-            ));
-        }
-        lanes.push(lane);
-    }
-    Ok((Target::Thickness { panel: p, plies }, lanes))
+    bodies
+        .iter()
+        .map(|b| {
+            let lane = format!("{b}.design.{dname}");
+            if listed.contains(&lane) {
+                Ok(lane)
+            } else {
+                Err(study.error(
+                    "scene.sensitivities",
+                    format!("{listed:?}"),
+                    format!("a list containing \"{lane}\" (the gradient of scene_problem.{key})"),
+                ))
+            }
+        })
+        .collect()
 }
 
 /// Names of a panel's design variables (`theta_1_4` for plies 1 and 4),

@@ -36,6 +36,17 @@ pub(super) struct Search<'s> {
 }
 
 impl Search<'_> {
+    /// f predicted on the binding limits, `φ(0) = f + ∇fᵀc₀`.
+    fn phi0(&self) -> f64 {
+        self.base.f + dot(self.gf, self.c0)
+    }
+
+    /// Reference for a decrease: f at the base, or the predicted f on the
+    /// binding limits when reaching them costs (base slightly violated).
+    fn f_ref(&self) -> f64 {
+        self.base.f.max(self.phi0())
+    }
+
     /// Whether the followed constraints have needed no correction in this
     /// search (none followed, or the last trial met them as it was): then
     /// a fitted step is likely accepted as evaluated, and evaluating it
@@ -168,7 +179,7 @@ impl Mmfd {
     ) -> Result<Option<Searched>> {
         let o = &self.options;
         let ok = |p: &Point| p.max_g() <= o.ctmin;
-        let phi0 = sr.base.f + dot(sr.gf, sr.c0);
+        let phi0 = sr.phi0();
         let d0 = dot(sr.gf, sr.s);
         let snorm = sr.s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         // Pure pull onto the binding limits (S = 0).
@@ -177,7 +188,7 @@ impl Mmfd {
                 return Ok(None);
             }
             let t = self.trial(problem, sr, 0.0)?;
-            return Ok((ok(&t) && t.f < sr.base.f.max(phi0)).then_some((t, 0.0, None)));
+            return Ok((ok(&t) && t.f < sr.f_ref()).then_some((t, 0.0, None)));
         }
         let amax = self.alpha_max(problem, sr);
         let fscale = sr.base.f.abs().max(self.dabobj);
@@ -199,9 +210,7 @@ impl Mmfd {
         if !(alpha > 0.0 && alpha.is_finite()) {
             return Ok(None);
         }
-        // Reference for a decrease: f at the base, or the predicted f on the
-        // binding limits when reaching them costs (base slightly violated).
-        let f_ref = sr.base.f.max(phi0);
+        let f_ref = sr.f_ref();
         let mut best: Option<(Point, f64)> = None;
         let mut evals = 0;
         // Phase A: a feasible trial with a decrease.
@@ -337,7 +346,7 @@ impl Mmfd {
         }
         // The line search's pull-back extrapolation is for its own trials.
         *sr.learned.borrow_mut() = None;
-        let f_ref = sr.base.f.max(sr.base.f + dot(sr.gf, sr.c0));
+        let f_ref = sr.f_ref();
         let noise = o.noise * sr.base.f.abs().max(1.0);
         let model = match sr.curvature {
             Some(k) => -d0 / (k * dot(sr.s, sr.s)),
