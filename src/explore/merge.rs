@@ -15,7 +15,8 @@ use crate::study::Study;
 use std::path::{Path, PathBuf};
 
 /// `plyscape merge`: combine the shard directories of one multistart into
-/// the tables an unsharded run gives, in `out/<study>/`.
+/// the tables an unsharded run gives, in `out/<study>/` (with the
+/// `[robustness]` columns of optima.csv when the study asks for them).
 ///
 /// Strict by design: shards are only read, never modified (a torn last
 /// line is refused, not repaired: finish that shard with `--resume`); a
@@ -84,6 +85,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<multistart::Re
     if !quiet {
         print_optima(problem.as_ref(), &report);
     }
+    // `[robustness]`: the merged optima.csv again with the worst-case
+    // columns, as an unsharded run writes it.
+    super::robustness::apply(&ctx, problem.as_ref(), &report.optima, &dir)?;
     Ok(report)
 }
 

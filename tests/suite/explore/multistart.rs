@@ -189,7 +189,10 @@ fn resume_after_a_kill_gives_the_uninterrupted_tables() {
 fn merged_shards_equal_the_unsharded_run() {
     let tmp = temp_dir("ms-shards");
     let dir = tmp.path().to_path_buf();
-    let s = study("h", &himmelblau(17, ""));
+    // With `[robustness]`: the merged optima.csv carries the worst-case
+    // columns as the unsharded one does (compared below, cell by cell).
+    let text = himmelblau(17, "") + "[robustness]\ntolerance = [0.05, 0.05]\n";
+    let s = study("h", &text);
     let full = dir.join("full");
     explore::run_multistart(&ctx(&s, &full, 2, DriveFlags::default())).unwrap();
     let sharded = dir.join("sharded");
@@ -231,6 +234,14 @@ fn merged_shards_equal_the_unsharded_run() {
             table_without(&full.join("h").join(f), &["wall_seconds"]),
             table_without(&sharded.join("h").join(f), &["wall_seconds"]),
             "{f}"
+        );
+    }
+    let merged = table_without(&sharded.join("h/optima.csv"), &[]);
+    for c in plyscape::explore::robustness::COLUMNS {
+        assert!(
+            merged[0].iter().any(|h| h == c),
+            "{c} missing: {:?}",
+            merged[0]
         );
     }
 }
