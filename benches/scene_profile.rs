@@ -5,8 +5,9 @@
 //!
 //! Prints, at the consistent initial state of the study's scene:
 //! - the natural frequencies of each flexible body's modal basis (Hz);
-//! - the cost of the pieces of one right-hand side in `f64` and in
-//!   `Dual64` (one Jacobian-vector product), from
+//! - the cost of the pieces of one right-hand side in `f64`, in
+//!   `Dual64` (one Jacobian-vector product) and in `DualN<8>` (the eight
+//!   lanes of a fused 8-variable sensitivity evaluation), from
 //!   [`plyscape::sections::kernel_bench::rhs_pieces`] (fastest of 7 batches, µs);
 //! - the cost of one dense Jacobian by `n` dual evaluations (what an
 //!   implicit method pays per Jacobian without column compression);
@@ -15,6 +16,7 @@
 //!   stiffness an integrator meets.
 use nalgebra::{DMatrix, DVector};
 use num_dual::Dual64;
+use plyscape::mbs::math::DualN;
 use plyscape::mbs::{System, Workspace};
 use plyscape::scene::load_scene;
 use plyscape::sections::kernel_bench::{rhs_pieces, PIECES};
@@ -54,9 +56,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let scale = 1.0 / (n as f64).sqrt();
     let yd: Vec<Dual64> = y.iter().map(|&v| Dual64::new(v, scale)).collect();
     let dual = rhs_pieces(&sys, 0.0, &yd);
-    println!("{:<46} {:>10} {:>10}", "piece", "f64 [us]", "dual [us]");
+    // Eight lanes, as a fused 8-variable sensitivity evaluation carries
+    // (state lanes only: the design lanes of the invariants cost the same
+    // arithmetic).
+    let y8: Vec<DualN<8>> = y
+        .iter()
+        .enumerate()
+        .map(|(k, &v)| {
+            DualN::new(
+                v,
+                std::array::from_fn(|l| scale * (1.0 + ((k * 7 + l * 3) % 5) as f64)),
+            )
+        })
+        .collect();
+    let dual8 = rhs_pieces(&sys, 0.0, &y8);
+    println!(
+        "{:<46} {:>10} {:>10} {:>10}",
+        "piece", "f64 [us]", "dual [us]", "8 lanes [us]"
+    );
     for (k, name) in PIECES.iter().enumerate() {
-        println!("{name:<46} {:>10.1} {:>10.1}", plain[k], dual[k]);
+        println!(
+            "{name:<46} {:>10.1} {:>10.1} {:>10.1}",
+            plain[k], dual[k], dual8[k]
+        );
     }
     // Dense Jacobian by n dual evaluations.
     let mut ws = Workspace::<Dual64>::empty();
