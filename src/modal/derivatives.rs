@@ -791,14 +791,25 @@ pub(crate) fn compute(
         let mut kpsi_all: Vec<Mat<f64>> = Vec::with_capacity(nv);
         for (v, s) in setups.iter().enumerate() {
             let g = &s.gamma[ci];
-            let psi = Mat::<f64>::from_fn(n, r, |i, j| {
-                (0..r)
-                    .map(|l| modes.modes[(i, first + l)] * g[(l, j)])
-                    .sum()
-            });
-            let kpsi = Mat::<f64>::from_fn(n, r, |i, j| {
-                (0..r).map(|l| s.kpx[(i, first + l)] * g[(l, j)]).sum()
-            });
+            // Ψ = X_C Γ and K'Ψ; a distinct eigenvalue's Γ is the 1 × 1
+            // identity, so its columns are copied (the same numbers).
+            let (psi, kpsi) = if r == 1 {
+                (
+                    modes.modes.as_ref().subcols(first, 1).to_owned(),
+                    s.kpx.as_ref().subcols(first, 1).to_owned(),
+                )
+            } else {
+                (
+                    Mat::<f64>::from_fn(n, r, |i, j| {
+                        (0..r)
+                            .map(|l| modes.modes[(i, first + l)] * g[(l, j)])
+                            .sum()
+                    }),
+                    Mat::<f64>::from_fn(n, r, |i, j| {
+                        (0..r).map(|l| s.kpx[(i, first + l)] * g[(l, j)]).sum()
+                    }),
+                )
+            };
             for j in 0..r {
                 let dl = s.dlambda[first + j];
                 for i in 0..n {

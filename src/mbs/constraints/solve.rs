@@ -85,9 +85,14 @@ impl System {
             v.extend_from_slice(&ws.q[o..o + d]);
             bb.b.clear();
             bb.b.extend(v.iter().map(T::re_part));
+            // Lane-major (`lanes[l·len + i]`), filled in one pass over v.
+            let len = v.len();
             bb.lanes.clear();
-            for l in 0..nl {
-                bb.lanes.extend(v.iter().map(|x| x.lane_part(l)));
+            bb.lanes.resize(nl * len, 0.0);
+            for (i, x) in v.iter().enumerate() {
+                for l in 0..nl {
+                    bb.lanes[l * len + i] = x.lane_part(l);
+                }
             }
             if self.modes[s] > 0 {
                 bb.minv.clear();

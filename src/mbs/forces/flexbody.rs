@@ -36,7 +36,7 @@
 #![allow(clippy::needless_range_loop)] // index-heavy small dense kernels
 
 use crate::mbs::math::{cst, mm, mv, quadratic_form, spd_inverse, sym_times, Scalar};
-use crate::mbs::model::Force;
+use crate::mbs::model::{Energy, Force};
 use crate::mbs::system::{bump, same_seeds, InvT, System, Workspace, SEED_SPARES};
 use nalgebra::{Matrix3, Vector3};
 
@@ -324,10 +324,12 @@ impl System {
                     wd: &k.qd,
                 };
                 flex_terms(inv, &st, eff, &mut mass, &mut fq);
-                let v: Vec<T> = (k.v.iter().chain(k.wb.iter()).chain(&k.qd))
-                    .copied()
-                    .collect();
-                ws.kinetic[s] = quadratic_form(&mass, &v, d);
+                if !forces || self.kinetic_integrated(self.moving[s]) {
+                    let v: Vec<T> = (k.v.iter().chain(k.wb.iter()).chain(&k.qd))
+                        .copied()
+                        .collect();
+                    ws.kinetic[s] = quadratic_form(&mass, &v, d);
+                }
             }
             // A non-positive pivot leaves a NaN in the factor, which the
             // integrator reports with the time.
@@ -341,6 +343,17 @@ impl System {
                 }
             }
         }
+    }
+
+    /// Whether an integrated state of the model ([`Integral`](crate::mbs::model::Integral)) reads the kinetic
+    /// energy of body `b`: only then does a right-hand side form `½vᵀMv`
+    /// of a flexible body (an energy sum, which calls
+    /// [`System::mass_factors`], always does).
+    fn kinetic_integrated(&self, b: usize) -> bool {
+        self.model
+            .integrals
+            .iter()
+            .any(|i| i.terms.contains(&Energy::Kinetic(b)))
     }
 
     /// Factored mass matrices of the flexible bodies at the kinematics in

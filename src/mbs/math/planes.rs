@@ -18,12 +18,17 @@ use nalgebra::Vector3;
 /// Most planes a number splits into: the real part and its lanes.
 const MAX_PLANES: usize = MAX_LANES + 1;
 
-/// The shape rows `(Φ_j, Ψ_j)`, `j < n`, of one node as planes: `v[(p·n +
-/// j)·6 + c]` with plane `p = 0` the real parts and `p = 1 + l` lane `l`,
-/// `c < 3` the translation `Φ_j` and `c ≥ 3` the rotation `Ψ_j`.
+/// The shape rows `(Φ_j, Ψ_j)`, `j < n`, of one node as planes:
+/// `v[(j·6 + c)·np + p]` (`np` = 1 + lanes) with plane `p = 0` the real
+/// parts and `p = 1 + l` lane `l`, `c < 3` the translation `Φ_j` and
+/// `c ≥ 3` the rotation `Ψ_j`. The planes of one entry are contiguous, so
+/// the sums below run over all lanes of an entry at once (vector
+/// instructions), each lane with the operations, in the order, of the
+/// product rule.
 #[derive(Debug, Clone, Default)]
 pub struct ShapePlanes {
     n: usize,
+    np: usize,
     v: Vec<f64>,
 }
 
@@ -40,16 +45,13 @@ impl ShapePlanes {
     pub fn new<T: Scalar>(phi: &[Vector3<T>], psi: &[Vector3<T>]) -> ShapePlanes {
         let (n, np) = (phi.len(), 1 + T::NL);
         let mut v = vec![0.0; np * n * 6];
-        let mut parts = vec![0.0; np];
         for (j, (f, s)) in phi.iter().zip(psi).enumerate() {
             for c in 0..6 {
-                split(if c < 3 { &f[c] } else { &s[c - 3] }, &mut parts);
-                for (p, x) in parts.iter().enumerate() {
-                    v[(p * n + j) * 6 + c] = *x;
-                }
+                let e = (j * 6 + c) * np;
+                split(if c < 3 { &f[c] } else { &s[c - 3] }, &mut v[e..e + np]);
             }
         }
-        ShapePlanes { n, v }
+        ShapePlanes { n, np, v }
     }
 
     /// Number of modes.
@@ -57,37 +59,36 @@ impl ShapePlanes {
         self.n
     }
 
-    /// Row `j` of plane `p` (six entries: `Φ_j`, then `Ψ_j`).
-    fn row(&self, p: usize, j: usize) -> &[f64] {
-        &self.v[(p * self.n + j) * 6..(p * self.n + j + 1) * 6]
+    /// The planes of row `j` (six entries, `np` planes each: `Φ_j`, then
+    /// `Ψ_j`).
+    fn row(&self, j: usize) -> &[f64] {
+        &self.v[j * 6 * self.np..(j + 1) * 6 * self.np]
     }
 
     /// `(Σ_j Φ_j x_j, Σ_j Ψ_j x_j)` for the `n` numbers `x`.
     pub fn combine<T: Scalar>(&self, x: &[T]) -> (Vector3<T>, Vector3<T>) {
         let np = 1 + T::NL;
         assert!(np <= MAX_PLANES, "at most {} lanes", MAX_PLANES - 1);
+        assert!(
+            self.n == 0 || np == self.np,
+            "planes built for another lane count"
+        );
+        // acc[c·np + p]: plane p of component c.
         let mut acc = [0.0; MAX_PLANES * 6];
         let mut xp = [0.0; MAX_PLANES];
         for (j, xj) in x.iter().enumerate().take(self.n) {
             split(xj, &mut xp[..np]);
-            let s0 = self.row(0, j);
+            let row = self.row(j);
             for c in 0..6 {
-                acc[c] += s0[c] * xp[0];
-            }
-            for p in 1..np {
-                let sp = self.row(p, j);
-                for c in 0..6 {
-                    acc[p * 6 + c] += sp[c] * xp[0] + s0[c] * xp[p];
+                let s = &row[c * np..(c + 1) * np];
+                let a = &mut acc[c * np..(c + 1) * np];
+                a[0] += s[0] * xp[0];
+                for p in 1..np {
+                    a[p] += s[p] * xp[0] + s[0] * xp[p];
                 }
             }
         }
-        let mut lanes = [0.0; MAX_PLANES];
-        let mut entry = |c: usize| {
-            for (l, v) in lanes[..np - 1].iter_mut().enumerate() {
-                *v = acc[(1 + l) * 6 + c];
-            }
-            T::from_parts(acc[c], &lanes[..np - 1])
-        };
+        let entry = |c: usize| T::from_parts(acc[c * np], &acc[c * np + 1..(c + 1) * np]);
         (
             Vector3::new(entry(0), entry(1), entry(2)),
             Vector3::new(entry(3), entry(4), entry(5)),
@@ -105,14 +106,17 @@ impl ShapePlanes {
     ) -> T {
         let np = 1 + T::NL;
         assert!(np <= MAX_PLANES, "at most {} lanes", MAX_PLANES - 1);
-        // ab[p][k]: plane p of the six coefficients (a, then b).
+        assert!(
+            self.n == 0 || np == self.np,
+            "planes built for another lane count"
+        );
+        // ab[k·np + p]: plane p of coefficient k (a, then b).
         let mut ab = [0.0; MAX_PLANES * 6];
-        let mut parts = [0.0; MAX_PLANES];
         for k in 0..6 {
-            split(if k < 3 { &a[k] } else { &b[k - 3] }, &mut parts[..np]);
-            for p in 0..np {
-                ab[p * 6 + k] = parts[p];
-            }
+            split(
+                if k < 3 { &a[k] } else { &b[k - 3] },
+                &mut ab[k * np..(k + 1) * np],
+            );
         }
         let nk = if b.iter().all(|v| v.is_exact_zero()) {
             3
@@ -121,11 +125,17 @@ impl ShapePlanes {
         };
         let (mut e, mut cp, mut sum) = ([0.0; MAX_PLANES], [0.0; MAX_PLANES], [0.0; MAX_PLANES]);
         for (j, cj) in c.iter().enumerate().take(self.n) {
-            let s0 = self.row(0, j);
-            e[0] = (0..nk).map(|k| ab[k] * s0[k]).sum();
-            for p in 1..np {
-                let sp = self.row(p, j);
-                e[p] = (0..nk).map(|k| ab[p * 6 + k] * s0[k] + ab[k] * sp[k]).sum();
+            let row = self.row(j);
+            // e[p] = Σ_k (ab_k^p s_k^0 + ab_k^0 s_k^p) (p ≥ 1) and
+            // e[0] = Σ_k ab_k^0 s_k^0, summed over k in order from −0
+            // (as `Iterator::sum` does).
+            e[..np].fill(-0.0);
+            for k in 0..nk {
+                let (s, abk) = (&row[k * np..(k + 1) * np], &ab[k * np..(k + 1) * np]);
+                e[0] += abk[0] * s[0];
+                for p in 1..np {
+                    e[p] += abk[p] * s[0] + abk[0] * s[p];
+                }
             }
             out.push(T::from_parts(e[0], &e[1..np]));
             split(cj, &mut cp[..np]);
@@ -197,5 +207,47 @@ mod tests {
         let xr: Vec<f64> = x.iter().map(|e| e.re).collect();
         let (ur, _) = ShapePlanes::new(&phr, &psr).combine(&xr);
         assert!((ur[0] - u0[0].re).abs() < 1e-14);
+    }
+
+    #[test]
+    fn eight_lane_sums_equal_dual_arithmetic_to_the_bit() {
+        // With the planes of an entry contiguous, each lane still gets the
+        // product rule's operations in the order of dual arithmetic
+        // (`acc + (s·x)`: s'x + x's), so the deformation sums equal
+        // `DualN<8>`'s own to the last bit.
+        type D8 = DualN<8>;
+        let e = |k: usize| {
+            let x = k as f64;
+            D8::new(
+                (0.7 * x).sin(),
+                std::array::from_fn(|l| (1.3 * x + l as f64).cos()),
+            )
+        };
+        let n = 14;
+        let phi: Vec<Vector3<D8>> = (0..n)
+            .map(|j| Vector3::new(e(6 * j), e(6 * j + 1), e(6 * j + 2)))
+            .collect();
+        let psi: Vec<Vector3<D8>> = (0..n)
+            .map(|j| Vector3::new(e(6 * j + 3), e(6 * j + 4), e(6 * j + 5)))
+            .collect();
+        let x: Vec<D8> = (0..n).map(|j| e(200 + j)).collect();
+        let (u, t) = ShapePlanes::new(&phi, &psi).combine(&x);
+        let (mut u0, mut t0) = (Vector3::<D8>::zeros(), Vector3::<D8>::zeros());
+        for j in 0..n {
+            u0 += phi[j] * x[j];
+            t0 += psi[j] * x[j];
+        }
+        for c in 0..3 {
+            for (a, b) in [(u[c], u0[c]), (t[c], t0[c])] {
+                assert_eq!(a.re.to_bits(), b.re.to_bits(), "component {c}");
+                for l in 0..8 {
+                    assert_eq!(
+                        a.eps[l].to_bits(),
+                        b.eps[l].to_bits(),
+                        "component {c}, lane {l}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -99,7 +99,7 @@ impl Pencil {
     /// by those of the identity.
     fn shifted_values(&self, s: f64, fixed: &[usize]) -> Vec<f64> {
         let o = &self.ordered;
-        let mut val: Vec<f64> = o.src.iter().map(|&p| self.k_val[p]).collect();
+        let mut val = self.k_lower.clone();
         for jn in 0..self.n {
             // Rows are sorted and ≥ the column: the diagonal comes first.
             val[o.col_ptr[jn]] -= s * self.mass[o.fwd[jn]];

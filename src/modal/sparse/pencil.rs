@@ -18,6 +18,10 @@ pub(crate) struct Pencil {
     pub(super) row_idx: Vec<usize>,
     /// Values of `K` on the pattern (zero where only the diagonal was added).
     pub(super) k_val: Vec<f64>,
+    /// Values of `K` on the permuted lower pattern ([`Ordered`], entry `e`
+    /// is `k_val[ordered.src[e]]`), gathered once per stiffness for the
+    /// shifted factorizations (one per mode for the mode derivatives).
+    pub(super) k_lower: Vec<f64>,
     /// Lumped mass, length `n`.
     pub(super) mass: Vec<f64>,
     /// The lower triangle of `P(K ∪ diag)Pᵀ` in the fill-reducing order.
@@ -80,11 +84,13 @@ impl Pencil {
         } = pat;
         let (ordered, symbolic) = Ordered::build(n, &col_ptr, &row_idx)?;
         let input = InputMap::build(k, &col_ptr, &row_idx).unwrap_or_else(InputMap::empty);
+        let k_lower = ordered.src.iter().map(|&p| k_val[p]).collect();
         Ok(Pencil {
             n,
             col_ptr,
             row_idx,
             k_val,
+            k_lower,
             mass: mass.to_vec(),
             ordered,
             input,
@@ -112,6 +118,7 @@ impl Pencil {
         if pat.col_ptr == self.col_ptr && pat.row_idx == self.row_idx {
             self.k_val = pat.k_val;
             self.k_max = pat.k_max;
+            self.gather_lower();
             Ok(false)
         } else {
             let mass = std::mem::take(&mut self.mass);
@@ -159,7 +166,15 @@ impl Pencil {
         }
         self.k_val = val;
         self.k_max = k_max;
+        self.gather_lower();
         true
+    }
+
+    /// `k_lower` from `k_val` (after new values of `K`).
+    fn gather_lower(&mut self) {
+        let (src, val) = (&self.ordered.src, &self.k_val);
+        self.k_lower.clear();
+        self.k_lower.extend(src.iter().map(|&p| val[p]));
     }
 
     /// The pencil restricted to `dofs` (ascending): `K_BB` and `M_B` on the
@@ -189,6 +204,7 @@ impl Pencil {
             col_ptr,
             row_idx,
             k_val: Vec::new(),
+            k_lower: Vec::new(),
             mass: dofs.iter().map(|&d| self.mass[d]).collect(),
             ordered,
             input: InputMap::empty(),
@@ -206,6 +222,7 @@ impl Pencil {
         self.k_val.clear();
         self.k_val.extend(map.iter().map(|&p| full.k_val[p]));
         self.k_max = self.k_val.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        self.gather_lower();
     }
 
     /// Column `j` of `K` (rows, values); by symmetry also row `j`.
