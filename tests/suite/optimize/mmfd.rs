@@ -407,9 +407,12 @@ fn hs_function_calls_with_the_fitted_step() {
 /// at most 16 function and 5 gradient calls (issue 23's target; 24 f + 5 g
 /// with the first line search, 12 f + 5 g measured), and the best design
 /// known, found independently by IPOP-CMA-ES and made strictly feasible
-/// by the polish (results/sar_explore/comparison.csv, row `cmaes,strict`:
+/// by the polish (the first sweep's results/sar_explore/comparison.csv, of
+/// 2026-11-26 in the repository's history, row `cmaes,strict`:
 /// 50.95189259307°/−48.92301018699°, f = 0.9089481415), to 0.01° and 1e-6
-/// in f. About 2 s in release.
+/// in f. (The sweep of 2026-11-27 ends all three methods at
+/// 50.9497°/−48.9097°, f = 0.90894853: the same optimum within the
+/// evaluation noise.) About 2 s in release.
 #[test]
 fn sar_from_55_minus_55_in_16_function_and_5_gradient_calls() {
     let study = plyscape::study::Study::load("studies/sar_optimize.toml").unwrap();
