@@ -345,10 +345,11 @@ impl System {
         }
     }
 
-    /// Whether an integrated state of the model ([`Integral`](crate::mbs::model::Integral)) reads the kinetic
-    /// energy of body `b`: only then does a right-hand side form `½vᵀMv`
-    /// of a flexible body (an energy sum, which calls
-    /// [`System::mass_factors`], always does).
+    /// Whether an integrated state of the model
+    /// ([`Integral`](crate::mbs::model::Integral)) reads the kinetic energy
+    /// of body `b`: only then does a right-hand side form `½vᵀMv` of a
+    /// flexible body (an energy sum, through [`System::mass_factors`],
+    /// always does).
     fn kinetic_integrated(&self, b: usize) -> bool {
         self.model
             .integrals

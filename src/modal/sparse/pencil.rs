@@ -84,20 +84,21 @@ impl Pencil {
         } = pat;
         let (ordered, symbolic) = Ordered::build(n, &col_ptr, &row_idx)?;
         let input = InputMap::build(k, &col_ptr, &row_idx).unwrap_or_else(InputMap::empty);
-        let k_lower = ordered.src.iter().map(|&p| k_val[p]).collect();
-        Ok(Pencil {
+        let mut pencil = Pencil {
             n,
             col_ptr,
             row_idx,
             k_val,
-            k_lower,
+            k_lower: Vec::new(),
             mass: mass.to_vec(),
             ordered,
             input,
             symbolic,
             k_max,
             global: Vec::new(),
-        })
+        };
+        pencil.gather_lower();
+        Ok(pencil)
     }
 
     /// Replace `K` by a matrix of the same size; the symbolic structure is
