@@ -11,7 +11,9 @@
 //! over the repeats, one thread: the panel bases computed (and how many
 //! with mode derivatives) and their time, the rest of the scene build, the
 //! integration (states and, for `f+g`, the sensitivity lanes), the output
-//! and response evaluation, the total, the integrator's steps,
+//! and response evaluation, the total (with the smallest and largest
+//! total of the repeats: the spread a single timing carries on that
+//! machine), the integrator's steps,
 //! right-hand-side calls and Jacobian-vector products (for fused
 //! sensitivities: multi-lane dual evaluations) and the integration time
 //! per right-hand-side call. Wall times are what a user waits; `cpu [ms]`
@@ -60,7 +62,7 @@ pub struct EvalBenchSpec {
 }
 
 /// Column headers of `eval_bench.csv`.
-pub const HEADERS: [&str; 20] = [
+pub const HEADERS: [&str; 22] = [
     "problem",
     "method",
     "design [deg]",
@@ -74,6 +76,8 @@ pub const HEADERS: [&str; 20] = [
     "integrate [ms]",
     "outputs [ms]",
     "total [ms]",
+    "total_min [ms]",
+    "total_max [ms]",
     "steps",
     "rhs_calls",
     "jvp_calls",
@@ -105,6 +109,11 @@ fn row(
     let cpu = median(timed.iter().map(|t| t.cpu).collect());
     let design: Vec<String> = x.iter().map(|v| v.to_string()).collect();
     let per_rhs = med(&|r| r.integrate_seconds / r.rhs_calls.max(1) as f64);
+    // The spread of the repeats' totals, beside their median: how far one
+    // evaluation's wall time moved on this machine while the case ran.
+    let (lo, hi) = runs.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
+        (lo.min(r.total_seconds), hi.max(r.total_seconds))
+    });
     vec![
         name.to_string(),
         method.to_string(),
@@ -119,6 +128,8 @@ fn row(
         ms(&|r| r.integrate_seconds),
         ms(&|r| r.outputs_seconds),
         ms(&|r| r.total_seconds),
+        format!("{:.3}", 1e3 * lo),
+        format!("{:.3}", 1e3 * hi),
         p.steps.to_string(),
         p.rhs_calls.to_string(),
         p.jvp_calls.to_string(),

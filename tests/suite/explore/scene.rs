@@ -329,6 +329,10 @@ fn evaluations_compute_only_what_they_are_asked() {
         .map(|c| col(r, c).parse::<f64>().unwrap())
         .sum();
         assert!(total > 0.0 && parts <= total * 1.01 + 0.01, "{r:?}");
+        // One repeat: its total is the median, the smallest and the
+        // largest.
+        assert_eq!(col(r, "total_min [ms]"), col(r, "total [ms]"), "{r:?}");
+        assert_eq!(col(r, "total_max [ms]"), col(r, "total [ms]"), "{r:?}");
     }
     assert!(rows.iter().all(|r| col(r, "method") == "tsit45"));
     // The same problem with BDF (`methods`): f has Jacobian columns, f+g
