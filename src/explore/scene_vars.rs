@@ -407,13 +407,7 @@ fn tie(
                 .into(),
         )
     })?;
-    let Some(p) = panels.iter().position(|p| p.name == pname) else {
-        let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
-        return Err(bad(format!(
-            "a [[panels]] name before ':' ({}), or \"scene\"",
-            names.join(", ")
-        )));
-    };
+    let p = panel_index(panels, pname, ", or \"scene\"").map_err(&bad)?;
     let names = design_names(&panels[p].design);
     let Some(d) = names.iter().position(|n| n == dname) else {
         return Err(bad(format!(
@@ -453,13 +447,7 @@ fn thickness(
     let (pname, dname) = entry
         .split_once(':')
         .ok_or_else(|| bad("\"<panel>:thickness_<plies>\"".into()))?;
-    let Some(p) = panels.iter().position(|p| p.name == pname) else {
-        let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
-        return Err(bad(format!(
-            "a [[panels]] name before ':' ({})",
-            names.join(", ")
-        )));
-    };
+    let p = panel_index(panels, pname, "").map_err(&bad)?;
     let n = panels[p].laminate.plies().len();
     let plies = crate::panels::thickness_group(dname, n).map_err(|_| {
         bad(format!(
@@ -476,6 +464,19 @@ fn thickness(
     used.extend(plies.iter().map(|&k| (p, k)));
     let lanes = panel_lanes(study, plan, key, entry, pname, dname)?;
     Ok((Target::Thickness { panel: p, plies }, lanes))
+}
+
+/// The index of the panel named `pname`, or what a `sets` entry expects
+/// before its ':' (the panels' names, then `also`).
+fn panel_index(
+    panels: &[crate::fe::Panel],
+    pname: &str,
+    also: &str,
+) -> std::result::Result<usize, String> {
+    panels.iter().position(|p| p.name == pname).ok_or_else(|| {
+        let names: Vec<&str> = panels.iter().map(|p| p.name.as_str()).collect();
+        format!("a [[panels]] name before ':' ({}){also}", names.join(", "))
+    })
 }
 
 /// The sensitivity lanes `<body>.design.<dname>` of every scene body built

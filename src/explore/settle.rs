@@ -200,10 +200,7 @@ fn rescue(
     };
     let max_g = e.max_g();
     let o = &settled.outcome;
-    let (f_calls, g_calls) = (
-        o.function_calls + counted.function_calls(),
-        o.gradient_calls + counted.gradient_calls(),
-    );
+    let (f_calls, g_calls) = (o.function_calls + calls.0, o.gradient_calls + calls.1);
     if max_g > tol {
         let note = format!(
             "rescue: the descent on the violation from the start ended infeasible too \

@@ -165,26 +165,39 @@ mod tests {
         tol(a.re, b.re) && (0..2).all(|l| tol(a.lane_part(l), b.lane_part(l)))
     }
 
+    /// The shape rows `(Φ_j, Ψ_j)`, `j < n`, with entries `e(6j + c)`.
+    type Rows<T> = (Vec<Vector3<T>>, Vec<Vector3<T>>);
+    fn shape_rows<T: Scalar>(n: usize, e: impl Fn(usize) -> T) -> Rows<T> {
+        let row =
+            |j: usize, c: usize| Vector3::new(e(6 * j + c), e(6 * j + c + 1), e(6 * j + c + 2));
+        (
+            (0..n).map(|j| row(j, 0)).collect(),
+            (0..n).map(|j| row(j, 3)).collect(),
+        )
+    }
+
+    /// `(Σ_j Φ_j x_j, Σ_j Ψ_j x_j)` by the scalar type's own arithmetic.
+    fn dual_sums<T: Scalar>((phi, psi): &Rows<T>, x: &[T]) -> (Vector3<T>, Vector3<T>) {
+        let (mut u0, mut t0) = (Vector3::<T>::zeros(), Vector3::<T>::zeros());
+        for j in 0..x.len() {
+            u0 += phi[j] * x[j];
+            t0 += psi[j] * x[j];
+        }
+        (u0, t0)
+    }
+
     #[test]
     fn plane_sums_equal_dual_arithmetic() {
         // The planes' product rule against num-dual's own products, for
         // the deformation sums and the modal entries of a row.
         let n = 5;
-        let phi: Vec<Vector3<D>> = (0..n)
-            .map(|j| Vector3::new(d(6 * j), d(6 * j + 1), d(6 * j + 2)))
-            .collect();
-        let psi: Vec<Vector3<D>> = (0..n)
-            .map(|j| Vector3::new(d(6 * j + 3), d(6 * j + 4), d(6 * j + 5)))
-            .collect();
+        let rows = shape_rows(n, d);
+        let (phi, psi) = &rows;
         let x: Vec<D> = (0..n).map(|j| d(100 + j)).collect();
-        let planes = ShapePlanes::new(&phi, &psi);
+        let planes = ShapePlanes::new(phi, psi);
         assert_eq!(planes.n(), n);
         let (u, t) = planes.combine(&x);
-        let (mut u0, mut t0) = (Vector3::<D>::zeros(), Vector3::<D>::zeros());
-        for j in 0..n {
-            u0 += phi[j] * x[j];
-            t0 += psi[j] * x[j];
-        }
+        let (u0, t0) = dual_sums(&rows, &x);
         for c in 0..3 {
             assert!(close(u[c], u0[c]) && close(t[c], t0[c]), "component {c}");
         }
@@ -224,19 +237,10 @@ mod tests {
             )
         };
         let n = 14;
-        let phi: Vec<Vector3<D8>> = (0..n)
-            .map(|j| Vector3::new(e(6 * j), e(6 * j + 1), e(6 * j + 2)))
-            .collect();
-        let psi: Vec<Vector3<D8>> = (0..n)
-            .map(|j| Vector3::new(e(6 * j + 3), e(6 * j + 4), e(6 * j + 5)))
-            .collect();
+        let rows = shape_rows(n, e);
         let x: Vec<D8> = (0..n).map(|j| e(200 + j)).collect();
-        let (u, t) = ShapePlanes::new(&phi, &psi).combine(&x);
-        let (mut u0, mut t0) = (Vector3::<D8>::zeros(), Vector3::<D8>::zeros());
-        for j in 0..n {
-            u0 += phi[j] * x[j];
-            t0 += psi[j] * x[j];
-        }
+        let (u, t) = ShapePlanes::new(&rows.0, &rows.1).combine(&x);
+        let (u0, t0) = dual_sums(&rows, &x);
         for c in 0..3 {
             for (a, b) in [(u[c], u0[c]), (t[c], t0[c])] {
                 assert_eq!(a.re.to_bits(), b.re.to_bits(), "component {c}");

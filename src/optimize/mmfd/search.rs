@@ -36,6 +36,16 @@ pub(super) struct Search<'s> {
 }
 
 impl Search<'_> {
+    /// The slope of f along the direction at the base, `f'(0) = ∇fᵀS`.
+    fn slope0(&self) -> f64 {
+        dot(self.gf, self.s)
+    }
+
+    /// `max_i |S_i|` (scaled), the direction's size.
+    fn s_max(&self) -> f64 {
+        self.s.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
     /// f predicted on the binding limits, `φ(0) = f + ∇fᵀc₀`.
     fn phi0(&self) -> f64 {
         self.base.f + dot(self.gf, self.c0)
@@ -129,7 +139,7 @@ impl Mmfd {
     /// variables.
     fn alpha_max(&self, problem: &Ap<'_>, sr: &Search<'_>) -> f64 {
         let vars = variables(problem);
-        let snorm = sr.s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let snorm = sr.s_max();
         let mut amax = f64::INFINITY;
         for (i, v) in vars.iter().enumerate() {
             if v.period.is_some() || sr.s[i].abs() <= 1e-9 * snorm {
@@ -180,8 +190,8 @@ impl Mmfd {
         let o = &self.options;
         let ok = |p: &Point| p.max_g() <= o.ctmin;
         let phi0 = sr.phi0();
-        let d0 = dot(sr.gf, sr.s);
-        let snorm = sr.s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let d0 = sr.slope0();
+        let snorm = sr.s_max();
         // Pure pull onto the binding limits (S = 0).
         if snorm == 0.0 || d0 >= 0.0 {
             if norm(sr.c0) == 0.0 {
@@ -339,8 +349,8 @@ impl Mmfd {
         sr: &Search<'_>,
     ) -> Result<Option<Searched>> {
         let o = &self.options;
-        let d0 = dot(sr.gf, sr.s);
-        let snorm = sr.s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let d0 = sr.slope0();
+        let snorm = sr.s_max();
         if snorm == 0.0 || d0.is_nan() || d0 >= 0.0 {
             return Ok(None);
         }
