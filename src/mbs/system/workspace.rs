@@ -92,9 +92,6 @@ pub struct Workspace<T: Scalar> {
     /// Per moving body: the constraint rows touching it and their
     /// products with its inverse mass ([`BodyBlock`]).
     pub(crate) blocks: Vec<BodyBlock>,
-    /// Per moving body: its rows' and force's entries as gathered, before
-    /// the split into real parts and lanes.
-    pub(crate) gather: Vec<Vec<T>>,
     /// Scratch for the permutation of the constraint-space solve.
     pub(crate) perm: Vec<f64>,
     /// Modal Jacobian entries of the rows' flexible sides.
@@ -152,7 +149,8 @@ pub struct Workspace<T: Scalar> {
 /// One body's share of the constraint-space matrix, in real arithmetic:
 /// the rows touching the body, their entries `d_i` for its `dof`
 /// velocities followed by its applied force `Q` (`b`, `(k + 1) × dof`,
-/// real parts; `lanes`, the same per lane of a dual evaluation), `w =
+/// real parts; `lanes`, their lanes in a dual evaluation, the lanes of
+/// each entry together: `lanes[i · NL + l]`), `w =
 /// M⁻¹ b` alike, the Gram block `g_ij = b_i · w_j` (`(k + 1)²`, lower
 /// triangle), and the real inverse mass (`minv`, `dof²`; a rigid body
 /// keeps `1/m` in `inv_mass` and its inertia in the model).
@@ -174,10 +172,11 @@ pub struct SolveScratch {
     pub(crate) lam: Vec<f64>,
     pub(crate) acc: Vec<f64>,
     pub(crate) tmp: Vec<f64>,
-    /// Per lane: λ' (`lanes × m`) and v̇' (`lanes × nvel`).
+    /// λ' and v̇' of every lane (lane-interleaved, `m × lanes` and
+    /// `nvel × lanes`).
     pub(crate) dlam: Vec<f64>,
     pub(crate) dacc: Vec<f64>,
-    /// One body's `r₁` of every lane (lane-major, `lanes × dof`).
+    /// One body's `r₁` of every lane (lane-interleaved, `dof × lanes`).
     pub(crate) r1: Vec<f64>,
     /// One body's `w_iᵀ M' w_i` per row and lane (lane-interleaved).
     pub(crate) quad: Vec<f64>,
@@ -274,7 +273,6 @@ impl<T: Scalar> Workspace<T> {
             planes: Vec::new(),
             shape_spare: Vec::new(),
             blocks: Vec::new(),
-            gather: Vec::new(),
             perm: Vec::new(),
             mjac: Vec::new(),
             mfac: Vec::new(),
