@@ -135,6 +135,30 @@ pub fn spd_solve_many(
     let acc = f.accepted;
     tmp.clear();
     tmp.extend((0..acc * nc).map(|x| b[x] * scale[x / nc]));
+    // Fixed column counts get loops the compiler unrolls across the
+    // columns; the operations are the same.
+    let l = (a, m, pattern, acc);
+    match nc {
+        2 => substitute::<2>(l, nc, tmp),
+        4 => substitute::<4>(l, nc, tmp),
+        8 => substitute::<8>(l, nc, tmp),
+        _ => substitute::<0>(l, nc, tmp),
+    }
+    b.fill(0.0);
+    for (x, t) in tmp.iter().enumerate() {
+        b[x] = t * scale[x / nc];
+    }
+}
+
+/// The forward and backward substitutions of [`spd_solve_many`] on the
+/// `nc` interleaved columns of `tmp`; `N` = `nc` when it is not 0 (a
+/// column count known at compile time), 0 for any `nc`.
+fn substitute<const N: usize>(
+    (a, m, pattern, acc): (&[f64], usize, &CholPattern, usize),
+    nc: usize,
+    tmp: &mut [f64],
+) {
+    let nc = if N == 0 { nc } else { N };
     for k in 0..acc {
         let (done, rest) = tmp.split_at_mut(k * nc);
         let s = &mut rest[..nc];
@@ -159,10 +183,6 @@ pub fn spd_solve_many(
         }
         let d = a[k * m + k];
         s.iter_mut().for_each(|x| *x /= d);
-    }
-    b.fill(0.0);
-    for (x, t) in tmp.iter().enumerate() {
-        b[x] = t * scale[x / nc];
     }
 }
 
@@ -326,8 +346,9 @@ mod tests {
     fn multi_column_solve_is_the_single_solve_to_the_bit() {
         // A sparse SPD matrix (a band plus a coupling row, rank-deficient
         // by one duplicated row so the regularised pivot is met too) on its
-        // symbolic pattern: three right-hand sides solved together equal,
-        // bit for bit, three single solves (spd_solve_many's contract).
+        // symbolic pattern: 2, 3 and 8 right-hand sides solved together
+        // (the fixed-count and the general substitutions) equal, bit for
+        // bit, single solves (spd_solve_many's contract).
         let n = 7;
         let g = |i: usize, k: usize| {
             let i = if i == 6 { 2 } else { i };
@@ -351,24 +372,26 @@ mod tests {
         let mut scale = Vec::new();
         let f = spd_factor(&mut a, n, &mut scale, (1e-8, 1e-12), &mut sc);
         assert_eq!(f.rank, n - 1);
-        let cols: Vec<Vec<f64>> = (0..3)
-            .map(|c| {
-                (0..n)
-                    .map(|i| ((i * 7 + c * 13) % 9) as f64 - 4.3)
-                    .collect()
-            })
-            .collect();
-        let mut many: Vec<f64> = (0..n * 3).map(|x| cols[x % 3][x / 3]).collect();
-        spd_solve_many(&a, n, &scale, f, 3, &mut many, &mut sc);
-        for (c, col) in cols.iter().enumerate() {
-            let mut one = col.clone();
-            spd_solve(&a, n, &scale, f, &mut one, &mut sc);
-            for i in 0..n {
-                assert_eq!(
-                    many[i * 3 + c].to_bits(),
-                    one[i].to_bits(),
-                    "column {c}, row {i}"
-                );
+        for nc in [2, 3, 8] {
+            let cols: Vec<Vec<f64>> = (0..nc)
+                .map(|c| {
+                    (0..n)
+                        .map(|i| ((i * 7 + c * 13) % 9) as f64 - 4.3)
+                        .collect()
+                })
+                .collect();
+            let mut many: Vec<f64> = (0..n * nc).map(|x| cols[x % nc][x / nc]).collect();
+            spd_solve_many(&a, n, &scale, f, nc, &mut many, &mut sc);
+            for (c, col) in cols.iter().enumerate() {
+                let mut one = col.clone();
+                spd_solve(&a, n, &scale, f, &mut one, &mut sc);
+                for i in 0..n {
+                    assert_eq!(
+                        many[i * nc + c].to_bits(),
+                        one[i].to_bits(),
+                        "{nc} columns: column {c}, row {i}"
+                    );
+                }
             }
         }
     }
