@@ -7,7 +7,13 @@
 //! without gradients (`f`) and with them (`f+g`, once per sensitivity
 //! form listed in `forms`, e.g. `f+g fused`), `repeats` times each
 //! after one untimed warm-up of each kind (which makes the pooled panel
-//! analyses: pattern, symbolic factorization). Reported per case, medians
+//! analyses: pattern, symbolic factorization). The repeats run in rounds:
+//! each round evaluates every kind once, one after the other, so that
+//! the `f+g` of a round is timed beside its `f`, and `total_per_f` is the
+//! median over the rounds of a kind's total over the `f` total of the
+//! same round (1 for `f`): the f+g/f ratio with the machine's slow and
+//! fast spells paired out, which the ratio of the two medians is not on a
+//! machine whose speed drifts. Reported per case, medians
 //! over the repeats, one thread: the panel bases computed (and how many
 //! with mode derivatives) and their time, the rest of the scene build, the
 //! integration (states and, for `f+g`, the sensitivity lanes), the output
@@ -62,7 +68,7 @@ pub struct EvalBenchSpec {
 }
 
 /// Column headers of `eval_bench.csv`.
-pub const HEADERS: [&str; 22] = [
+pub const HEADERS: [&str; 23] = [
     "problem",
     "method",
     "design [deg]",
@@ -78,6 +84,7 @@ pub const HEADERS: [&str; 22] = [
     "total [ms]",
     "total_min [ms]",
     "total_max [ms]",
+    "total_per_f",
     "steps",
     "rhs_calls",
     "jvp_calls",
@@ -99,7 +106,7 @@ fn row(
     (name, method): (&str, &str),
     x: &[f64],
     (mode, load): (&str, Option<f64>),
-    setup: f64,
+    (setup, per_f): (f64, f64),
     timed: &[Timed],
 ) -> Vec<String> {
     let runs: Vec<&EvalProfile> = timed.iter().map(|t| &t.profile).collect();
@@ -130,6 +137,7 @@ fn row(
         ms(&|r| r.total_seconds),
         format!("{:.3}", 1e3 * lo),
         format!("{:.3}", 1e3 * hi),
+        format!("{per_f:.3}"),
         p.steps.to_string(),
         p.rhs_calls.to_string(),
         p.jvp_calls.to_string(),
@@ -195,22 +203,37 @@ pub fn run_eval_bench(
             for form in &spec.forms {
                 modes.push((format!("f+g {}", form.name()), true, Some(*form)));
             }
-            for (mode, gradients, form) in modes {
+            // Warm-ups, then the rounds (module doc).
+            let set_form = |problem: &mut SceneProblem, form: &Option<SensitivityForm>| {
                 if let Some(form) = form {
-                    problem.set_sensitivity_form(form);
+                    problem.set_sensitivity_form(*form);
                 }
-                problem.evaluate_profiled(x, gradients)?;
-                let load = load_average();
-                let cpu = || thread_cpu_seconds().unwrap_or(f64::NAN);
-                let runs = (0..spec.repeats)
-                    .map(|_| {
-                        let c0 = cpu();
-                        let profile = problem.evaluate_profiled(x, gradients)?.1;
-                        let cpu = cpu() - c0;
-                        Ok(Timed { profile, cpu })
-                    })
-                    .collect::<Result<Vec<_>>>()?;
-                let r = row((&inner.name(), method_name), x, (&mode, load), setup, &runs);
+            };
+            for (_, gradients, form) in &modes {
+                set_form(&mut problem, form);
+                problem.evaluate_profiled(x, *gradients)?;
+            }
+            let load = load_average();
+            let cpu = || thread_cpu_seconds().unwrap_or(f64::NAN);
+            let mut timed: Vec<Vec<Timed>> = modes.iter().map(|_| Vec::new()).collect();
+            for _ in 0..spec.repeats {
+                for ((_, gradients, form), runs) in modes.iter().zip(timed.iter_mut()) {
+                    set_form(&mut problem, form);
+                    let c0 = cpu();
+                    let profile = problem.evaluate_profiled(x, *gradients)?.1;
+                    let cpu = cpu() - c0;
+                    runs.push(Timed { profile, cpu });
+                }
+            }
+            for ((mode, ..), runs) in modes.iter().zip(&timed) {
+                let per_f = median(
+                    runs.iter()
+                        .zip(&timed[0])
+                        .map(|(a, f)| a.profile.total_seconds / f.profile.total_seconds)
+                        .collect(),
+                );
+                let case = (inner.name(), method_name);
+                let r = row((&case.0, case.1), x, (mode, load), (setup, per_f), runs);
                 progress(&r);
                 rows.push(r);
             }

@@ -334,6 +334,17 @@ fn evaluations_compute_only_what_they_are_asked() {
         assert_eq!(col(r, "total_min [ms]"), col(r, "total [ms]"), "{r:?}");
         assert_eq!(col(r, "total_max [ms]"), col(r, "total [ms]"), "{r:?}");
     }
+    // The f+g of the round over the f of the round (one round: the ratio
+    // of the two totals; f over itself is 1).
+    assert_eq!(col(f, "total_per_f"), "1.000");
+    let total = |r: &Vec<String>| col(r, "total [ms]").parse::<f64>().unwrap();
+    let per_f: f64 = col(fg, "total_per_f").parse().unwrap();
+    assert!(
+        (per_f - total(fg) / total(f)).abs() <= 1e-3 * per_f + 1e-3,
+        "{per_f} vs {} / {}",
+        total(fg),
+        total(f)
+    );
     assert!(rows.iter().all(|r| col(r, "method") == "tsit45"));
     // The same problem with BDF (`methods`): f has Jacobian columns, f+g
     // fused the same two lanes and the same steps as f (the lanes weigh
