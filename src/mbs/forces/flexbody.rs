@@ -89,17 +89,16 @@ pub fn flex_terms<T: Scalar>(
     // forces use too) and J_tr = tr(E) I − E.
     let mut h = Vec::with_capacity(n);
     let mut e = inv.e0;
-    for j in 0..n {
-        let pj = Matrix3::from_fn(|r, c| inv.p[j * 9 + 3 * r + c]);
-        let mut qw = Matrix3::<T>::zeros();
-        for i in 0..n {
-            let o = (j * n + i) * 9;
-            for r in 0..3 {
-                for c in 0..3 {
-                    qw[(r, c)] += inv.q[o + 3 * r + c] * w[i];
-                }
+    for (j, (pj, qj)) in inv.p.chunks_exact(9).zip(inv.q.chunks_exact(9 * n)).enumerate() {
+        let pj = Matrix3::from_fn(|r, c| pj[3 * r + c]);
+        // Σ_i Q_ji w_i, entry (r, c) at 3r + c, summed over i in order.
+        let mut acc = [T::zero(); 9];
+        for (qji, wi) in qj.chunks_exact(9).zip(w) {
+            for (a, q) in acc.iter_mut().zip(qji) {
+                *a += *q * *wi;
             }
         }
+        let qw = Matrix3::from_fn(|r, c| acc[3 * r + c]);
         e += (pj + pj.transpose() + qw) * w[j];
         h.push(pj + qw);
     }
@@ -107,15 +106,17 @@ pub fn flex_terms<T: Scalar>(
     // M_ωw columns: ls_j + Σ_i w_i V_ij + c_rot_j.
     let mut mwq = vec![Vector3::<T>::zeros(); n];
     for (j, col) in mwq.iter_mut().enumerate() {
-        for c in 0..3 {
-            col[c] = inv.ls[c * n + j] + inv.c_rot[c * n + j];
+        let mut acc = [T::zero(); 3];
+        for (c, a) in acc.iter_mut().enumerate() {
+            *a = inv.ls[c * n + j] + inv.c_rot[c * n + j];
         }
-        for i in 0..n {
-            let o = (i * n + j) * 3;
-            for c in 0..3 {
-                col[c] += inv.v[o + c] * w[i];
+        // Σ_i w_i V_ij, in order of i (V_ij at (i n + j) · 3).
+        for (vi, wi) in inv.v.chunks_exact(3 * n).zip(w) {
+            for (a, v) in acc.iter_mut().zip(&vi[3 * j..3 * j + 3]) {
+                *a += *v * *wi;
             }
         }
+        *col = Vector3::new(acc[0], acc[1], acc[2]);
     }
     mass.clear();
     mass.resize(d * d, T::zero());
@@ -175,13 +176,13 @@ pub fn flex_terms<T: Scalar>(
     for (j, h) in h.iter().enumerate() {
         g += h * wd[j];
         // Σ_i ẇ_i V_ij.
-        let mut vs = Vector3::<T>::zeros();
-        for i in 0..n {
-            let o = (i * n + j) * 3;
-            for c in 0..3 {
-                vs[c] += inv.v[o + c] * wd[i];
+        let mut acc = [T::zero(); 3];
+        for (vi, wdi) in inv.v.chunks_exact(3 * n).zip(wd) {
+            for (a, v) in acc.iter_mut().zip(&vi[3 * j..3 * j + 3]) {
+                *a += *v * *wdi;
             }
         }
+        let vs = Vector3::new(acc[0], acc[1], acc[2]);
         let qj = om.dot(&mv(h, &om)) - om.norm_squared() * h.trace() + two * om.dot(&vs);
         force[6 + j] -= qj;
         for c in 0..3 {
