@@ -26,7 +26,7 @@
 //! split, stay unique. One factorization per evaluation (plus the explicit
 //! inverse of each flexible body's mass). The solve is real arithmetic for
 //! every scalar type: a dual-number evaluation adds its tangent with the
-//! same factorizations (`crate::mbs::constraints::solve` has the formulas), with no dual
+//! same factorizations (`crate::mbs::constraints::tangent` has the formulas), with no dual
 //! arithmetic inside a factorization and no finite differences.
 //!
 //! Everything is generic over the scalar `T` so that `num_dual::Dual64`

@@ -89,7 +89,12 @@ pub fn flex_terms<T: Scalar>(
     // forces use too) and J_tr = tr(E) I − E.
     let mut h = Vec::with_capacity(n);
     let mut e = inv.e0;
-    for (j, (pj, qj)) in inv.p.chunks_exact(9).zip(inv.q.chunks_exact(9 * n)).enumerate() {
+    for (j, (pj, qj)) in inv
+        .p
+        .chunks_exact(9)
+        .zip(inv.q.chunks_exact(9 * n))
+        .enumerate()
+    {
         let pj = Matrix3::from_fn(|r, c| pj[3 * r + c]);
         // Σ_i Q_ji w_i, entry (r, c) at 3r + c, summed over i in order.
         let mut acc = [T::zero(); 9];

@@ -96,7 +96,7 @@ impl<const N: usize> Lanes for DualN<N> {
 /// [`Scalar::dense_factor`] for dual numbers: the real parts become the
 /// explicit inverse `A⁻¹` of the real matrix ([`spd_inverse`]), the dual
 /// parts keep `A'`, which the tangent of the constraint-space solve reads
-/// (`crate::mbs::constraints::solve`).
+/// (`crate::mbs::constraints::tangent`).
 fn lanes_dense_factor<D: Lanes>(a: &mut [D], n: usize) -> bool {
     let mut inv: Vec<f64> = a.iter().map(|v| v.re()).collect();
     let ok = spd_inverse(&mut inv, n);

@@ -16,7 +16,7 @@ use nalgebra::RealField;
 /// The two symmetric positive definite solves of a right-hand side (the
 /// constraint-space matrix and the dense mass of a flexible body) are not
 /// run in dual arithmetic: the solve is real, and a dual evaluation adds
-/// its tangent with the same factorizations (`crate::mbs::constraints::solve`,
+/// its tangent with the same factorizations (`crate::mbs::constraints::tangent`,
 /// docs/numerics.md); the parts accessors below split a number into its
 /// real part and lanes for that.
 pub trait Scalar: RealField + Copy {
