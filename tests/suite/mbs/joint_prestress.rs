@@ -242,6 +242,62 @@ fn prestress_tangent_matches_central_differences() {
     }
 }
 
+#[test]
+fn prestress_tangent_lanes_ride_together_as_alone() {
+    // The multi-lane tangent of the prestress iteration (lane-interleaved,
+    // plyscape::mbs::constraints::tangent): one 4-lane evaluation of the
+    // pulled cantilever at a deformed, moving state, four state directions
+    // and the puller's mass in the first lane, against four one-lane
+    // (Dual64) evaluations, one per direction: each lane equal to the
+    // bit (every lane gets the operations of a one-lane evaluation, in
+    // the same order; the lanes must not see each other).
+    use crate::common::scenes::scene as build;
+    use num_dual::Dual64;
+    use plyscape::mbs::math::DualN;
+    use plyscape::mbs::{Param, System, Workspace};
+    let model = build(&scene(4.0, 0.05, 8, true)).model;
+    let puller = model
+        .bodies
+        .iter()
+        .position(|b| b.name == "puller")
+        .unwrap();
+    let sys = System::new(model);
+    let mut y = sys.initial_state();
+    let (p, o) = (sys.pos_off(0), sys.vel_off(0));
+    for j in 0..sys.modes[0] {
+        y[p + 7 + j] = 2e-2 / (1 + j) as f64 * if j % 3 == 0 { 1.0 } else { -0.6 };
+        y[o + 6 + j] = 0.1 * ((j as f64) * 0.9).sin();
+    }
+    sys.project(0.0, &mut y).unwrap();
+    let n = y.len();
+    let dir = |l: usize, k: usize| ((k as f64) * (1.3 + 0.7 * l as f64)).cos();
+    let (m, dm) = (0.05, 0.02);
+    let mut w4 = Workspace::empty();
+    w4.params = vec![(Param::Mass(puller), DualN::new(m, [dm, 0.0, 0.0, 0.0]))];
+    let y4: Vec<DualN<4>> = (0..n)
+        .map(|k| DualN::new(y[k], std::array::from_fn(|l| dir(l, k))))
+        .collect();
+    let mut f4 = vec![DualN::<4>::cst(0.0); n];
+    sys.rhs(0.0, &y4, &mut f4, &mut w4);
+    let mut worst = 0.0f64;
+    let mut scale = 0.0f64;
+    for l in 0..4 {
+        let mut w1 = Workspace::empty();
+        let dml = if l == 0 { dm } else { 0.0 };
+        w1.params = vec![(Param::Mass(puller), Dual64::new(m, dml))];
+        let y1: Vec<Dual64> = (0..n).map(|k| Dual64::new(y[k], dir(l, k))).collect();
+        let mut f1 = vec![Dual64::from(0.0); n];
+        sys.rhs(0.0, &y1, &mut f1, &mut w1);
+        for k in 0..n {
+            scale = scale.max(f1[k].eps.abs());
+            worst = worst.max((f4[k].eps[l] - f1[k].eps).abs());
+            assert_eq!(f4[k].re.to_bits(), f1[k].re.to_bits(), "value {k}");
+        }
+    }
+    println!("max |Jv| {scale:e}, worst lane difference {worst:e}");
+    assert!(scale > 0.0 && worst == 0.0, "{worst:e} of {scale:e}");
+}
+
 /// A centre-clamped panel (1.0 m × 0.6 m, [θ/−45/−45/θ]) swung about x by
 /// a driven hinge (θ = t²) as in `flex.rs`, with a 0.2 kg body on a
 /// spherical joint at its corner (0.5, 0.3) that carries an in-plane load
