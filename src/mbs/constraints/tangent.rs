@@ -22,11 +22,14 @@
 //! All lanes in one pass, lane-interleaved (`x[i · nl + l]`: the lanes of
 //! an entry together): the rows' and forces' lanes as the solve gathers
 //! them body by body ([`BodyBlock`]), `r₁`, the right-hand sides of λ',
-//! `D'`, λ' and v̇'. Every kernel runs over the
-//! lanes innermost (vector instructions across lanes) and gives each lane
-//! the operations, in the order, of the scalar kernels of the real solve
+//! `D'`, λ' and v̇' (the prestress force `B'λ` alone stays lane-major, as
+//! the prestress code writes it). Every kernel runs over the lanes
+//! innermost (vector instructions across lanes) and gives each lane the
+//! operations, in the order, of the scalar kernels of the real solve
 //! ([`fdot`], [`sym_times`]), so that a lane's numbers do not depend on
-//! how many lanes ride together, nor on the layout.
+//! how many lanes ride together, nor on the layout. The one exception is
+//! the quadratic forms of `D'` ([`mass_lane_terms`]), summed over the
+//! lower triangle of `M'`; they enter only as `ε D'`.
 
 use crate::mbs::math::{fdot, spd_solve_many, sym_times, Factored, Scalar, MAX_LANES};
 use crate::mbs::model::Param;

@@ -92,7 +92,7 @@ pub fn flex_terms<T: Scalar>(
     for (j, (pj, qj)) in inv
         .p
         .chunks_exact(9)
-        .zip(inv.q.chunks_exact(9 * n))
+        .zip(inv.q.chunks_exact(9 * n.max(1)))
         .enumerate()
     {
         let pj = Matrix3::from_fn(|r, c| pj[3 * r + c]);

@@ -191,7 +191,8 @@ pub struct SolveScratch {
     /// or the system's), for the tangent.
     pub(crate) dropped: Vec<bool>,
     /// The joint-load prestress force `B λ` (velocity layout, modal
-    /// entries only), the iteration's λ and right-hand side.
+    /// entries only; in a dual evaluation's tangent, every lane's `B'λ`,
+    /// lane-major), the iteration's λ and right-hand side.
     pub(crate) bz: Vec<f64>,
     pub(crate) plam: Vec<f64>,
     pub(crate) prhs: Vec<f64>,
