@@ -28,7 +28,7 @@
 //! operations, in the order, of the scalar kernels of the real solve
 //! ([`fdot`], [`sym_times`]), so that a lane's numbers do not depend on
 //! how many lanes ride together, nor on the layout. The one exception is
-//! the quadratic forms of `D'` ([`mass_lane_terms`]), summed over the
+//! the quadratic forms of `D'` (`mass_lane_terms`), summed over the
 //! lower triangle of `M'`; they enter only as `ε D'`.
 
 use crate::mbs::math::{fdot, spd_solve_many, sym_times, Factored, Scalar, MAX_LANES};
