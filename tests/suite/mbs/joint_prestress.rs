@@ -177,17 +177,12 @@ fn axial_joint_load_stiffens_and_softens_as_the_taut_beam() {
     }
 }
 
-#[test]
-fn prestress_tangent_matches_central_differences() {
-    // The tangent of the prestress iteration (plyscape::mbs::constraints::
-    // prestress: r₁ gains −B'λ, λ' by the same iteration) at a deformed,
-    // moving state of the pulled cantilever, in a state direction together
-    // with a parameter lane (the puller's mass, which changes λ and so
-    // B λ): one Dual64 evaluation against central differences of plain
-    // evaluations.
+/// The pulled cantilever of the prestress tangent tests (axial load 4 N,
+/// puller 0.05 kg, 8 modes, geometric stiffening on): its model, system,
+/// a deformed and moving consistent state and the puller's body index.
+fn deformed_pulled_cantilever() -> (plyscape::mbs::Model, plyscape::mbs::System, Vec<f64>, usize) {
     use crate::common::scenes::scene as build;
-    use num_dual::Dual64;
-    use plyscape::mbs::{Param, System, Workspace};
+    use plyscape::mbs::System;
     let model = build(&scene(4.0, 0.05, 8, true)).model;
     let puller = model
         .bodies
@@ -202,6 +197,20 @@ fn prestress_tangent_matches_central_differences() {
         y[o + 6 + j] = 0.1 * ((j as f64) * 0.9).sin();
     }
     sys.project(0.0, &mut y).unwrap();
+    (model, sys, y, puller)
+}
+
+#[test]
+fn prestress_tangent_matches_central_differences() {
+    // The tangent of the prestress iteration (plyscape::mbs::constraints::
+    // prestress: r₁ gains −B'λ, λ' by the same iteration) at a deformed,
+    // moving state of the pulled cantilever, in a state direction together
+    // with a parameter lane (the puller's mass, which changes λ and so
+    // B λ): one Dual64 evaluation against central differences of plain
+    // evaluations.
+    use num_dual::Dual64;
+    use plyscape::mbs::{Param, System, Workspace};
+    let (model, sys, y, puller) = deformed_pulled_cantilever();
     let n = y.len();
     let dir: Vec<f64> = (0..n).map(|k| ((k as f64) * 1.3).cos()).collect();
     let (m, dm) = (0.05, 0.02);
@@ -251,24 +260,10 @@ fn prestress_tangent_lanes_ride_together_as_alone() {
     // (Dual64) evaluations, one per direction: each lane equal to the
     // bit (every lane gets the operations of a one-lane evaluation, in
     // the same order; the lanes must not see each other).
-    use crate::common::scenes::scene as build;
     use num_dual::Dual64;
     use plyscape::mbs::math::DualN;
-    use plyscape::mbs::{Param, System, Workspace};
-    let model = build(&scene(4.0, 0.05, 8, true)).model;
-    let puller = model
-        .bodies
-        .iter()
-        .position(|b| b.name == "puller")
-        .unwrap();
-    let sys = System::new(model);
-    let mut y = sys.initial_state();
-    let (p, o) = (sys.pos_off(0), sys.vel_off(0));
-    for j in 0..sys.modes[0] {
-        y[p + 7 + j] = 2e-2 / (1 + j) as f64 * if j % 3 == 0 { 1.0 } else { -0.6 };
-        y[o + 6 + j] = 0.1 * ((j as f64) * 0.9).sin();
-    }
-    sys.project(0.0, &mut y).unwrap();
+    use plyscape::mbs::{Param, Workspace};
+    let (_, sys, y, puller) = deformed_pulled_cantilever();
     let n = y.len();
     let dir = |l: usize, k: usize| ((k as f64) * (1.3 + 0.7 * l as f64)).cos();
     let (m, dm) = (0.05, 0.02);
