@@ -1,7 +1,8 @@
 //! Helpers and fixtures shared by the test modules: temporary directories
 //! (`tempfile`), columns of tables by name ([`tables`]), scenes from the
-//! shipped studies or from text ([`scenes`]), and the helpers of the
-//! exploration, modal and SAR tests.
+//! shipped studies or from text ([`scenes`]), the parts of an input error
+//! ([`errors`]), and the helpers of the exploration, modal and SAR tests.
+pub mod errors;
 pub mod explore;
 pub mod modal;
 pub mod sar;

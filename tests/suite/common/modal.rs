@@ -1,11 +1,12 @@
 //! Test problems for the modal tests: spring–mass chains and grids built
-//! from springs, and a dense reference eigen-solver (nalgebra) for small
-//! problems.
+//! from springs, a dense reference eigen-solver (nalgebra) for small
+//! problems, and the crate's solver at a given tolerance.
 #![allow(dead_code)]
 
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 use nalgebra::{DMatrix, SymmetricEigen};
+use plyscape::modal::{ModalOptions, ModalSolver, Modes};
 
 /// A spring between DOFs `a` and `b` (`b = None`: to ground) of stiffness `k`.
 #[derive(Clone, Copy, Debug)]
@@ -128,4 +129,12 @@ pub fn maxabs(a: &[f64]) -> f64 {
 /// Max-norm of a − b.
 pub fn maxdiff(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).fold(0.0, |m, (x, y)| m.max((x - y).abs()))
+}
+
+/// The `n_modes` lowest modes of (K, M) by the crate's solver at
+/// tolerance `tol`.
+pub fn solve(k: &SparseColMat<usize, f64>, mass: &[f64], n_modes: usize, tol: f64) -> Modes {
+    let mut o = ModalOptions::new(n_modes);
+    o.tol = tol;
+    ModalSolver::new(k, mass).unwrap().solve(&o).unwrap()
 }

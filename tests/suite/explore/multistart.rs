@@ -2,7 +2,7 @@
 //! shards, bad input.
 
 use crate::common::explore::{column, ctx, study, table_without};
-use crate::common::temp_dir;
+use crate::common::{errors, temp_dir};
 use plyscape::explore::multistart::Shard;
 use plyscape::explore::{self, DriveFlags};
 
@@ -286,35 +286,28 @@ fn wall_time_budget_stops_cleanly_and_resume_completes() {
     }
 }
 
-fn error_of(text: &str) -> String {
-    let tmp = temp_dir("ms-bad");
-    let dir = tmp.path().to_path_buf();
-    let s = match plyscape::study::Study::parse("bad.toml", text) {
-        Ok(s) => s,
-        Err(e) => return e.to_string(),
-    };
-    let e = explore::run_multistart(&ctx(&s, &dir, 1, DriveFlags::default()))
-        .expect_err("bad input must fail")
-        .to_string();
-    std::fs::remove_dir_all(&dir).unwrap();
-    e
-}
-
 #[test]
 fn bad_study_input_gets_a_clear_error() {
+    let message_of = |text: &str| {
+        let tmp = temp_dir("ms-bad");
+        errors::error_of("bad.toml", text, |s| {
+            explore::run_multistart(&ctx(s, tmp.path(), 1, DriveFlags::default()))
+        })
+        .message
+    };
     let base = "[problem]\nname = \"himmelblau\"\n[multistart]\nmethod = \"steepest\"\n";
-    let e = error_of(&format!("{base}sampler = \"halton\"\nstarts = 4\n"));
+    let e = message_of(&format!("{base}sampler = \"halton\"\nstarts = 4\n"));
     assert_eq!(
         e,
         "bad.toml: `multistart.sampler` = \"halton\": expected one of `lhs`, `sobol`, \
          `uniform` (unknown variant `halton`)"
     );
-    let e = error_of(&format!("{base}starts = 0\n"));
+    let e = message_of(&format!("{base}starts = 0\n"));
     assert!(
         e.contains("multistart.starts") && e.contains("at least one start"),
         "{e}"
     );
-    let e = error_of(
+    let e = message_of(
         "[problem]\nname = \"himmelblau\"\nbounds = [[-5.0, 5.0], [3.0, -3.0]]\n\
          [multistart]\nstarts = 4\n",
     );
@@ -322,14 +315,14 @@ fn bad_study_input_gets_a_clear_error() {
         e.contains("problem.bounds[1]") && e.contains("lower < upper"),
         "{e}"
     );
-    let e = error_of(&format!("[study]\nthreads = 0\n{base}starts = 4\n"));
+    let e = message_of(&format!("[study]\nthreads = 0\n{base}starts = 4\n"));
     assert!(e.contains("study.threads") && e.contains(">= 1"), "{e}");
-    let e = error_of(&format!("{base}starts = 4\npoints = [[9.0, 0.0]]\n"));
+    let e = message_of(&format!("{base}starts = 4\npoints = [[9.0, 0.0]]\n"));
     assert!(
         e.contains("multistart.points[0][0]") && e.contains("[-5, 5]"),
         "{e}"
     );
-    let e = error_of(&format!("{base}starts = 4\nmethod = \"newton\"\n"));
+    let e = message_of(&format!("{base}starts = 4\nmethod = \"newton\"\n"));
     // A key given twice is a TOML error: the file, the line and column of
     // the second one, the line itself and the parser's reason.
     assert!(
@@ -337,14 +330,15 @@ fn bad_study_input_gets_a_clear_error() {
             && e.ends_with("expected valid TOML: duplicate key"),
         "{e}"
     );
-    let e =
-        error_of("[problem]\nname = \"himmelblau\"\n[multistart]\nmethod = \"bfgs\"\nstarts = 4\n");
+    let e = message_of(
+        "[problem]\nname = \"himmelblau\"\n[multistart]\nmethod = \"bfgs\"\nstarts = 4\n",
+    );
     assert_eq!(
         e,
         "bad.toml: `multistart.method` = \"bfgs\": expected `mmfd` or `steepest` \
          (unknown variant `bfgs`)"
     );
-    let e = error_of(&format!("{base}starts = 4\nstrats = 5\n"));
+    let e = message_of(&format!("{base}starts = 4\nstrats = 5\n"));
     assert!(e.contains("multistart") && e.contains("strats"), "{e}");
     // --threads 0 on the command line.
     let common = plyscape::cli::Common {

@@ -1,30 +1,20 @@
-//! Tests of `plyscape::mbs` and the scenes built on it: kernel, joints, loads, flexible bodies, sensitivities, the SAR scenes and the shipped studies.
+//! Tests of `plyscape::mbs` on the scenes built on it: the kernel's
+//! identities, joints, loads, flexible bodies, energy, mechanisms and the
+//! SAR scenes.
 mod andrews;
-mod convergence;
-mod deploy_hinge;
-mod drives;
 mod energy;
-mod events;
 mod flex;
-mod flexible_responses;
 mod free;
-mod input;
 mod joint_prestress;
 mod kernel;
 mod loads;
 mod mechanisms;
 mod prismatic;
-mod responses;
-mod responses_flex;
-mod robust;
 mod sar;
 mod sar_clamp;
 mod sar_flex;
 mod sar_holddown;
-mod scene_convergence;
-mod sens;
 mod slider_crank;
 mod stiffening;
-mod studies;
 mod thickness;
 mod torsion;

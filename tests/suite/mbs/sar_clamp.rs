@@ -9,6 +9,7 @@
 //! and a ply-angle sensitivity of U3 through the screened bases matches
 //! central differences of whole simulations.
 
+use crate::common::sar::CoarseSar;
 use plyscape::sections::support_compare::{compare, reference_of, run_compare, CompareSpec};
 use plyscape::study::Study;
 
@@ -78,33 +79,17 @@ fn centre_clamp_bases_drop_the_drilling_mode() {
 /// per panel; 0–0.5 s at rtol 1e-10) with panel 3's outer plies at
 /// `theta_deg`; `sens`: with the sensitivity to B3.design.theta_1_4.
 fn coarse(theta_deg: f64, sens: bool) -> plyscape::simulate::Simulation {
-    let swap = |t: String, from: &str, to: &str, n: usize| {
-        assert_eq!(t.matches(from).count(), n, "{from:?} in the study");
-        t.replace(from, to)
-    };
-    let mut t = STUDY.to_string();
-    t = swap(t, "divisions = 32", "divisions = 16", 2);
-    t = swap(t, "t_end = 3.0", "t_end = 0.5", 1);
-    t = swap(t, "rtol = 1e-6", "rtol = 1e-10", 1);
-    t = swap(t, "atol = 1e-8", "atol = 1e-12", 1);
-    let sens_line = "sensitivities = [\"B3.design.theta_1_4\", \"B3.design.theta_2_3\", \
-                     \"B2.design.theta_1_4\", \"B2.design.theta_2_3\"]";
-    let new = if sens {
-        "sensitivities = [\"B3.design.theta_1_4\"]"
-    } else {
-        ""
-    };
-    t = swap(t, sens_line, new, 1);
-    let (head, tail) = t.split_once("name = \"panel3\"").expect("panel3 entry");
-    let tail = swap(
-        tail.to_string(),
-        "{ angle = 55.0, thickness",
-        &format!("{{ angle = {theta_deg:.15}, thickness"),
-        2,
-    );
-    let text = format!("{head}name = \"panel3\"{tail}");
-    let study = Study::parse("sar_phase1_centre_clamp.toml", &text).unwrap();
-    let scene = plyscape::scene::load_scene(&study).unwrap();
+    let scene = CoarseSar {
+        text: STUDY,
+        file: "sar_phase1_centre_clamp.toml",
+        divisions: 16,
+        modes: None,
+        panel: 3,
+        theta_deg,
+        sens,
+        flexible: true,
+    }
+    .scene();
     for b in &scene.model.bodies {
         if let Some(f) = &b.flex {
             assert_eq!(f.basis.n_modes, 11, "{}", b.name);

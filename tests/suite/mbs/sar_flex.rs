@@ -9,7 +9,7 @@
 //! The balance and the sensitivity are also checked on the study at full
 //! size (2 × 14 modes on 32 divisions, 0–3 s; a few seconds each).
 
-use crate::common::sar::{coarse_sar, replace};
+use crate::common::sar::{replace, vary_panel, CoarseSar};
 use crate::common::tables::column_index;
 use plyscape::mbs::{Force, PiecewiseLaw};
 use plyscape::scene::load_scene;
@@ -23,35 +23,17 @@ const STUDY: &str = include_str!("../../../studies/sar_phase1_flexible.toml");
 /// sensitivity to B3.design.theta_1_4; `flexible` = false runs the
 /// same scene rigid (no "flexibility" effect).
 fn coarse(theta_deg: f64, sens: bool, flexible: bool) -> Simulation {
-    let mut t = coarse_sar(STUDY, 8, 6);
-    let sens_line = "sensitivities = [\"B3.design.theta_1_4\", \"B3.design.theta_2_3\", \
-                     \"B2.design.theta_1_4\", \"B2.design.theta_2_3\"]";
-    let new_sens = if sens {
-        "sensitivities = [\"B3.design.theta_1_4\"]"
-    } else {
-        ""
+    let sar = CoarseSar {
+        text: STUDY,
+        file: "sar_phase1_flexible.toml",
+        divisions: 8,
+        modes: Some(6),
+        panel: 3,
+        theta_deg,
+        sens,
+        flexible,
     };
-    t = replace(&t, sens_line, new_sens, 1);
-    if !flexible {
-        t = replace(
-            &t,
-            "effects = [\"actuators\", \"damping\", \"flexibility\", \"quadratic_velocity\"]",
-            "effects = [\"actuators\", \"damping\", \"quadratic_velocity\"]",
-            1,
-        );
-    }
-    // Panel 3's plies: the entry after `name = "panel3"`.
-    let (head, tail) = t.split_once("name = \"panel3\"").expect("panel3 entry");
-    let tail = replace(
-        tail,
-        "{ angle = 55.0, thickness",
-        &format!("{{ angle = {theta_deg:.15}, thickness"),
-        2,
-    );
-    let text = format!("{head}name = \"panel3\"{tail}");
-    let study = Study::parse("sar_phase1_flexible.toml", &text).unwrap();
-    let scene = load_scene(&study).unwrap();
-    simulate(&scene).unwrap().1
+    simulate(&sar.scene()).unwrap().1
 }
 
 /// The index of history column `name` (by header prefix).
@@ -234,26 +216,11 @@ fn strain_energy_ply_angle_sensitivity_matches_central_differences() {
 /// sensitivity to B3.design.theta_1_4 (else none); panel 3's outer plies
 /// at `theta_deg`.
 fn full(theta_deg: f64, sens: bool, method: &str, rtol: &str, atol: &str) -> Simulation {
-    let sens_line = "sensitivities = [\"B3.design.theta_1_4\", \"B3.design.theta_2_3\", \
-                     \"B2.design.theta_1_4\", \"B2.design.theta_2_3\"]";
-    let new_sens = if sens {
-        "sensitivities = [\"B3.design.theta_1_4\"]"
-    } else {
-        ""
-    };
-    let mut t = replace(STUDY, sens_line, new_sens, 1);
+    let mut t = vary_panel(STUDY, 3, theta_deg, sens);
     t = replace(&t, "method = \"bdf\"", &format!("method = \"{method}\""), 1);
     t = replace(&t, "rtol = 1e-6", &format!("rtol = {rtol}"), 1);
     t = replace(&t, "atol = 1e-8", &format!("atol = {atol}"), 1);
-    let (head, tail) = t.split_once("name = \"panel3\"").expect("panel3 entry");
-    let tail = replace(
-        tail,
-        "{ angle = 55.0, thickness",
-        &format!("{{ angle = {theta_deg:.15}, thickness"),
-        2,
-    );
-    let text = format!("{head}name = \"panel3\"{tail}");
-    let study = Study::parse("sar_phase1_flexible.toml", &text).unwrap();
+    let study = Study::parse("sar_phase1_flexible.toml", &t).unwrap();
     simulate(&load_scene(&study).unwrap()).unwrap().1
 }
 

@@ -9,13 +9,12 @@
 //! gradient of panel 2's part of Ψ₀ matches central differences of whole
 //! simulations.
 
-use crate::common::sar::{coarse_sar, replace};
+use crate::common::sar::CoarseSar;
 use crate::common::tables::column_index;
 use nalgebra::DMatrix;
 use plyscape::mbs::{Force, System, Workspace};
-use plyscape::scene::{load_scene, Scene};
+use plyscape::scene::Scene;
 use plyscape::simulate::{simulate, Simulation};
-use plyscape::study::Study;
 
 const STUDY: &str = include_str!("../../../studies/sar_phase1_holddown.toml");
 
@@ -23,26 +22,17 @@ const STUDY: &str = include_str!("../../../studies/sar_phase1_holddown.toml");
 /// 2's outer plies (1 and 4) at `theta_deg`; `sens` = with the one
 /// sensitivity lane B2.design.theta_1_4.
 fn coarse(theta_deg: f64, sens: bool) -> Scene {
-    let mut t = coarse_sar(STUDY, 16, 6);
-    let lanes = "sensitivities = [\"B3.design.theta_1_4\", \"B3.design.theta_2_3\", \
-                 \"B2.design.theta_1_4\", \"B2.design.theta_2_3\"]";
-    let lane = if sens {
-        "sensitivities = [\"B2.design.theta_1_4\"]"
-    } else {
-        ""
-    };
-    t = replace(&t, lanes, lane, 1);
-    // Panel 2's plies: the entry after `name = "panel2"`, before panel 3.
-    let (head, tail) = t.split_once("name = \"panel2\"").expect("panel2 entry");
-    let (p2, p3) = tail.split_once("[[panels]]").expect("panel3 entry");
-    let p2 = replace(
-        p2,
-        "{ angle = 55.0, thickness",
-        &format!("{{ angle = {theta_deg:.15}, thickness"),
-        2,
-    );
-    let text = format!("{head}name = \"panel2\"{p2}[[panels]]{p3}");
-    load_scene(&Study::parse("sar_phase1_holddown.toml", &text).unwrap()).unwrap()
+    CoarseSar {
+        text: STUDY,
+        file: "sar_phase1_holddown.toml",
+        divisions: 16,
+        modes: Some(6),
+        panel: 2,
+        theta_deg,
+        sens,
+        flexible: true,
+    }
+    .scene()
 }
 
 fn run(scene: &Scene) -> Simulation {

@@ -1,6 +1,6 @@
 //! Ply thickness as a scene sensitivity parameter
 //! (`<body>.design.thickness_<plies>`): the swung centre-clamped panel of
-//! `mbs/flex.rs`, its strain energy and modal coordinates at 0.4 s
+//! `mbs/flex/sensitivities.rs`, its strain energy and modal coordinates at 0.4 s
 //! differentiated along the thickness of ply 1 (stiffness and mass both
 //! move), against central differences of whole simulations with the
 //! basis rebuilt at t ± h.

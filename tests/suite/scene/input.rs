@@ -1,10 +1,10 @@
 //! Scene input errors (one clear error each, naming file, key and value),
 //! the effects list (what is not listed is not built), and the
 //! `plyscape simulate` command end to end.
+use crate::common::errors::{error_of, InputError};
 use plyscape::scene::load_scene;
 use plyscape::simulate::simulate;
 use plyscape::study::Study;
-use plyscape::Error;
 
 /// A small valid scene: a pendulum rod on a revolute joint.
 const BASE: &str = r#"
@@ -31,18 +31,6 @@ dt_out = 0.1
 [scene.outputs]
 quantities = ["pin.angle"]
 "#;
-
-fn error_of(text: &str) -> (String, String, String) {
-    let study = Study::parse("bad.toml", text).unwrap();
-    let r =
-        load_scene(&study).and_then(|s| simulate(&s).map(|_| ()).map_err(study.locate("scene")));
-    match r {
-        Err(Error::Input {
-            file, key, value, ..
-        }) => (file, key, value),
-        other => panic!("expected an input error, got {other:?}"),
-    }
-}
 
 #[test]
 fn base_scene_runs() {
@@ -97,27 +85,20 @@ fn each_bad_input_names_file_key_and_value() {
     ];
     for (text, key, value) in cases {
         println!("case {key}");
-        let (file, k, v) = error_of(&text);
+        let InputError {
+            file,
+            key: k,
+            value: v,
+            ..
+        } = error_of("bad.toml", &text, |study| {
+            load_scene(study).and_then(|s| simulate(&s).map(|_| ()).map_err(study.locate("scene")))
+        });
         assert_eq!(file, "bad.toml");
         assert_eq!(k, key, "value {v}");
         assert!(
             v.contains(value),
             "key {k}: value {v} should contain {value}"
         );
-    }
-}
-
-/// The whole input error of `text`: (file, key, value, expected).
-fn full_error_of(text: &str) -> (String, String, String, String) {
-    let study = Study::parse("bad.toml", text).unwrap();
-    match load_scene(&study) {
-        Err(Error::Input {
-            file,
-            key,
-            value,
-            expected,
-        }) => (file, key, value, expected),
-        other => panic!("expected an input error, got {other:?}"),
     }
 }
 
@@ -218,7 +199,13 @@ fn force_and_response_errors_name_key_value_and_the_expected_values() {
         ),
     ];
     for (text, key, value, expected) in cases {
-        let (file, k, v, e) = full_error_of(&text);
+        let InputError {
+            file,
+            key: k,
+            value: v,
+            expected: e,
+            ..
+        } = error_of("bad.toml", &text, load_scene);
         println!("{file}: {k} = {v}: expected {e}");
         assert_eq!(file, "bad.toml");
         assert_eq!(k, key, "value {v}");

@@ -1,11 +1,10 @@
 //! Driven joints with a piecewise law or a table (`drive = { pieces = .. }`,
 //! `drive = { table = .. }`): the rotor follows the law and the joint's
 //! torque is `I θ̈`; bad laws name file, dotted key, value and expectation.
+use crate::common::errors::{error_of, InputError};
 use crate::common::scenes::{column, scene};
 use plyscape::scene::load_scene;
 use plyscape::simulate::simulate;
-use plyscape::study::Study;
-use plyscape::Error;
 use std::f64::consts::PI;
 
 /// A rotor (I_zz = 0.3 kg·m² about its centre, on the axis) driven about z
@@ -152,24 +151,21 @@ fn polynomial_drive_is_unchanged() {
     );
 }
 
-fn error_of(drive: &str) -> (String, String, String, String) {
+/// The input error of the rotor scene driven by `drive`.
+fn bad_drive(drive: &str) -> InputError {
     let text = format!("[study]\nname = \"d\"\n{}", ROTOR.replace("DRIVE", drive));
-    let study = Study::parse("drive.toml", &text).unwrap();
-    match load_scene(&study) {
-        Err(Error::Input {
-            file,
-            key,
-            value,
-            expected,
-        }) => (file, key, value, expected),
-        other => panic!("expected an input error, got {other:?}"),
-    }
+    error_of("drive.toml", &text, load_scene)
 }
 
 #[test]
 fn bad_drives_name_file_key_value_and_expectation() {
-    let (file, key, value, expected) =
-        error_of("{ pieces = [ { until = 1.0, poly = [0.0, 1.0] }, { poly = [1.2, 1.0] } ] }");
+    let InputError {
+        file,
+        key,
+        value,
+        expected,
+        ..
+    } = bad_drive("{ pieces = [ { until = 1.0, poly = [0.0, 1.0] }, { poly = [1.2, 1.0] } ] }");
     assert_eq!(file, "drive.toml");
     assert_eq!(key, "scene.joints[0].drive.pieces[1]");
     assert!(
@@ -181,27 +177,36 @@ fn bad_drives_name_file_key_value_and_expectation() {
         "{expected}"
     );
 
-    let (_, key, value, expected) =
-        error_of("{ pieces = [ { poly = [0.0, 1.0] }, { poly = [1.0, 1.0] } ] }");
+    let InputError {
+        key,
+        value,
+        expected,
+        ..
+    } = bad_drive("{ pieces = [ { poly = [0.0, 1.0] }, { poly = [1.0, 1.0] } ] }");
     assert_eq!(
         (key.as_str(), value.as_str()),
         ("scene.joints[0].drive.pieces[0].until", "(missing)")
     );
     assert!(expected.contains("every piece but the last"), "{expected}");
 
-    let (_, key, value, expected) =
-        error_of("{ table = [[0.0, 0.0], [1.0, 1.0], [0.9, 1.0], [2.0, 0.0]] }");
+    let InputError {
+        key,
+        value,
+        expected,
+        ..
+    } = bad_drive("{ table = [[0.0, 0.0], [1.0, 1.0], [0.9, 1.0], [2.0, 0.0]] }");
     assert_eq!(
         (key.as_str(), value.as_str()),
         ("scene.joints[0].drive.table[2]", "[0.9, 1.0]")
     );
     assert!(expected.contains("strictly increasing"), "{expected}");
 
-    let (_, key, _, expected) = error_of("{ pieces = [ { poly = [0.0], until_t = 1.0 } ] }");
+    let InputError { key, expected, .. } =
+        bad_drive("{ pieces = [ { poly = [0.0], until_t = 1.0 } ] }");
     assert_eq!(key, "scene.joints[0].drive.pieces[0].until_t");
     assert!(expected.contains("until"), "{expected}");
 
-    let (_, key, _, expected) = error_of("\"fast\"");
+    let InputError { key, expected, .. } = bad_drive("\"fast\"");
     assert_eq!(key, "scene.joints[0].drive");
     assert!(expected.contains("{ pieces = [..] }"), "{expected}");
 }

@@ -1,0 +1,179 @@
+//! MMFD's steps at work: the fitted line search's function calls on the
+//! Hock–Schittkowski problems and the SAR problem, the restoration ending
+//! only where the violation is stationary, and the polish's slope search.
+//!
+//! Call counts are snapshots of the current implementation (like diffsol's
+//! solver statistics): a change that makes MMFD slower fails here and must
+//! update the numbers knowingly.
+
+use plyscape::optimize::mmfd::{self, MmfdOptions};
+use plyscape::optimize::testproblems::{self as tp, Analytic};
+use plyscape::optimize::{History, Problem, Termination};
+
+/// The line search's frugality on the Hock–Schittkowski problems of
+/// `benches/mmfd_peers.rs` with DOT's defaults (issue 23): at most 79
+/// function calls in all (110 with the first line search,
+/// results/mmfd_peers/line_search_before.csv, counted then with a call
+/// for every evaluation), a median of at most 2 function calls per
+/// gradient call (the issue's target; 3.17 before), and every optimum to
+/// 3.1e-4 relative in f (the published optima are cited in
+/// `plyscape::optimize::testproblems`).
+#[test]
+fn hs_function_calls_with_the_fitted_step() {
+    let d = MmfdOptions::default();
+    let mut ratios = Vec::new();
+    let mut total = 0;
+    for p in [tp::hs21(), tp::hs35(), tp::hs43(), tp::hs76(), tp::hs100()] {
+        let o = mmfd::minimize(&p, &p.x0, &d, &mut History::default()).unwrap();
+        let rel = (o.f - p.f_opt).abs() / p.f_opt.abs().max(1.0);
+        // DOT's change exits (DELOBJ 1e-3) stop HS 100 in its flat
+        // valley at 3.1e-4 (2.0e-4 with the first line search); the polish
+        // takes it to 2e-9 (results/mmfd_peers).
+        assert!(rel <= 3.1e-4, "{}: rel {rel:.3e}", p.name());
+        println!(
+            "{}: {} f, {} g, rel {rel:.3e}",
+            p.name(),
+            o.function_calls,
+            o.gradient_calls
+        );
+        total += o.function_calls;
+        ratios.push(o.function_calls as f64 / o.gradient_calls as f64);
+    }
+    ratios.sort_by(f64::total_cmp);
+    assert!(total <= 79, "{total} function calls");
+    assert!(ratios[2] <= 2.0, "median {} ({ratios:?})", ratios[2]);
+}
+
+/// The paper's problem (studies/sar_optimize.toml, full model) from its
+/// start 55°/−55° with DOT's defaults, as the study's first MMFD run:
+/// at most 16 function and 5 gradient calls (issue 23's target; 24 f + 5 g
+/// with the first line search, 12 f + 5 g measured), and the best design
+/// known, found independently by IPOP-CMA-ES and made strictly feasible
+/// by the polish (the first sweep's results/sar_explore/comparison.csv, of
+/// 2026-11-26 in the repository's history, row `cmaes,strict`:
+/// 50.95189259307°/−48.92301018699°, f = 0.9089481415), to 0.01° and 1e-6
+/// in f. (The sweep of 2026-11-27 ends all three methods at
+/// 50.9497°/−48.9097°, f = 0.90894853: the same optimum within the
+/// evaluation noise.) About 2 s in release.
+#[test]
+fn sar_from_55_minus_55_in_16_function_and_5_gradient_calls() {
+    let study = plyscape::study::Study::load("studies/sar_optimize.toml").unwrap();
+    let p = plyscape::explore::problem(&study).unwrap();
+    let o = mmfd::minimize(
+        p.as_ref(),
+        &[55.0, -55.0],
+        &MmfdOptions::default(),
+        &mut History::default(),
+    )
+    .unwrap();
+    println!(
+        "SAR: {:?} f = {:.10} g = {:?}, {} f + {} g, {}",
+        o.x, o.f, o.g, o.function_calls, o.gradient_calls, o.termination
+    );
+    assert!(o.function_calls <= 16 && o.gradient_calls <= 5, "{o:?}");
+    assert!(
+        (o.x[0] - 50.95189259307).abs() < 0.01 && (o.x[1] + 48.92301018699).abs() < 0.01,
+        "{o:?}"
+    );
+    assert!((o.f - 0.9089481415).abs() < 1e-6, "{o:?}");
+    assert!(o.g[0] <= MmfdOptions::default().ctmin, "{o:?}");
+}
+
+/// The restoration on a violation with many local minima
+/// (`testproblems::ripple`, SAR-like): from a 12 × 12 grid of starts on the
+/// torus, every run that ends infeasible ends at a stationary point of the
+/// violation (its Kuhn–Tucker test, `optimize::kkt`), and MMFD reaches the
+/// feasible set from at least as many starts as a pure steepest descent on
+/// the violation (`explore::violation::descend`) from the same starts.
+/// Before restorations that stall switched to descent on the violation, a
+/// stall rule (three Newton restorations lowering the violation by less
+/// than 1 %) ended runs at non-stationary points here (residuals up to
+/// 1.8e-2). Measured: 44 and 32 of 144 starts reach the feasible set.
+#[test]
+fn restoration_ends_only_where_the_violation_is_stationary() {
+    use plyscape::explore::violation::descend;
+    use plyscape::optimize::kkt::{certify_at, KktTolerances};
+    let p = tp::ripple();
+    let d = MmfdOptions::default();
+    let n = 12;
+    let (mut feasible_mmfd, mut feasible_descent) = (0, 0);
+    let pi = std::f64::consts::PI;
+    for i in 0..n {
+        for j in 0..n {
+            let at = |k: usize| -pi + (k as f64 + 0.5) * 2.0 * pi / n as f64;
+            let x0 = [at(i), at(j)];
+            let o = mmfd::minimize(&p, &x0, &d, &mut plyscape::optimize::NoObserver).unwrap();
+            if o.g[0] <= d.ctmin {
+                feasible_mmfd += 1;
+            } else {
+                assert_eq!(o.termination, Termination::Infeasible, "{x0:?}");
+                let (_, c) = certify_at(&p, &o.x, &KktTolerances::default()).unwrap();
+                assert_eq!(
+                    c.violation_stationary,
+                    Some(true),
+                    "{x0:?} ends at {:?}, residual {:?}",
+                    o.x,
+                    c.violation_residual
+                );
+            }
+            if descend(&p, &x0, d.ctmin).unwrap().1.max_g() <= d.ctmin {
+                feasible_descent += 1;
+            }
+        }
+    }
+    assert!(
+        feasible_mmfd >= feasible_descent,
+        "{feasible_mmfd} vs {feasible_descent}"
+    );
+    assert_eq!((feasible_mmfd, feasible_descent), (44, 32));
+}
+
+/// The polish's slope search (module doc of `optimize::mmfd`, step 5b)
+/// leaves an end that an f-based line search cannot: the start (0.3003,
+/// −0.1999) of `f = (x1 − 0.3)² + (x2 + 0.2)²` sits 5e-7 below every other
+/// design (a jump of f's noise in its favour, as MMFD's ends on the SAR
+/// problem sit where the adaptive integrator's step sequence favours
+/// them), while the exact gradient still points to the minimum at
+/// (0.3, −0.2): the best decrease, 1e-7, is below the noise.
+#[test]
+fn the_polish_leaves_a_noise_minimum_by_the_slope() {
+    const X0: [f64; 2] = [0.3003, -0.1999];
+    fn k(x: &[f64]) -> (f64, Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+        let noise = if x == X0 { 0.0 } else { 5e-7 };
+        let (a, b) = (x[0] - 0.3, x[1] + 0.2);
+        (
+            a * a + b * b + noise,
+            vec![],
+            vec![2.0 * a, 2.0 * b],
+            vec![],
+        )
+    }
+    let p = Analytic {
+        name: "noisy bowl".into(),
+        variables: vec![
+            plyscape::optimize::Variable::bounded("x1", -1.0, 1.0).unwrap(),
+            plyscape::optimize::Variable::bounded("x2", -1.0, 1.0).unwrap(),
+        ],
+        n_constraints: 0,
+        kernel: k,
+        x0: X0.to_vec(),
+        optima: vec![vec![0.3, -0.2]],
+        f_opt: 5e-7,
+    };
+    // Scaled gradient at the start: 2 (range) × 2 × (3e-4, 1e-4), |.| =
+    // 1.26e-3, above the polish's Kuhn–Tucker exit 5e-5.
+    let f_based = MmfdOptions {
+        slope_search: false,
+        ..MmfdOptions::polish()
+    };
+    let o = mmfd::minimize(&p, &X0, &f_based, &mut History::default()).unwrap();
+    assert_eq!(o.termination, Termination::NoFeasibleDirection, "{o:?}");
+    assert_eq!(o.x, X0.to_vec());
+    let o = mmfd::minimize(&p, &X0, &MmfdOptions::polish(), &mut History::default()).unwrap();
+    assert_eq!(o.termination, Termination::KuhnTucker, "{o:?}");
+    // |∇f| scaled <= 5e-5 means |x − x*| <= 1.25e-5.
+    assert!(
+        (o.x[0] - 0.3).abs() < 1.3e-5 && (o.x[1] + 0.2).abs() < 1.3e-5,
+        "{o:?}"
+    );
+}

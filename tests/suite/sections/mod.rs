@@ -1,0 +1,4 @@
+//! Tests of `plyscape::sections`: the shipped studies through
+//! `plyscape run`, the `[kernel_bench]` and `[scene_convergence]` drivers.
+mod scene_convergence;
+mod studies;
