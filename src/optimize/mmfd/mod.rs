@@ -122,6 +122,8 @@ mod geometry;
 mod options;
 mod restore;
 mod search;
+#[cfg(test)]
+mod tests;
 
 /// A design with its scaled gradients of f and of the constraints.
 type Secant = (Vec<f64>, Vec<f64>, Vec<Vec<f64>>);
