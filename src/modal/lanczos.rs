@@ -27,7 +27,7 @@
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
-use nalgebra::{DMatrix, SymmetricEigen};
+use nalgebra::{DMatrix, Dyn, SymmetricEigen};
 
 use super::modes::ModalOptions;
 use super::sparse::{Factor, Pencil};
@@ -212,187 +212,286 @@ pub(crate) fn block_lanczos(
     opts: &ModalOptions,
     want: usize,
 ) -> Result<LanczosOut> {
-    let n = pencil.n();
-    let mass = pencil.mass();
-    let p = opts.block_size.clamp(1, n);
-    let m_max = opts
-        .max_basis
-        .unwrap_or(3 * want + 4 * p + 8)
-        .max(want + 2 * p)
-        .min(n);
-    let cap = m_max + p;
-    let mut v = Mat::<f64>::zeros(n, cap);
-    let mut h = Mat::<f64>::zeros(cap, cap);
-    let mut solves = 0usize;
-    let mut restarts = 0usize;
-    let mut basis = 0usize;
-    let mut dim = 0usize;
-    let mut salt = 0usize;
-    // First basis column of the previous block: the first CGS pass runs
-    // against `local..dim` only (full after a restart or fresh block).
-    let mut local = 0usize;
-    let mut q = fresh_block(v.as_ref().subcols(0, 0), mass, p, salt, factor, &mut solves);
+    let mut run = Lanczos::new(pencil, factor, opts, want);
+    let mut q = run.fresh_block();
     loop {
-        // Place the block and apply the operator.
+        let (step, mut q_next) = run.extend(&q)?;
+        // Rayleigh–Ritz (a dense eigen-decomposition of H, the dominant
+        // cost per step after the solves) only from twice the wanted count:
+        // at tol 1e-10 the wanted pairs converge well after that (the SAR
+        // panel at dimension ~3k), so earlier checks would only cost time.
+        let exhausted = run.dim == run.n;
+        let check_from = 2 * want;
+        let next = q_next.ncols();
+        if run.dim < check_from && !exhausted && next > 0 && run.dim + next <= run.m_max {
+            q = q_next;
+            run.local = step.start;
+            continue;
+        }
+        let ritz = run.rayleigh_ritz();
+        let need = want.min(run.dim);
+        let converged = run.dim >= want
+            && ritz.order[..need].iter().all(|&c| {
+                let th = ritz.eig.eigenvalues[c];
+                th > 0.0 && ritz.residual(&step, c) <= opts.tol * th
+            });
+        if converged || exhausted {
+            return run.finish(&ritz);
+        }
+        if q_next.ncols() == 0 {
+            // Invariant subspace: continue with fresh directions.
+            run.salt += run.p;
+            q_next = run.fresh_block();
+        }
+        if run.dim + q_next.ncols() > run.m_max {
+            run.restart(&ritz, &step, q_next.ncols())?;
+        }
+        q = q_next;
+    }
+}
+
+/// One Lanczos run: the basis `V` (`n × dim` in use), the projected matrix
+/// `H` and the counts reported in [`LanczosOut`].
+struct Lanczos<'a, 'f, 'p> {
+    mass: &'a [f64],
+    factor: &'f mut Factor<'p>,
+    opts: &'a ModalOptions,
+    want: usize,
+    n: usize,
+    /// Block size.
+    p: usize,
+    /// Largest basis dimension; beyond it the basis restarts.
+    m_max: usize,
+    v: Mat<f64>,
+    h: Mat<f64>,
+    dim: usize,
+    solves: usize,
+    restarts: usize,
+    basis: usize,
+    /// Offset of the start-value sequence of the next fresh block.
+    salt: usize,
+    /// First basis column of the previous block: the first CGS pass runs
+    /// against `local..dim` only (full after a restart or fresh block).
+    local: usize,
+}
+
+/// The block a step added to the basis and its coupling to the next.
+struct Step {
+    /// Its first column in the basis.
+    start: usize,
+    /// Its width.
+    pb: usize,
+    /// The coupling `B` to the next block (`next × pb`).
+    b: Mat<f64>,
+}
+
+/// Rayleigh–Ritz on `H`: its eigen-decomposition and the order of its
+/// eigenvalues, largest θ first (ties by index keep the result
+/// deterministic).
+struct Ritz {
+    eig: SymmetricEigen<f64, Dyn>,
+    order: Vec<usize>,
+}
+
+impl Ritz {
+    /// The residual `‖B y_last‖` of the Ritz pair of column `col`, with
+    /// `y_last` its entries on the last block.
+    fn residual(&self, step: &Step, col: usize) -> f64 {
+        let b = &step.b;
+        let mut s = 0.0;
+        for r in 0..b.nrows() {
+            let mut t = 0.0;
+            for c in 0..step.pb {
+                t += b[(r, c)] * self.eig.eigenvectors[(step.start + c, col)];
+            }
+            s += t * t;
+        }
+        s.sqrt()
+    }
+
+    /// The Ritz vectors `V y` of the `count` largest θ.
+    fn vectors(&self, v: MatRef<'_, f64>, count: usize) -> Mat<f64> {
+        let dim = v.ncols();
+        let y = Mat::<f64>::from_fn(dim, count, |i, j| self.eig.eigenvectors[(i, self.order[j])]);
+        let mut out = Mat::<f64>::zeros(v.nrows(), count);
+        matmul(out.as_mut(), Accum::Replace, v, y.as_ref(), 1.0, Par::Seq);
+        out
+    }
+}
+
+impl<'a, 'f, 'p> Lanczos<'a, 'f, 'p> {
+    fn new(
+        pencil: &'a Pencil,
+        factor: &'f mut Factor<'p>,
+        opts: &'a ModalOptions,
+        want: usize,
+    ) -> Self {
+        let n = pencil.n();
+        let p = opts.block_size.clamp(1, n);
+        let m_max = opts
+            .max_basis
+            .unwrap_or(3 * want + 4 * p + 8)
+            .max(want + 2 * p)
+            .min(n);
+        let cap = m_max + p;
+        Lanczos {
+            mass: pencil.mass(),
+            factor,
+            opts,
+            want,
+            n,
+            p,
+            m_max,
+            v: Mat::<f64>::zeros(n, cap),
+            h: Mat::<f64>::zeros(cap, cap),
+            dim: 0,
+            solves: 0,
+            restarts: 0,
+            basis: 0,
+            salt: 0,
+            local: 0,
+        }
+    }
+
+    /// A fresh block M-orthogonal to the basis ([`fresh_block`]).
+    fn fresh_block(&mut self) -> Mat<f64> {
+        fresh_block(
+            self.v.as_ref().subcols(0, self.dim),
+            self.mass,
+            self.p,
+            self.salt,
+            self.factor,
+            &mut self.solves,
+        )
+    }
+
+    /// Place the block `q` in the basis, apply the operator to it and
+    /// orthogonalise the result (its coefficients are the block's columns
+    /// of `H`); returns the step and the next block.
+    fn extend(&mut self, q: &Mat<f64>) -> Result<(Step, Mat<f64>)> {
+        let (n, mass) = (self.n, self.mass);
         let pb = q.ncols();
         if pb == 0 {
             return Err(Error::numerical(
                 "modal::lanczos",
-                format!("no new direction found at basis dimension {dim} of {n}"),
+                format!(
+                    "no new direction found at basis dimension {} of {n}",
+                    self.dim
+                ),
             ));
         }
-        let start = dim;
-        v.as_mut().subcols_mut(start, pb).copy_from(q.as_ref());
-        dim += pb;
-        basis = basis.max(dim);
+        let start = self.dim;
+        self.v.as_mut().subcols_mut(start, pb).copy_from(q.as_ref());
+        self.dim += pb;
+        self.basis = self.basis.max(self.dim);
         let mut w = q.clone();
-        apply_op(factor, mass, w.as_mut());
-        solves += pb;
+        apply_op(self.factor, mass, w.as_mut());
+        self.solves += pb;
         let ref_norm: Vec<f64> = (0..pb)
             .map(|c| {
                 let col = col_slice(w.as_ref(), c);
                 m_dot(mass, col, col).sqrt()
             })
             .collect();
-        let coef = cgs2(v.as_ref().subcols(0, dim), mass, w.as_mut(), local);
+        let coef = cgs2(
+            self.v.as_ref().subcols(0, self.dim),
+            mass,
+            w.as_mut(),
+            self.local,
+        );
         for j in 0..pb {
-            for i in 0..dim {
-                h[(i, start + j)] = coef[(i, j)];
+            for i in 0..self.dim {
+                self.h[(i, start + j)] = coef[(i, j)];
             }
         }
-        let (mut q_next, b) = block_qr(w.as_ref(), mass, &ref_norm);
-        let local_next = start;
+        let (q_next, b) = block_qr(w.as_ref(), mass, &ref_norm);
+        Ok((Step { start, pb, b }, q_next))
+    }
 
-        // Rayleigh–Ritz (a dense eigen-decomposition of H, the dominant
-        // cost per step after the solves) only from twice the wanted count:
-        // at tol 1e-10 the wanted pairs converge well after that (the SAR
-        // panel at dimension ~3k), so earlier checks would only cost time.
-        let exhausted = dim == n;
-        let check_from = 2 * want;
-        if dim < check_from && !exhausted && q_next.ncols() > 0 && dim + q_next.ncols() <= m_max {
-            q = q_next;
-            local = local_next;
-            continue;
-        }
-
-        // Rayleigh–Ritz on the symmetric part (upper triangle is computed).
+    /// Rayleigh–Ritz on the symmetric part of `H` (its upper triangle is
+    /// computed).
+    fn rayleigh_ritz(&self) -> Ritz {
+        let (dim, h) = (self.dim, &self.h);
         let hs =
             DMatrix::<f64>::from_fn(dim, dim, |i, j| if i <= j { h[(i, j)] } else { h[(j, i)] });
         let eig = SymmetricEigen::new(hs);
         let mut order: Vec<usize> = (0..dim).collect();
-        // Largest θ first; ties by index keep the result deterministic.
         order.sort_by(|&a, &c| {
             eig.eigenvalues[c]
                 .total_cmp(&eig.eigenvalues[a])
                 .then(a.cmp(&c))
         });
-        let estimate = |col: usize| -> f64 {
-            let mut s = 0.0;
-            for r in 0..b.nrows() {
-                let mut t = 0.0;
-                for c in 0..pb {
-                    t += b[(r, c)] * eig.eigenvectors[(start + c, col)];
-                }
-                s += t * t;
-            }
-            s.sqrt()
-        };
-        let need = want.min(dim);
-        let converged = dim >= want
-            && order[..need].iter().all(|&c| {
-                let th = eig.eigenvalues[c];
-                th > 0.0 && estimate(c) <= opts.tol * th
-            });
-        if converged || exhausted {
-            if dim < want {
-                return Err(Error::numerical(
-                    "modal::lanczos",
-                    format!("basis exhausted at dimension {dim} < {want} wanted modes"),
-                ));
-            }
-            let y = Mat::<f64>::from_fn(dim, want, |i, j| eig.eigenvectors[(i, order[j])]);
-            let mut vectors = Mat::<f64>::zeros(n, want);
-            matmul(
-                vectors.as_mut(),
-                Accum::Replace,
-                v.as_ref().subcols(0, dim),
-                y.as_ref(),
-                1.0,
-                Par::Seq,
-            );
-            let mut lambda = Vec::with_capacity(want);
-            for &c in &order[..want] {
-                let th = eig.eigenvalues[c];
-                if th <= 0.0 || !th.is_finite() {
-                    return Err(Error::numerical(
-                        "modal::lanczos",
-                        format!(
-                            "Ritz value theta = {th:e} of (K - sigma M)^-1 M is not positive \
-                             (shift sigma = {:e})",
-                            opts.shift
-                        ),
-                    ));
-                }
-                lambda.push(opts.shift + 1.0 / th);
-            }
-            return Ok(LanczosOut {
-                lambda,
-                vectors,
-                solves,
-                restarts,
-                basis,
-            });
-        }
+        Ritz { eig, order }
+    }
 
-        if q_next.ncols() == 0 {
-            // Invariant subspace: continue with fresh directions.
-            salt += p;
-            q_next = fresh_block(
-                v.as_ref().subcols(0, dim),
-                mass,
-                p,
-                salt,
-                factor,
-                &mut solves,
-            );
+    /// The wanted eigenpairs `λ = σ + 1/θ` from the converged (or
+    /// exhausted) basis.
+    fn finish(&self, ritz: &Ritz) -> Result<LanczosOut> {
+        let (dim, want, opts) = (self.dim, self.want, self.opts);
+        if dim < want {
+            return Err(Error::numerical(
+                "modal::lanczos",
+                format!("basis exhausted at dimension {dim} < {want} wanted modes"),
+            ));
         }
-
-        if dim + q_next.ncols() > m_max {
-            restarts += 1;
-            if restarts > opts.max_restarts {
-                let worst = order[..need]
-                    .iter()
-                    .map(|&c| estimate(c) / eig.eigenvalues[c].abs())
-                    .fold(0.0, f64::max);
+        let vectors = ritz.vectors(self.v.as_ref().subcols(0, dim), want);
+        let mut lambda = Vec::with_capacity(want);
+        for &c in &ritz.order[..want] {
+            let th = ritz.eig.eigenvalues[c];
+            if th <= 0.0 || !th.is_finite() {
                 return Err(Error::numerical(
                     "modal::lanczos",
                     format!(
-                        "no convergence after {} restarts (basis {m_max}, block {p}): worst \
-                         relative Ritz residual {worst:e} > tol {:e}",
-                        opts.max_restarts, opts.tol
+                        "Ritz value theta = {th:e} of (K - sigma M)^-1 M is not positive \
+                         (shift sigma = {:e})",
+                        opts.shift
                     ),
                 ));
             }
-            // Keep the wanted Ritz vectors plus a block of the next ones.
-            let keep = (want + p).min(dim).min(m_max - q_next.ncols());
-            let y = Mat::<f64>::from_fn(dim, keep, |i, j| eig.eigenvectors[(i, order[j])]);
-            let mut kept = Mat::<f64>::zeros(n, keep);
-            matmul(
-                kept.as_mut(),
-                Accum::Replace,
-                v.as_ref().subcols(0, dim),
-                y.as_ref(),
-                1.0,
-                Par::Seq,
-            );
-            v.as_mut().subcols_mut(0, keep).copy_from(kept.as_ref());
-            h.fill(0.0);
-            for (j, &c) in order[..keep].iter().enumerate() {
-                h[(j, j)] = eig.eigenvalues[c];
-            }
-            dim = keep;
-            local = 0;
+            lambda.push(opts.shift + 1.0 / th);
         }
-        q = q_next;
+        Ok(LanczosOut {
+            lambda,
+            vectors,
+            solves: self.solves,
+            restarts: self.restarts,
+            basis: self.basis,
+        })
+    }
+
+    /// Thick restart before a block of `incoming` columns: keep the wanted
+    /// Ritz vectors plus a block of the next ones, with `H` their diagonal
+    /// of θ. An error after `max_restarts`.
+    fn restart(&mut self, ritz: &Ritz, step: &Step, incoming: usize) -> Result<()> {
+        let (dim, want, p, m_max) = (self.dim, self.want, self.p, self.m_max);
+        self.restarts += 1;
+        if self.restarts > self.opts.max_restarts {
+            let need = want.min(dim);
+            let worst = ritz.order[..need]
+                .iter()
+                .map(|&c| ritz.residual(step, c) / ritz.eig.eigenvalues[c].abs())
+                .fold(0.0, f64::max);
+            return Err(Error::numerical(
+                "modal::lanczos",
+                format!(
+                    "no convergence after {} restarts (basis {m_max}, block {p}): worst \
+                     relative Ritz residual {worst:e} > tol {:e}",
+                    self.opts.max_restarts, self.opts.tol
+                ),
+            ));
+        }
+        let keep = (want + p).min(dim).min(m_max - incoming);
+        let kept = ritz.vectors(self.v.as_ref().subcols(0, dim), keep);
+        self.v
+            .as_mut()
+            .subcols_mut(0, keep)
+            .copy_from(kept.as_ref());
+        self.h.fill(0.0);
+        for (j, &c) in ritz.order[..keep].iter().enumerate() {
+            self.h[(j, j)] = ritz.eig.eigenvalues[c];
+        }
+        self.dim = keep;
+        self.local = 0;
+        Ok(())
     }
 }

@@ -280,6 +280,8 @@ pub fn by_name(name: &str) -> Option<MoAnalytic> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::optimize::multiobjective::{EpsilonConstraint, Oriented, Tchebycheff};
+    use crate::optimize::Problem;
 
     fn check_gradients(p: &MoAnalytic, x: &[f64]) {
         let e = p.evaluate(x, true).unwrap();
@@ -353,5 +355,76 @@ mod tests {
         assert_eq!(gaps, 4);
         let end = z.windows(2).find(|w| w[1][0] - w[0][0] > 0.01).unwrap()[0][0];
         assert!((end - 0.0830).abs() < 2e-4, "{end}");
+    }
+
+    // The scalarizations of `multiobjective` on these problems.
+
+    /// Central differences of every objective and constraint of a
+    /// scalarization against its exact gradients.
+    fn check_scalarization(p: &dyn Problem, x: &[f64]) {
+        let e = p.evaluate(x, true).unwrap();
+        let (gf, gg) = (e.grad_f.unwrap(), e.grad_g.unwrap());
+        for i in 0..x.len() {
+            let h = 1e-6;
+            let (mut a, mut b) = (x.to_vec(), x.to_vec());
+            a[i] += h;
+            b[i] -= h;
+            let (ea, eb) = (
+                p.evaluate(&a, false).unwrap(),
+                p.evaluate(&b, false).unwrap(),
+            );
+            let fd = (ea.f - eb.f) / (2.0 * h);
+            assert!((fd - gf[i]).abs() < 1e-6 * (1.0 + fd.abs()), "df/dx{i}");
+            for (j, row) in gg.iter().enumerate() {
+                let fd = (ea.g[j] - eb.g[j]) / (2.0 * h);
+                assert!((fd - row[i]).abs() < 1e-6 * (1.0 + fd.abs()), "dg{j}/dx{i}");
+            }
+        }
+    }
+
+    #[test]
+    fn scalarizations_have_exact_gradients() {
+        let z = zdt1();
+        let x: Vec<f64> = (0..30).map(|i| 0.1 + 0.025 * i as f64).collect();
+        check_scalarization(
+            &EpsilonConstraint::new(&z, vec![1.0, 0.0], vec![(1, 0.4, 2.0)]),
+            &x,
+        );
+        let t = Tchebycheff::new(
+            &z,
+            (vec![0.0, 0.0], vec![1.0, 2.0]),
+            vec![0.3, 0.7],
+            1e-3,
+            (-2.0, 20.0),
+        )
+        .unwrap();
+        let mut xt = x.clone();
+        xt.push(0.2);
+        check_scalarization(&t, &xt);
+        // Maximizing −f2 is minimizing f2: same values, same gradients.
+        let d = dtlz2();
+        let o = Oriented::new(&d, &[("f3".into(), false), ("f1".into(), true)]).unwrap();
+        let x: Vec<f64> = (0..12).map(|i| 0.2 + 0.05 * i as f64).collect();
+        let (eo, ed) = (o.evaluate(&x, true).unwrap(), d.evaluate(&x, true).unwrap());
+        assert_eq!(eo.f, vec![ed.f[2], -ed.f[0]]);
+        assert_eq!(eo.grad_f.unwrap()[1][3], -ed.grad_f.unwrap()[0][3]);
+        let e = Oriented::new(&d, &[("f4".into(), false)]).err().unwrap();
+        assert!(e.to_string().contains("objectives[0].name"), "{e}");
+    }
+
+    #[test]
+    fn the_tchebycheff_start_satisfies_its_constraints() {
+        let z = zdt1();
+        let t = Tchebycheff::new(
+            &z,
+            (vec![0.0, 0.0], vec![1.0, 1.0]),
+            vec![0.5, 0.5],
+            1e-4,
+            (-2.0, 20.0),
+        )
+        .unwrap();
+        let x0 = vec![0.5; 30];
+        let e = t.evaluate(&t.start(&x0).unwrap(), false).unwrap();
+        assert!(e.max_g().abs() < 1e-12, "{:?}", e.g);
     }
 }

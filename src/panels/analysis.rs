@@ -173,6 +173,69 @@ impl PanelAnalysis {
         laminate: &crate::laminate::Laminate,
         n_modes: usize,
     ) -> Result<PanelModes> {
+        self.check_mode_count(n_modes)?;
+        let t0 = Instant::now();
+        self.model
+            .assemble_into(laminate, &self.panel.design, &mut self.sys)?;
+        self.solver.set_stiffness(&self.sys.k)?;
+        let t1 = Instant::now();
+        let free = self.panel.support == crate::fe::Support::FreeFree;
+        let mut opts = ModalOptions::new(if free { n_modes + 6 } else { n_modes });
+        if free {
+            opts.shift = FREE_FREE_SHIFT;
+        }
+        let mut modes = self.solver.solve(&opts)?;
+        let t2 = Instant::now();
+        if free {
+            // The rigid-body modes go before the derivatives: they do not
+            // depend on the ply angles, and their 6-fold cluster at λ = 0
+            // would cost six factorizations and the adjacent-eigenvector
+            // method for nothing. Each elastic mode's derivative is its own
+            // solve, so the elastic derivatives are the same.
+            remove_rigid_modes(&mut modes, &mut [], &self.sys)?;
+        }
+        let derivatives = self.derivatives(laminate, &modes)?;
+        let t3 = Instant::now();
+        let labels = (0..modes.lambda.len())
+            .map(|j| label_mode(&self.sys, &self.mirrors, &modes, j))
+            .collect();
+        let frame = self.rigid_frame(laminate)?;
+        let rigid_content = (0..modes.lambda.len())
+            .map(|j| {
+                frame.content(
+                    self.sys
+                        .dof_map
+                        .iter()
+                        .enumerate()
+                        .map(|(f, &(node, comp))| (node, comp, modes.modes[(f, j)])),
+                )
+            })
+            .collect();
+        let mut with_layup = self.panel.clone();
+        with_layup.laminate = laminate.clone();
+        Ok(PanelModes {
+            panel: self.panel.name.clone(),
+            layup: layup_label(&with_layup),
+            dofs: self.sys.m_diag.len(),
+            modes,
+            labels,
+            derivatives,
+            variables: self.variable_names(),
+            seconds: [
+                (t1 - t0).as_secs_f64(),
+                (t2 - t1).as_secs_f64(),
+                (t3 - t2).as_secs_f64(),
+            ],
+            dof_map: self.sys.dof_map.clone(),
+            nodes: self.panel.mesh.nodes.clone(),
+            rigid_content,
+            frame,
+        })
+    }
+
+    /// `n_modes` within 1..=[`Self::max_modes`], else an input error that
+    /// names the largest allowed and why.
+    fn check_mode_count(&self, n_modes: usize) -> Result<()> {
         let max = self.max_modes();
         if n_modes == 0 || n_modes > max {
             let dofs = self.sys.m_diag.len();
@@ -187,27 +250,19 @@ impl PanelAnalysis {
                 format!("between 1 and {max} for this mesh ({why})"),
             ));
         }
-        let t0 = Instant::now();
-        self.model
-            .assemble_into(laminate, &self.panel.design, &mut self.sys)?;
-        self.solver.set_stiffness(&self.sys.k)?;
-        let t1 = Instant::now();
-        let free = self.panel.support == crate::fe::Support::FreeFree;
-        let mut opts = ModalOptions::new(if free { n_modes + 6 } else { n_modes });
-        if free {
-            opts.shift = FREE_FREE_SHIFT;
-        }
-        let mut modes = self.solver.solve(&opts)?;
-        let t2 = Instant::now();
-        let sys = &self.sys;
-        if free {
-            // The rigid-body modes go before the derivatives: they do not
-            // depend on the ply angles, and their 6-fold cluster at λ = 0
-            // would cost six factorizations and the adjacent-eigenvector
-            // method for nothing. Each elastic mode's derivative is its own
-            // solve, so the elastic derivatives are the same.
-            remove_rigid_modes(&mut modes, &mut [], sys)?;
-        }
+        Ok(())
+    }
+
+    /// The derivatives the analysis was built for (none, fixed-mode or
+    /// updated-mode; [`PanelAnalysis::new`]) of `modes` with respect to the
+    /// ply angles and then the ply-group thicknesses. The thickness
+    /// system is assembled for every such run, `K''` of the ply angles
+    /// only when the modes hold a repeated cluster.
+    fn derivatives(
+        &mut self,
+        laminate: &crate::laminate::Laminate,
+        modes: &Modes,
+    ) -> Result<Vec<VariableDerivatives>> {
         if let (Some(update), false) = (self.want, self.thickness.is_empty()) {
             let second = update == ModeUpdate::Updated;
             match &mut self.tsys {
@@ -221,57 +276,57 @@ impl PanelAnalysis {
                 }
             }
         }
-        let derivatives = match self.want {
-            None => Vec::new(),
-            Some(update) => {
-                let repeated = update == ModeUpdate::Updated
-                    && has_repeated(&modes, DerivativeOptions::default().cluster_tol);
-                if repeated {
-                    match &mut self.second {
-                        Some(s) => self.model.assemble_into(laminate, &self.panel.design, s)?,
-                        None => {
-                            self.second = Some(self.model.assemble(
-                                laminate,
-                                &self.panel.design,
-                                Derivatives::Second,
-                            )?)
-                        }
-                    }
-                }
-                let d2k = |v: usize| {
-                    self.second
-                        .as_ref()
-                        .filter(|_| repeated)
-                        .and_then(|s| s.d2k.get(v))
-                };
-                let mut vars: Vec<DesignDerivative<'_>> = (0..sys.dk.len())
-                    .map(|v| DesignDerivative {
-                        dk: &sys.dk[v],
-                        d2k: d2k(v),
-                        mass: None,
-                    })
-                    .collect();
-                if let Some(t) = &self.tsys {
-                    vars.extend((0..t.groups.len()).map(|v| DesignDerivative {
-                        dk: &t.dk[v],
-                        d2k: t.d2k.get(v),
-                        mass: Some(MassDerivative {
-                            dm: &t.dm[v],
-                            d2m: t.d2m.get(v).map(|m| &m[..]),
-                        }),
-                    }));
-                }
-                let opts = DerivativeOptions {
-                    update,
-                    ..DerivativeOptions::default()
-                };
-                self.solver.derivatives(&modes, &vars, &opts)?
-            }
+        let Some(update) = self.want else {
+            return Ok(Vec::new());
         };
-        let t3 = Instant::now();
-        let labels = (0..modes.lambda.len())
-            .map(|j| label_mode(sys, &self.mirrors, &modes, j))
+        let repeated = update == ModeUpdate::Updated
+            && has_repeated(modes, DerivativeOptions::default().cluster_tol);
+        if repeated {
+            match &mut self.second {
+                Some(s) => self.model.assemble_into(laminate, &self.panel.design, s)?,
+                None => {
+                    self.second = Some(self.model.assemble(
+                        laminate,
+                        &self.panel.design,
+                        Derivatives::Second,
+                    )?)
+                }
+            }
+        }
+        let sys = &self.sys;
+        let d2k = |v: usize| {
+            self.second
+                .as_ref()
+                .filter(|_| repeated)
+                .and_then(|s| s.d2k.get(v))
+        };
+        let mut vars: Vec<DesignDerivative<'_>> = (0..sys.dk.len())
+            .map(|v| DesignDerivative {
+                dk: &sys.dk[v],
+                d2k: d2k(v),
+                mass: None,
+            })
             .collect();
+        if let Some(t) = &self.tsys {
+            vars.extend((0..t.groups.len()).map(|v| DesignDerivative {
+                dk: &t.dk[v],
+                d2k: t.d2k.get(v),
+                mass: Some(MassDerivative {
+                    dm: &t.dm[v],
+                    d2m: t.d2m.get(v).map(|m| &m[..]),
+                }),
+            }));
+        }
+        let opts = DerivativeOptions {
+            update,
+            ..DerivativeOptions::default()
+        };
+        self.solver.derivatives(modes, &vars, &opts)
+    }
+
+    /// The design variables' names: a `theta_<plies>` per ply group, then,
+    /// with derivatives, a `thickness_<plies>` per thickness group.
+    fn variable_names(&self) -> Vec<String> {
         let mut variables: Vec<String> = self
             .panel
             .design
@@ -282,44 +337,20 @@ impl PanelAnalysis {
         if self.want.is_some() {
             variables.extend(self.thickness.iter().map(|g| group_name("thickness", g)));
         }
+        variables
+    }
+
+    /// The panel's rigid frame for `laminate`, reused while the laminate's
+    /// mass and rotary inertia per area stay the same.
+    fn rigid_frame(&mut self, laminate: &crate::laminate::Laminate) -> Result<RigidFrame> {
         let key = [laminate.mass_per_area(), laminate.rotary_inertia_per_area()];
-        let frame = match &self.frame {
+        Ok(match &self.frame {
             Some((k, f)) if *k == key => f.clone(),
             _ => {
                 let f = RigidFrame::of_panel(&self.panel, laminate)?;
                 self.frame = Some((key, f.clone()));
                 f
             }
-        };
-        let rigid_content = (0..modes.lambda.len())
-            .map(|j| {
-                frame.content(
-                    sys.dof_map
-                        .iter()
-                        .enumerate()
-                        .map(|(f, &(node, comp))| (node, comp, modes.modes[(f, j)])),
-                )
-            })
-            .collect();
-        let mut with_layup = self.panel.clone();
-        with_layup.laminate = laminate.clone();
-        Ok(PanelModes {
-            panel: self.panel.name.clone(),
-            layup: layup_label(&with_layup),
-            dofs: sys.m_diag.len(),
-            modes,
-            labels,
-            derivatives,
-            variables,
-            seconds: [
-                (t1 - t0).as_secs_f64(),
-                (t2 - t1).as_secs_f64(),
-                (t3 - t2).as_secs_f64(),
-            ],
-            dof_map: sys.dof_map.clone(),
-            nodes: self.panel.mesh.nodes.clone(),
-            rigid_content,
-            frame,
         })
     }
 }

@@ -105,21 +105,25 @@
 
 use super::driver::{self, OptState, Recorded};
 use super::{
-    qp, Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination, Variable,
+    Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination, Variable,
 };
 use crate::error::{Error, Result};
 use argmin::core::{
     Problem as ArgminProblem, Solver, State, TerminationReason, TerminationStatus, KV,
 };
+use direction::{Direction, SideConstraints};
 use geometry::{dot, least_norm, norm};
 pub use options::{KtScale, MmfdOptions};
 use restore::Restoration;
 use search::Search;
 
+mod direction;
 mod geometry;
 mod options;
 mod restore;
 mod search;
+#[cfg(test)]
+mod tests;
 
 /// A design with its scaled gradients of f and of the constraints.
 type Secant = (Vec<f64>, Vec<f64>, Vec<Vec<f64>>);
@@ -369,9 +373,42 @@ impl Mmfd {
 
     /// One MMFD iteration (steps 1–6 of the module doc).
     fn iterate(&mut self, problem: &mut Ap<'_>) -> Result<()> {
-        let o = self.options.clone();
         let vars = variables(problem).to_vec();
-        let n = vars.len();
+        let (base, gf, gg) = self.base_point(problem)?;
+        // Step 2: restoration.
+        if base.max_g() > self.options.ctmin {
+            return self.restore_from(problem, &base, &gg);
+        }
+        self.restoration = Restoration::Newton;
+        self.slow_restorations = 0;
+        // Step 1: active sets.
+        let active: Vec<usize> = (0..base.g.len())
+            .filter(|&j| base.g[j] >= self.ct_now)
+            .collect();
+        let sides = SideConstraints::at(&vars, &base.x, &self.range);
+        // Steps 3–4: direction.
+        let dir = if active.is_empty() && sides.rows.is_empty() {
+            self.conjugate_direction(&gf)
+        } else {
+            self.fr_prev = None;
+            self.fr_count = 0;
+            Direction::projected(&gf, &gg, &active, &sides)?
+        };
+        self.update_curvature(&vars, &base.x, (&gf, &gg), &dir);
+        let curvature = self.curvature.along(&dir.s);
+        self.secant = Some((base.x.clone(), gf.clone(), gg.clone()));
+        // Kuhn–Tucker test.
+        if self.kuhn_tucker(&base, &gf, &dir) {
+            self.stop(problem, &base, Termination::KuhnTucker);
+            return Ok(());
+        }
+        self.search_and_move(problem, &base, (&gf, &gg), &dir, curvature)
+    }
+
+    /// The current design evaluated with gradients (the evaluation the
+    /// last step made, if any; the start's on the first iteration), with
+    /// the gradients of f and of the constraints scaled by the ranges.
+    fn base_point(&mut self, problem: &mut Ap<'_>) -> Result<(Point, Vec<f64>, Vec<Vec<f64>>)> {
         if self.current.is_none() {
             self.start(problem)?;
         }
@@ -412,132 +449,49 @@ impl Mmfd {
                 format!("non-finite gradient at x = {:?}", base.x),
             ));
         }
-        // Step 2: restoration.
-        if base.max_g() > o.ctmin {
-            self.fr_prev = None;
-            self.prev_step = None;
-            match self.restoration_move(problem, &base, &gg)? {
-                Some(p) => {
-                    let step = self.scaled_distance(problem, &p.x, &base.x);
-                    self.finish_iteration(problem, &base, p, step);
-                }
-                None => {
-                    self.current = Some(base.clone());
-                    self.termination = Some(Termination::Infeasible);
-                    self.record_stay(problem, &base);
-                }
+        Ok((base, gf, gg))
+    }
+
+    /// Step 2 from the infeasible `base`: the restoration move, or the end
+    /// of the run (`infeasible`) when no move lowers the violation.
+    fn restore_from(&mut self, problem: &mut Ap<'_>, base: &Point, gg: &[Vec<f64>]) -> Result<()> {
+        self.fr_prev = None;
+        self.prev_step = None;
+        match self.restoration_move(problem, base, gg)? {
+            Some(p) => {
+                let step = self.scaled_distance(problem, &p.x, &base.x);
+                self.finish_iteration(problem, base, p, step);
             }
-            return Ok(());
+            None => self.stop(problem, base, Termination::Infeasible),
         }
-        self.restoration = Restoration::Newton;
-        self.slow_restorations = 0;
-        // Step 1: active sets.
-        let active: Vec<usize> = (0..base.g.len())
-            .filter(|&j| base.g[j] >= self.ct_now)
-            .collect();
-        let eps = 1e-9;
-        let mut side_rows = Vec::new();
-        let mut side_vars = Vec::new();
-        for (i, v) in vars.iter().enumerate() {
-            if v.period.is_some() {
-                continue;
-            }
-            let y = (base.x[i] - v.lower) / self.range[i];
-            let mut e = vec![0.0; n];
-            if y <= eps {
-                e[i] = -1.0;
-                side_rows.push(e);
-                side_vars.push((i, 1.0));
-            } else if y >= 1.0 - eps {
-                e[i] = 1.0;
-                side_rows.push(e);
-                side_vars.push((i, -1.0));
-            }
-        }
-        // Steps 3–4: direction.
-        let (s, binding, mult) = if active.is_empty() && side_rows.is_empty() {
-            let mut s: Vec<f64> = gf.iter().map(|v| -v).collect();
-            if let Some((gprev, sprev)) = &self.fr_prev {
-                if self.fr_count < n {
-                    let beta = dot(&gf, &gf) / dot(gprev, gprev).max(1e-300);
-                    let cand: Vec<f64> = s.iter().zip(sprev).map(|(a, b)| a + beta * b).collect();
-                    if dot(&cand, &gf) < -1e-3 * norm(&cand) * norm(&gf) {
-                        s = cand;
-                        self.fr_count += 1;
-                    } else {
-                        self.fr_count = 0;
-                    }
-                } else {
-                    self.fr_count = 0;
-                }
-            }
-            self.fr_prev = Some((gf.clone(), s.clone()));
-            (s, vec![], vec![])
-        } else {
-            self.fr_prev = None;
-            self.fr_count = 0;
-            let mut rows: Vec<Vec<f64>> = active.iter().map(|&j| gg[j].clone()).collect();
-            rows.extend(side_rows.iter().cloned());
-            let b = vec![0.0; rows.len()];
-            let sol = qp::solve(&gf, &rows, &b)?;
-            let lmax = sol.lambda.iter().copied().fold(0.0, f64::max);
-            // Binding: positive multiplier and S tangent to the constraint
-            // (complementarity); constraints S moves away from are free.
-            let sn = norm(&sol.s);
-            let binding: Vec<usize> = active
-                .iter()
-                .enumerate()
-                .filter(|(k, &j)| {
-                    sol.lambda[*k] > 1e-8 * lmax.max(1e-300)
-                        && dot(&gg[j], &sol.s) >= -1e-6 * norm(&gg[j]) * sn
-                })
-                .map(|(_, &j)| j)
-                .collect();
-            let mult: Vec<f64> = active
-                .iter()
-                .enumerate()
-                .filter(|(_, j)| binding.contains(j))
-                .map(|(k, _)| sol.lambda[k])
-                .collect();
-            let mut s = sol.s;
-            // Remove round-off components pointing out of an active bound.
-            for &(i, sign) in &side_vars {
-                if s[i] * sign < 0.0 {
-                    s[i] = 0.0;
-                }
-            }
-            (s, binding, mult)
-        };
-        // Secant curvature of the Lagrangian (the binding multipliers of
-        // this direction) along the step from the last gradient evaluation.
-        if let Some((xp, gfp, ggp)) = self.secant.take() {
-            let st: Vec<f64> = vars
-                .iter()
-                .enumerate()
-                .map(|(i, v)| v.difference(base.x[i], xp[i]) / self.range[i])
-                .collect();
-            let mut y: Vec<f64> = gf.iter().zip(&gfp).map(|(a, b)| a - b).collect();
-            for (&j, l) in binding.iter().zip(&mult) {
-                for (yi, (a, b)) in y.iter_mut().zip(gg[j].iter().zip(&ggp[j])) {
-                    *yi += l * (a - b);
-                }
-            }
-            self.curvature.update(&st, &y);
-        }
-        let curvature = self.curvature.along(&s);
-        self.secant = Some((base.x.clone(), gf.clone(), gg.clone()));
-        // Kuhn–Tucker test.
-        let on_limits = binding.iter().all(|&j| base.g[j].abs() <= o.ctmin);
+        Ok(())
+    }
+
+    /// The Kuhn–Tucker test of step 6: `|S|` within `kt_tolerance` of the
+    /// option's scale with the binding constraints on their limits.
+    fn kuhn_tucker(&self, base: &Point, gf: &[f64], dir: &Direction) -> bool {
+        let o = &self.options;
+        let on_limits = dir.binding.iter().all(|&j| base.g[j].abs() <= o.ctmin);
         let kt_scale = match o.kt_scale {
             KtScale::Objective => base.f.abs().max(1.0),
-            KtScale::Gradient => norm(&gf).max(1.0),
+            KtScale::Gradient => norm(gf).max(1.0),
         };
-        if norm(&s) <= o.kt_tolerance * kt_scale && on_limits {
-            self.current = Some(base.clone());
-            self.termination = Some(Termination::KuhnTucker);
-            self.record_stay(problem, &base);
-            return Ok(());
-        }
+        norm(&dir.s) <= o.kt_tolerance * kt_scale && on_limits
+    }
+
+    /// Steps 5–5b: the line search along `dir` (then, if enabled and it
+    /// fails, the slope search) and the move to the point found. The run
+    /// ends when the slope search stalls or two searches in a row fail.
+    fn search_and_move(
+        &mut self,
+        problem: &mut Ap<'_>,
+        base: &Point,
+        (gf, gg): (&[f64], &[Vec<f64>]),
+        dir: &Direction,
+        curvature: Option<f64>,
+    ) -> Result<()> {
+        let n = base.x.len();
+        let (s, binding) = (&dir.s, &dir.binding);
         let c0 = if binding.is_empty() {
             vec![0.0; n]
         } else {
@@ -545,24 +499,22 @@ impl Mmfd {
             let r: Vec<f64> = binding.iter().map(|&j| base.g[j]).collect();
             least_norm(&cols, &r).unwrap_or_else(|| vec![0.0; n])
         };
-        let d0 = dot(&gf, &s);
+        let d0 = dot(gf, s);
         let sr = Search {
-            base: &base,
-            gf: &gf,
-            gg: &gg,
-            s: &s,
+            base,
+            gf,
+            gg,
+            s,
             c0: &c0,
-            binding: &binding,
+            binding,
             curvature,
             learned: std::cell::RefCell::new(None),
         };
         let searched = match self.line_search(problem, &sr)? {
-            None if o.slope_search => {
+            None if self.options.slope_search => {
                 let found = self.slope_search(problem, &sr)?;
-                if found.is_some() && self.slope_stalled(norm(&s)) {
-                    self.current = Some(base.clone());
-                    self.termination = Some(Termination::NoFeasibleDirection);
-                    self.record_stay(problem, &base);
+                if found.is_some() && self.slope_stalled(norm(s)) {
+                    self.stop(problem, base, Termination::NoFeasibleDirection);
                     return Ok(());
                 }
                 found
@@ -577,22 +529,27 @@ impl Mmfd {
                     self.prev_step = Some((alpha, d0));
                 }
                 let step = self.scaled_distance(problem, &p.x, &base.x);
-                self.finish_iteration(problem, &base, p, step);
+                self.finish_iteration(problem, base, p, step);
             }
             None => {
                 self.failed_searches += 1;
                 self.fr_prev = None;
                 self.prev_step = None;
                 if self.failed_searches >= 2 {
-                    self.current = Some(base.clone());
-                    self.termination = Some(Termination::NoFeasibleDirection);
-                    self.record_stay(problem, &base);
+                    self.stop(problem, base, Termination::NoFeasibleDirection);
                 } else {
-                    self.finish_iteration(problem, &base, base.clone(), 0.0);
+                    self.finish_iteration(problem, base, base.clone(), 0.0);
                 }
             }
         }
         Ok(())
+    }
+
+    /// End the run at `base`, not moved, for `why`.
+    fn stop(&mut self, problem: &Ap<'_>, base: &Point, why: Termination) {
+        self.current = Some(base.clone());
+        self.termination = Some(why);
+        self.record_stay(problem, base);
     }
 
     /// Whether the slope search has stalled: a step it found from a
