@@ -30,10 +30,8 @@ use super::legs::{lift_failure_cap, Integrand, Legs};
 use super::ode::OdeModel;
 use super::options::{Options, Stats};
 use crate::error::{Error, Result};
-use diffsol::error::DiffsolError;
 use diffsol::{
-    FaerContext, FaerMat, FaerVec, OdeBuilder, OdeEquations, OdeEquationsImplicit, OdeSolverMethod,
-    OdeSolverProblem, Tableau,
+    FaerContext, FaerMat, FaerVec, OdeBuilder, OdeEquations, OdeEquationsImplicit, OdeSolverProblem,
 };
 use std::cell::{Cell, RefCell};
 
@@ -141,39 +139,15 @@ where
     Eqn: OdeEquationsImplicit<T = f64, V = FaerVec<f64>, M = FaerMat<f64>, C = FaerContext>,
 {
     type Eqn = Eqn;
+    type Lu = BlockLu;
     const PLACE: &'static str = "integrate_sens (fused)";
+
+    fn problem(&self) -> &OdeSolverProblem<Eqn> {
+        &self.problem
+    }
 
     fn fused(&self) -> Option<usize> {
         Some(self.n)
-    }
-
-    fn bdf<'s>(&'s self) -> std::result::Result<impl OdeSolverMethod<'s, Eqn>, DiffsolError>
-    where
-        Eqn: 's,
-    {
-        self.problem.bdf::<BlockLu>()
-    }
-
-    fn sdirk<'s>(
-        &'s self,
-        tableau: Tableau<f64>,
-    ) -> std::result::Result<impl OdeSolverMethod<'s, Eqn>, DiffsolError>
-    where
-        Eqn: 's,
-    {
-        let state = self.problem.rk_state_and_consistent::<BlockLu>(&tableau)?;
-        self.problem.sdirk_solver::<BlockLu, _>(state, tableau)
-    }
-
-    fn explicit_rk<'s>(
-        &'s self,
-        tableau: Tableau<f64>,
-    ) -> std::result::Result<impl OdeSolverMethod<'s, Eqn>, DiffsolError>
-    where
-        Eqn: 's,
-    {
-        let state = self.problem.rk_state(&tableau)?;
-        self.problem.explicit_rk_solver(state, tableau)
     }
 
     fn implicit<R>(&self, leg: impl FnOnce() -> R) -> R {

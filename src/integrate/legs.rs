@@ -15,21 +15,29 @@ use super::options::{Options, Scheme, Stats};
 use crate::error::{Error, Result};
 use diffsol::error::DiffsolError;
 use diffsol::{
-    FaerContext, FaerMat, FaerVec, OdeEquations, OdeSolverMethod, OdeSolverStopReason, Tableau,
-    Vector,
+    FaerContext, FaerMat, FaerVec, LinearSolver, OdeEquationsImplicit, OdeSolverMethod,
+    OdeSolverProblem, OdeSolverStopReason, Tableau, Vector,
 };
 use std::cell::{Cell, RefCell};
 use std::time::Instant;
 
 /// What the legs of one integration integrate: a diffsol problem and the
 /// solvers built on it, one per family of methods, each starting from the
-/// current leg's start (the initial state, then each event's).
+/// current leg's start (the initial state, then each event's). The
+/// solvers are diffsol's plain ones unless a form provides its own (the
+/// staggered form: the sensitivity solvers).
 pub(super) trait Integrand {
     /// The problem's equations.
-    type Eqn: OdeEquations<T = f64, V = FaerVec<f64>, M = FaerMat<f64>, C = FaerContext>;
+    type Eqn: OdeEquationsImplicit<T = f64, V = FaerVec<f64>, M = FaerMat<f64>, C = FaerContext>;
+
+    /// The linear solver of the implicit methods' Newton matrix.
+    type Lu: LinearSolver<FaerMat<f64>>;
 
     /// Where a solver's set-up error is reported (`integrate`, ..).
     const PLACE: &'static str;
+
+    /// The problem integrated.
+    fn problem(&self) -> &OdeSolverProblem<Self::Eqn>;
 
     /// Sensitivity lanes the solver integrates itself (diffsol's forward
     /// sensitivities; 0 without, and 0 in the fused form).
@@ -43,26 +51,41 @@ pub(super) trait Integrand {
         None
     }
 
-    /// A BDF solver on the problem.
+    /// A BDF solver on the problem (the calls of diffsol's `bdf`).
     fn bdf<'s>(&'s self) -> std::result::Result<impl OdeSolverMethod<'s, Self::Eqn>, DiffsolError>
     where
-        Self::Eqn: 's;
+        Self::Eqn: 's,
+    {
+        self.problem().bdf::<Self::Lu>()
+    }
 
-    /// An SDIRK solver with `tableau` on the problem.
+    /// An SDIRK solver with `tableau` on the problem (the calls of
+    /// diffsol's `esdirk34` with another tableau).
     fn sdirk<'s>(
         &'s self,
         tableau: Tableau<f64>,
     ) -> std::result::Result<impl OdeSolverMethod<'s, Self::Eqn>, DiffsolError>
     where
-        Self::Eqn: 's;
+        Self::Eqn: 's,
+    {
+        let problem = self.problem();
+        let state = problem.rk_state_and_consistent::<Self::Lu>(&tableau)?;
+        problem.sdirk_solver::<Self::Lu, _>(state, tableau)
+    }
 
-    /// An explicit Runge–Kutta solver with `tableau` on the problem.
+    /// An explicit Runge–Kutta solver with `tableau` on the problem (the
+    /// calls of diffsol's `tsit45` with another tableau).
     fn explicit_rk<'s>(
         &'s self,
         tableau: Tableau<f64>,
     ) -> std::result::Result<impl OdeSolverMethod<'s, Self::Eqn>, DiffsolError>
     where
-        Self::Eqn: 's;
+        Self::Eqn: 's,
+    {
+        let problem = self.problem();
+        let state = problem.rk_state(&tableau)?;
+        problem.explicit_rk_solver(state, tableau)
+    }
 
     /// Run `leg`, which builds an implicit solver (its linear solver
     /// included) and drives it; the fused form sets the block count of its

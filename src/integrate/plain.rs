@@ -4,10 +4,9 @@ use super::legs::{lift_failure_cap, Integrand, Legs};
 use super::ode::OdeModel;
 use super::options::{Options, Stats};
 use crate::error::{Error, Result};
-use diffsol::error::DiffsolError;
 use diffsol::{
     FaerContext, FaerLU, FaerMat, FaerVec, OdeBuilder, OdeEquations, OdeEquationsImplicit,
-    OdeSolverMethod, OdeSolverProblem, Tableau,
+    OdeSolverProblem,
 };
 use std::cell::RefCell;
 
@@ -80,37 +79,11 @@ where
     Eqn: OdeEquationsImplicit<T = f64, V = FaerVec<f64>, M = FaerMat<f64>, C = FaerContext>,
 {
     type Eqn = Eqn;
+    type Lu = FaerLU<f64>;
     const PLACE: &'static str = "integrate";
 
-    fn bdf<'s>(&'s self) -> std::result::Result<impl OdeSolverMethod<'s, Eqn>, DiffsolError>
-    where
-        Eqn: 's,
-    {
-        self.problem.bdf::<FaerLU<f64>>()
-    }
-
-    fn sdirk<'s>(
-        &'s self,
-        tableau: Tableau<f64>,
-    ) -> std::result::Result<impl OdeSolverMethod<'s, Eqn>, DiffsolError>
-    where
-        Eqn: 's,
-    {
-        let state = self
-            .problem
-            .rk_state_and_consistent::<FaerLU<f64>>(&tableau)?;
-        self.problem.sdirk_solver::<FaerLU<f64>, _>(state, tableau)
-    }
-
-    fn explicit_rk<'s>(
-        &'s self,
-        tableau: Tableau<f64>,
-    ) -> std::result::Result<impl OdeSolverMethod<'s, Eqn>, DiffsolError>
-    where
-        Eqn: 's,
-    {
-        let state = self.problem.rk_state(&tableau)?;
-        self.problem.explicit_rk_solver(state, tableau)
+    fn problem(&self) -> &OdeSolverProblem<Eqn> {
+        &self.problem
     }
 
     fn restart(&mut self, t: f64, y: Vec<f64>, _s: Vec<f64>) {

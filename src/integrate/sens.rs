@@ -131,7 +131,12 @@ where
     Eqn: OdeEquationsImplicitSens<T = f64, V = FaerVec<f64>, M = FaerMat<f64>, C = FaerContext>,
 {
     type Eqn = Eqn;
+    type Lu = FaerLU<f64>;
     const PLACE: &'static str = "integrate_sens";
+
+    fn problem(&self) -> &OdeSolverProblem<Eqn> {
+        &self.problem
+    }
 
     fn nsens(&self) -> usize {
         self.np
