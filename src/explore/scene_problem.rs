@@ -74,7 +74,7 @@ use super::scene_vars::{problem_error, Ties};
 use crate::error::{Error, Result};
 use crate::integrate::SensitivityForm;
 use crate::laminate::Laminate;
-use crate::mbs::responses::{ResponseKind, ResponseValue, Sense};
+use crate::mbs::responses::{ResponseKindName, ResponseValue, Sense};
 use crate::optimize::{Evaluation, Problem, Variable};
 use crate::scene::{BuildProfile, ScenePlan};
 use crate::simulate::sampled::frequencies;
@@ -339,7 +339,7 @@ impl SceneProblem {
     /// integration needed).
     fn is_frequency(&self, name: &str) -> bool {
         let spec = self.plan.spec().responses.iter().find(|r| r.name == name);
-        spec.is_some_and(|r| r.kind == ResponseKind::Frequency)
+        spec.is_some_and(|r| r.kind == ResponseKindName::Frequency)
     }
 
     /// Simulate at `x` and return the named responses, each at its
@@ -560,7 +560,7 @@ fn at_point(r: &ResponseValue, point: usize) -> (f64, &[f64]) {
 /// The sense of response `name` of `scene` when it is a `peak`.
 fn peak_sense(scene: &crate::scene::SceneSpec, name: &str) -> Option<Sense> {
     let r = scene.responses.iter().find(|r| r.name == name)?;
-    (r.kind == ResponseKind::Peak).then(|| r.sense.unwrap_or_default())
+    (r.kind == ResponseKindName::Peak).then(|| r.sense.unwrap_or_default())
 }
 
 /// `theta1_deg = 55, theta2_deg = -55`.

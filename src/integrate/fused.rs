@@ -26,13 +26,14 @@
 //! SAR at rtol 1e-6, both within 3e-4 of a tight reference).
 
 use super::block_lu::{with_blocks, BlockLu};
-use super::legs::{lift_failure_cap, Legs};
+use super::legs::{lift_failure_cap, Integrand, Legs};
 use super::ode::OdeModel;
-use super::options::{Method, Options, Stats};
+use super::options::{Options, Stats};
 use crate::error::{Error, Result};
-use diffsol::{FaerMat, OdeBuilder};
+use diffsol::{
+    FaerContext, FaerMat, FaerVec, OdeBuilder, OdeEquations, OdeEquationsImplicit, OdeSolverProblem,
+};
 use std::cell::{Cell, RefCell};
-use std::time::Instant;
 
 /// [`super::integrate_sens`] in the fused form. `p0`: the parameters'
 /// values.
@@ -41,7 +42,7 @@ pub(super) fn integrate_fused<M: OdeModel>(
     y0: &[f64],
     opts: &Options,
     (params, p0): (&[M::Param], &[f64]),
-    mut observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+    observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
 ) -> Result<Stats> {
     let n = y0.len();
     let np = params.len();
@@ -108,47 +109,56 @@ pub(super) fn integrate_fused<M: OdeModel>(
         .build()
         .map_err(|e| Error::numerical("integrate_sens (fused): problem set-up", e.to_string()))?;
     lift_failure_cap(&mut problem.ode_options);
-    let start = Instant::now();
-    let observer_time = Cell::new(0.0f64);
-    let mut observe = |t: f64, y: &[f64], s: &[f64]| {
-        let t0 = Instant::now();
-        let r = observe(t, y, s);
-        observer_time.set(observer_time.get() + t0.elapsed().as_secs_f64());
-        r
+    let mut lanes = Lanes {
+        problem,
+        n,
+        blocks: 1 + np,
+        start_z: &start_z,
+        columns: &columns,
     };
-    let mut legs = Legs {
-        opts,
-        nsens: 0,
-        fused: Some(n),
-        next: 0,
-        model,
-        events: &ev,
-        work: &work,
-        params: (params, p0),
-    };
-    let mut stats = Stats::default();
-    let setup = |e: diffsol::error::DiffsolError| {
-        Error::numerical("integrate_sens (fused): solver set-up", e.to_string())
-    };
-    loop {
-        // A new leg may have a new piece frozen at the same point.
-        *columns.borrow_mut() = Columns::new(n);
-        let (leg, event) = match opts.method {
-            Method::Tsit45 => legs.drive(problem.tsit45().map_err(setup)?, &mut observe)?,
-            Method::Bdf => with_blocks(1 + np, || {
-                legs.drive(problem.bdf::<BlockLu>().map_err(setup)?, &mut observe)
-            })?,
-            Method::Esdirk34 => with_blocks(1 + np, || {
-                legs.drive(problem.esdirk34::<BlockLu>().map_err(setup)?, &mut observe)
-            })?,
-        };
-        let Some(e) = legs.end_leg(&mut stats, (leg, event), &mut observe)? else {
-            break;
-        };
-        problem.t0 = e.t;
-        *start_z.borrow_mut() = [e.y, e.s].concat();
+    let legs = Legs::new(opts, model, (&ev, &work), (params, p0), &lanes);
+    legs.run(&mut lanes, (&rhs_calls, &jvps), observe)
+}
+
+/// The states with the lanes in the state, `z = [y; s_1; ..; s_np]`, on
+/// diffsol's plain solvers; the implicit ones factor the states' own
+/// Newton matrix once for the `blocks = 1 + np` blocks ([`BlockLu`]). A
+/// leg starts from `start_z` (shared with the problem's initial
+/// condition) with the columns of `J` forgotten ([`Columns`]: a new leg
+/// may have a new piece frozen at the same point).
+struct Lanes<'c, Eqn: OdeEquations> {
+    problem: OdeSolverProblem<Eqn>,
+    n: usize,
+    blocks: usize,
+    start_z: &'c RefCell<Vec<f64>>,
+    columns: &'c RefCell<Columns>,
+}
+
+impl<Eqn> Integrand for Lanes<'_, Eqn>
+where
+    Eqn: OdeEquationsImplicit<T = f64, V = FaerVec<f64>, M = FaerMat<f64>, C = FaerContext>,
+{
+    type Eqn = Eqn;
+    type Lu = BlockLu;
+    const PLACE: &'static str = "integrate_sens (fused)";
+
+    fn problem(&self) -> &OdeSolverProblem<Eqn> {
+        &self.problem
     }
-    Ok(stats.finish(start, observer_time.get(), (rhs_calls.get(), jvps.get())))
+
+    fn fused(&self) -> Option<usize> {
+        Some(self.n)
+    }
+
+    fn implicit<R>(&self, leg: impl FnOnce() -> R) -> R {
+        with_blocks(self.blocks, leg)
+    }
+
+    fn restart(&mut self, t: f64, y: Vec<f64>, s: Vec<f64>) {
+        *self.columns.borrow_mut() = Columns::new(self.n);
+        self.problem.t0 = t;
+        *self.start_z.borrow_mut() = [y, s].concat();
+    }
 }
 
 /// Columns of `J` at one point `(t, y)`: the implicit methods build their

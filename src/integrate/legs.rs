@@ -1,12 +1,103 @@
 //! The legs of one integration: stepping a diffsol solver through the
 //! output times, locating the model's events, switching pieces with the
 //! sensitivity jump, and restarting (module doc of [`super`]).
+//!
+//! One loop ([`Legs::run`]) serves every form of integration; what a leg
+//! integrates (the states alone, the states with diffsol's forward
+//! sensitivities, or the fused lanes) is an [`Integrand`]: its problem,
+//! the solver it builds for each family of methods
+//! ([`super::options::Scheme`]) and how a leg starts from an event. A new
+//! method is a [`super::Method`] variant with its scheme; a new form is
+//! an [`Integrand`].
 
 use super::ode::OdeModel;
-use super::options::{Options, Stats};
+use super::options::{Options, Scheme, Stats};
 use crate::error::{Error, Result};
-use diffsol::{OdeSolverMethod, OdeSolverStopReason, Vector};
-use std::cell::RefCell;
+use diffsol::error::DiffsolError;
+use diffsol::{
+    FaerContext, FaerMat, FaerVec, LinearSolver, OdeEquationsImplicit, OdeSolverMethod,
+    OdeSolverProblem, OdeSolverStopReason, Tableau, Vector,
+};
+use std::cell::{Cell, RefCell};
+use std::time::Instant;
+
+/// What the legs of one integration integrate: a diffsol problem and the
+/// solvers built on it, one per family of methods, each starting from the
+/// current leg's start (the initial state, then each event's). The
+/// solvers are diffsol's plain ones unless a form provides its own (the
+/// staggered form: the sensitivity solvers).
+pub(super) trait Integrand {
+    /// The problem's equations.
+    type Eqn: OdeEquationsImplicit<T = f64, V = FaerVec<f64>, M = FaerMat<f64>, C = FaerContext>;
+
+    /// The linear solver of the implicit methods' Newton matrix.
+    type Lu: LinearSolver<FaerMat<f64>>;
+
+    /// Where a solver's set-up error is reported (`integrate`, ..).
+    const PLACE: &'static str;
+
+    /// The problem integrated.
+    fn problem(&self) -> &OdeSolverProblem<Self::Eqn>;
+
+    /// Sensitivity lanes the solver integrates itself (diffsol's forward
+    /// sensitivities; 0 without, and 0 in the fused form).
+    fn nsens(&self) -> usize {
+        0
+    }
+
+    /// In the fused form, the length of `y` in the solver's state
+    /// `[y; s_1; ..; s_np]`.
+    fn fused(&self) -> Option<usize> {
+        None
+    }
+
+    /// A BDF solver on the problem (the calls of diffsol's `bdf`).
+    fn bdf<'s>(&'s self) -> std::result::Result<impl OdeSolverMethod<'s, Self::Eqn>, DiffsolError>
+    where
+        Self::Eqn: 's,
+    {
+        self.problem().bdf::<Self::Lu>()
+    }
+
+    /// An SDIRK solver with `tableau` on the problem (the calls of
+    /// diffsol's `esdirk34` with another tableau).
+    fn sdirk<'s>(
+        &'s self,
+        tableau: Tableau<f64>,
+    ) -> std::result::Result<impl OdeSolverMethod<'s, Self::Eqn>, DiffsolError>
+    where
+        Self::Eqn: 's,
+    {
+        let problem = self.problem();
+        let state = problem.rk_state_and_consistent::<Self::Lu>(&tableau)?;
+        problem.sdirk_solver::<Self::Lu, _>(state, tableau)
+    }
+
+    /// An explicit Runge–Kutta solver with `tableau` on the problem (the
+    /// calls of diffsol's `tsit45` with another tableau).
+    fn explicit_rk<'s>(
+        &'s self,
+        tableau: Tableau<f64>,
+    ) -> std::result::Result<impl OdeSolverMethod<'s, Self::Eqn>, DiffsolError>
+    where
+        Self::Eqn: 's,
+    {
+        let problem = self.problem();
+        let state = problem.rk_state(&tableau)?;
+        problem.explicit_rk_solver(state, tableau)
+    }
+
+    /// Run `leg`, which builds an implicit solver (its linear solver
+    /// included) and drives it; the fused form sets the block count of its
+    /// Newton matrix here.
+    fn implicit<R>(&self, leg: impl FnOnce() -> R) -> R {
+        leg()
+    }
+
+    /// Start the next leg at time `t` from state `y` and sensitivities `s`
+    /// (lane-major; empty without).
+    fn restart(&mut self, t: f64, y: Vec<f64>, s: Vec<f64>);
+}
 
 /// diffsol counts nonlinear-solver failures over the WHOLE integration
 /// (`max_nonlinear_solver_failures`, default 50) and aborts past the cap,
@@ -48,7 +139,72 @@ pub(super) struct Legs<'c, M: OdeModel> {
     pub(super) params: (&'c [M::Param], &'c [f64]),
 }
 
-impl<M: OdeModel> Legs<'_, M> {
+impl<'c, M: OdeModel> Legs<'c, M> {
+    /// The legs of an integration of `model` with `opts` (its events, its
+    /// work space and the sensitivity parameters with their values) of
+    /// what `integrand` integrates, from the first output time.
+    pub(super) fn new(
+        opts: &'c Options,
+        model: &'c M,
+        (events, work): (&'c RefCell<M::Events>, &'c RefCell<M::Work>),
+        params: (&'c [M::Param], &'c [f64]),
+        integrand: &impl Integrand,
+    ) -> Self {
+        Legs {
+            opts,
+            nsens: integrand.nsens(),
+            fused: integrand.fused(),
+            next: 0,
+            model,
+            events,
+            work,
+            params,
+        }
+    }
+
+    /// Integrate leg after leg until the end time, calling `observe(t, y,
+    /// s)` at every output time, and return the statistics; `calls` count
+    /// the right-hand sides and the directional derivatives. Every method
+    /// and every form goes through here: the solver of the method's
+    /// family comes from `integrand`, and a new leg starts from each event
+    /// ([`Legs::end_leg`]).
+    pub(super) fn run<I: Integrand>(
+        mut self,
+        integrand: &mut I,
+        calls: (&Cell<u64>, &Cell<u64>),
+        mut observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+    ) -> Result<Stats> {
+        let start = Instant::now();
+        let observer_time = Cell::new(0.0f64);
+        let mut observe = |t: f64, y: &[f64], s: &[f64]| {
+            let t0 = Instant::now();
+            let r = observe(t, y, s);
+            observer_time.set(observer_time.get() + t0.elapsed().as_secs_f64());
+            r
+        };
+        let setup = |e: DiffsolError| {
+            Error::numerical(format!("{}: solver set-up", I::PLACE), e.to_string())
+        };
+        let mut stats = Stats::default();
+        loop {
+            let leg = match self.opts.method.scheme() {
+                Scheme::Bdf => integrand
+                    .implicit(|| self.drive(integrand.bdf().map_err(setup)?, &mut observe))?,
+                Scheme::Sdirk(tableau) => integrand.implicit(|| {
+                    self.drive(integrand.sdirk(tableau).map_err(setup)?, &mut observe)
+                })?,
+                Scheme::ExplicitRk(tableau) => {
+                    self.drive(integrand.explicit_rk(tableau).map_err(setup)?, &mut observe)?
+                }
+            };
+            let Some(e) = self.end_leg(&mut stats, leg, &mut observe)? else {
+                break;
+            };
+            integrand.restart(e.t, e.y, e.s);
+        }
+        Ok(stats.finish(start, observer_time.get(), (calls.0.get(), calls.1.get())))
+    }
+
     /// A solver state as `(y, lanes)`: in the fused form the lanes follow
     /// `y` in the state; otherwise there are none here.
     fn split(&self, mut z: Vec<f64>) -> (Vec<f64>, Vec<f64>) {
@@ -67,7 +223,7 @@ impl<M: OdeModel> Legs<'_, M> {
     /// too and handed to `observe` after the state. Outputs after an
     /// event are not served by this leg (its law is extended past the
     /// breakpoint there).
-    pub(super) fn drive<'a, Eqn, S>(
+    fn drive<'a, Eqn, S>(
         &mut self,
         mut solver: S,
         observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
@@ -191,7 +347,7 @@ impl<M: OdeModel> Legs<'_, M> {
     /// up to the event are already served), else switch the piece (the
     /// sensitivities jump), refreeze the model's pieces, and return the
     /// event when a new leg must start from it.
-    pub(super) fn end_leg(
+    fn end_leg(
         &mut self,
         stats: &mut Stats,
         leg: (Stats, Option<Event<M::Crossing>>),

@@ -2,6 +2,7 @@
 //! ([`Stats`]).
 
 use crate::error::{Error, Result};
+use diffsol::Tableau;
 
 /// Integration method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
@@ -24,6 +25,28 @@ impl Method {
             Method::Esdirk34 => "esdirk34",
         }
     }
+
+    /// The family of diffsol solvers the method belongs to, with its
+    /// Butcher tableau; every form of integration (`super::legs`) builds
+    /// its solver from this.
+    pub(super) fn scheme(&self) -> Scheme {
+        match self {
+            Method::Bdf => Scheme::Bdf,
+            Method::Tsit45 => Scheme::ExplicitRk(Tableau::tsit45()),
+            Method::Esdirk34 => Scheme::Sdirk(Tableau::esdirk34()),
+        }
+    }
+}
+
+/// A family of diffsol solvers ([`Method::scheme`]).
+pub(super) enum Scheme {
+    /// Variable-order BDF (implicit: needs a Newton matrix).
+    Bdf,
+    /// A singly diagonally implicit Runge–Kutta method with this tableau
+    /// (implicit).
+    Sdirk(Tableau<f64>),
+    /// An explicit Runge–Kutta method with this tableau.
+    ExplicitRk(Tableau<f64>),
 }
 
 /// How forward sensitivities are integrated.

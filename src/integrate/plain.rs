@@ -1,12 +1,14 @@
 //! [`integrate`]: the states alone.
 
-use super::legs::{lift_failure_cap, Legs};
+use super::legs::{lift_failure_cap, Integrand, Legs};
 use super::ode::OdeModel;
-use super::options::{Method, Options, Stats};
+use super::options::{Options, Stats};
 use crate::error::{Error, Result};
-use diffsol::{FaerLU, FaerMat, OdeBuilder};
+use diffsol::{
+    FaerContext, FaerLU, FaerMat, FaerVec, OdeBuilder, OdeEquations, OdeEquationsImplicit,
+    OdeSolverProblem,
+};
 use std::cell::RefCell;
-use std::time::Instant;
 
 /// Integrate `model` from `y0` (already consistent) and call
 /// `observe(t, y)` at every output time.
@@ -24,7 +26,6 @@ pub fn integrate<M: OdeModel>(
     model.freeze(&ev.borrow(), &mut work.borrow_mut());
     let jvps = std::cell::Cell::new(0u64);
     let rhs_calls = std::cell::Cell::new(0u64);
-    let observer_time = std::cell::Cell::new(0.0f64);
     let none: (&[M::Param], &[f64]) = (&[], &[]);
     // Start of the current leg (the initial state, then each event state).
     let start_y = RefCell::new(y0.to_vec());
@@ -58,43 +59,35 @@ pub fn integrate<M: OdeModel>(
         .build()
         .map_err(|e| Error::numerical("integrate: problem set-up", e.to_string()))?;
     lift_failure_cap(&mut problem.ode_options);
-    let start = Instant::now();
-    let mut observe = |t: f64, y: &[f64], _s: &[f64]| {
-        let t0 = Instant::now();
-        let r = observe(t, y);
-        observer_time.set(observer_time.get() + t0.elapsed().as_secs_f64());
-        r
+    let mut states = States {
+        problem,
+        start_y: &start_y,
     };
-    let setup = |e: diffsol::error::DiffsolError| {
-        Error::numerical("integrate: solver set-up", e.to_string())
-    };
-    let mut legs = Legs {
-        opts,
-        nsens: 0,
-        fused: None,
-        next: 0,
-        model,
-        events: &ev,
-        work: &work,
-        params: none,
-    };
-    let mut stats = Stats::default();
-    loop {
-        let (leg, event) = match opts.method {
-            Method::Bdf => {
-                legs.drive(problem.bdf::<FaerLU<f64>>().map_err(setup)?, &mut observe)?
-            }
-            Method::Esdirk34 => legs.drive(
-                problem.esdirk34::<FaerLU<f64>>().map_err(setup)?,
-                &mut observe,
-            )?,
-            Method::Tsit45 => legs.drive(problem.tsit45().map_err(setup)?, &mut observe)?,
-        };
-        let Some(e) = legs.end_leg(&mut stats, (leg, event), &mut observe)? else {
-            break;
-        };
-        problem.t0 = e.t;
-        *start_y.borrow_mut() = e.y;
+    let legs = Legs::new(opts, model, (&ev, &work), none, &states);
+    legs.run(&mut states, (&rhs_calls, &jvps), |t, y, _s| observe(t, y))
+}
+
+/// The states alone, on diffsol's plain solvers with its dense LU; a leg
+/// starts from `start_y` (shared with the problem's initial condition).
+struct States<'c, Eqn: OdeEquations> {
+    problem: OdeSolverProblem<Eqn>,
+    start_y: &'c RefCell<Vec<f64>>,
+}
+
+impl<Eqn> Integrand for States<'_, Eqn>
+where
+    Eqn: OdeEquationsImplicit<T = f64, V = FaerVec<f64>, M = FaerMat<f64>, C = FaerContext>,
+{
+    type Eqn = Eqn;
+    type Lu = FaerLU<f64>;
+    const PLACE: &'static str = "integrate";
+
+    fn problem(&self) -> &OdeSolverProblem<Eqn> {
+        &self.problem
     }
-    Ok(stats.finish(start, observer_time.get(), (rhs_calls.get(), jvps.get())))
+
+    fn restart(&mut self, t: f64, y: Vec<f64>, _s: Vec<f64>) {
+        self.problem.t0 = t;
+        *self.start_y.borrow_mut() = y;
+    }
 }

@@ -1,12 +1,15 @@
 //! [`integrate_sens`]: states and forward sensitivities.
 
-use super::legs::{lift_failure_cap, Legs};
+use super::legs::{lift_failure_cap, Integrand, Legs};
 use super::ode::OdeModel;
-use super::options::{Method, Options, SensitivityForm, Stats};
+use super::options::{Options, SensitivityForm, Stats};
 use crate::error::{Error, Result};
-use diffsol::{FaerLU, FaerMat, OdeBuilder};
+use diffsol::error::DiffsolError;
+use diffsol::{
+    FaerContext, FaerLU, FaerMat, FaerVec, OdeBuilder, OdeEquations, OdeEquationsImplicitSens,
+    OdeSolverMethod, OdeSolverProblem, Tableau,
+};
 use std::cell::RefCell;
-use std::time::Instant;
 
 /// Integrate `model` from `y0` together with the forward sensitivities of
 /// the state with respect to `params` (direct differentiation, paper Eqs.
@@ -25,7 +28,7 @@ pub fn integrate_sens<M: OdeModel>(
     y0: &[f64],
     opts: &Options,
     params: &[M::Param],
-    mut observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+    observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
 ) -> Result<Stats> {
     opts.validate()?;
     let n = y0.len();
@@ -104,46 +107,76 @@ pub fn integrate_sens<M: OdeModel>(
         .build()
         .map_err(|e| Error::numerical("integrate_sens: problem set-up", e.to_string()))?;
     lift_failure_cap(&mut problem.ode_options);
-    let start = Instant::now();
-    let observer_time = std::cell::Cell::new(0.0f64);
-    let mut observe = |t: f64, y: &[f64], s: &[f64]| {
-        let t0 = Instant::now();
-        let r = observe(t, y, s);
-        observer_time.set(observer_time.get() + t0.elapsed().as_secs_f64());
-        r
+    let mut states = WithSens {
+        problem,
+        np,
+        start: (&start_y, &start_s),
     };
-    let setup = |e: diffsol::error::DiffsolError| {
-        Error::numerical("integrate_sens: solver set-up", e.to_string())
-    };
-    let mut legs = Legs {
-        opts,
-        nsens: np,
-        fused: None,
-        next: 0,
-        model,
-        events: &ev,
-        work: &work,
-        params: (params, &p0),
-    };
-    let mut stats = Stats::default();
-    loop {
-        let (leg, event) = match opts.method {
-            Method::Bdf => legs.drive(
-                problem.bdf_sens::<FaerLU<f64>>().map_err(setup)?,
-                &mut observe,
-            )?,
-            Method::Esdirk34 => legs.drive(
-                problem.esdirk34_sens::<FaerLU<f64>>().map_err(setup)?,
-                &mut observe,
-            )?,
-            Method::Tsit45 => legs.drive(problem.tsit45_sens().map_err(setup)?, &mut observe)?,
-        };
-        let Some(e) = legs.end_leg(&mut stats, (leg, event), &mut observe)? else {
-            break;
-        };
-        problem.t0 = e.t;
-        *start_y.borrow_mut() = e.y;
-        *start_s.borrow_mut() = e.s;
+    let legs = Legs::new(opts, model, (&ev, &work), (params, &p0), &states);
+    legs.run(&mut states, (&rhs_calls, &jvps), observe)
+}
+
+/// The states and `np` lanes of forward sensitivities in diffsol's
+/// sensitivity equations (the staggered form), on its sensitivity solvers
+/// with its dense LU; a leg starts from `start` (state, lanes), shared
+/// with the problem's initial conditions.
+struct WithSens<'c, Eqn: OdeEquations> {
+    problem: OdeSolverProblem<Eqn>,
+    np: usize,
+    start: (&'c RefCell<Vec<f64>>, &'c RefCell<Vec<f64>>),
+}
+
+impl<Eqn> Integrand for WithSens<'_, Eqn>
+where
+    Eqn: OdeEquationsImplicitSens<T = f64, V = FaerVec<f64>, M = FaerMat<f64>, C = FaerContext>,
+{
+    type Eqn = Eqn;
+    type Lu = FaerLU<f64>;
+    const PLACE: &'static str = "integrate_sens";
+
+    fn problem(&self) -> &OdeSolverProblem<Eqn> {
+        &self.problem
     }
-    Ok(stats.finish(start, observer_time.get(), (rhs_calls.get(), jvps.get())))
+
+    fn nsens(&self) -> usize {
+        self.np
+    }
+
+    fn bdf<'s>(&'s self) -> std::result::Result<impl OdeSolverMethod<'s, Eqn>, DiffsolError>
+    where
+        Eqn: 's,
+    {
+        self.problem.bdf_sens::<FaerLU<f64>>()
+    }
+
+    fn sdirk<'s>(
+        &'s self,
+        tableau: Tableau<f64>,
+    ) -> std::result::Result<impl OdeSolverMethod<'s, Eqn>, DiffsolError>
+    where
+        Eqn: 's,
+    {
+        let state = self
+            .problem
+            .rk_state_sens_and_consistent::<FaerLU<f64>>(&tableau)?;
+        self.problem
+            .sdirk_solver_sens::<FaerLU<f64>, _>(state, tableau)
+    }
+
+    fn explicit_rk<'s>(
+        &'s self,
+        tableau: Tableau<f64>,
+    ) -> std::result::Result<impl OdeSolverMethod<'s, Eqn>, DiffsolError>
+    where
+        Eqn: 's,
+    {
+        let state = self.problem.rk_state_sens(&tableau)?;
+        self.problem.explicit_rk_solver_sens(state, tableau)
+    }
+
+    fn restart(&mut self, t: f64, y: Vec<f64>, s: Vec<f64>) {
+        self.problem.t0 = t;
+        *self.start.0.borrow_mut() = y;
+        *self.start.1.borrow_mut() = s;
+    }
 }

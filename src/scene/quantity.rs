@@ -9,24 +9,26 @@
 //! from that table; adding an output is one variant, its row of the table
 //! and its evaluation in `crate::simulate`. Response kinds are
 //! [`ResponseKind`] (integral, peak, final, value_at, crossing,
-//! frequency), deserialized directly from `[[scene.responses]] kind`.
+//! frequency), each variant with its own parameters, built from
+//! `[[scene.responses]] kind` and that kind's keys (`super::responses`).
 
-use crate::mbs::responses::{Direction, ResponseKind, Sense};
+use crate::mbs::responses::ResponseKind;
 use crate::mbs::Energy;
 
 /// A built response: `scale · Σ` outputs over the run, reduced by its
 /// kind, or a natural frequency of a flexible body.
 ///
-/// Two forms: sums of energies reduced by `integral`, `peak` (largest) or
-/// `final` are evaluated as before this struct had [`Response::outputs`]
-/// (integrals as integrated states, `terms`); every other response is
-/// sampled at the output times from [`Response::outputs`] and reduced by
-/// `crate::mbs::series`.
+/// Two forms: sums of energies of a kind with an energy form
+/// ([`ResponseKind::energy_form`]: `integral`, `peak` of the largest
+/// value, `final`) are evaluated from the energies `terms` (integrals as
+/// integrated states); every other response is sampled at the output
+/// times from [`Response::outputs`] and reduced by `crate::mbs::series`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Response {
     /// The `[[scene.responses]] name`.
     pub name: String,
-    /// How the series is reduced (or `frequency`).
+    /// How the series is reduced (or `frequency`), with the kind's
+    /// parameters.
     pub kind: ResponseKind,
     /// The energies summed (energy form; empty in the sampled form).
     pub terms: Vec<Energy>,
@@ -39,14 +41,6 @@ pub struct Response {
     /// The outputs summed in the sampled form (empty in the energy form
     /// and for frequencies).
     pub outputs: Vec<ScalarOutput>,
-    /// `peak`: largest or smallest value.
-    pub sense: Sense,
-    /// `value_at`: the time (s).
-    pub time: f64,
-    /// `crossing`: the level and the direction.
-    pub level: (f64, Direction),
-    /// `frequency`: the body and the 0-based mode of its basis.
-    pub mode: (usize, usize),
     /// SI unit of the response's value (`ResponseKind::unit_of` of the
     /// outputs' unit).
     pub unit: String,

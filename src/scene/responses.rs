@@ -15,7 +15,7 @@ use super::quantity::{Columns, QuantityKind, Response, ScalarOutput, Subject};
 use super::spec::ResponseSpec;
 use crate::error::{Error, Result};
 use crate::mbs::model::{Integral, Model};
-use crate::mbs::responses::{ResponseKind, Sense};
+use crate::mbs::responses::{ResponseKind, ResponseKindName};
 
 /// Build `[[scene.responses]]` against the model (integrals of energies
 /// become model states); `times` are the output times.
@@ -49,23 +49,18 @@ pub(super) fn build_responses(
                 "at least one output",
             ));
         }
-        check_kind_keys(&key, r, times)?;
+        let kind = kind_of(&key, r, times, model)?;
         let mut resp = Response {
             name: r.name.clone(),
-            kind: r.kind,
+            kind,
             terms: Vec::new(),
             scale: r.scale,
             integral: None,
             outputs: Vec::new(),
-            sense: r.sense.unwrap_or_default(),
-            time: r.time.unwrap_or(0.0),
-            level: (r.level.unwrap_or(0.0), r.direction.unwrap_or_default()),
-            mode: (0, 0),
             unit: String::new(),
         };
-        if r.kind == ResponseKind::Frequency {
-            resp.mode = frequency_mode(&key, r, model)?;
-            resp.unit = r.kind.unit_of("");
+        if let ResponseKind::Frequency { .. } = kind {
+            resp.unit = kind.unit_of("");
             out.push(resp);
             continue;
         }
@@ -73,15 +68,11 @@ pub(super) fn build_responses(
             r.of.iter()
                 .map(|q| parse_energy(model, flex_names, q))
                 .collect();
-        let energy_form = matches!(
-            (r.kind, resp.sense),
-            (ResponseKind::Integral | ResponseKind::Final, _) | (ResponseKind::Peak, Sense::Max)
-        );
         match energies {
-            Some(terms) if energy_form => {
+            Some(terms) if kind.energy_form() => {
                 resp.terms = terms.into_iter().flatten().collect();
-                resp.unit = r.kind.unit_of("J");
-                if r.kind == ResponseKind::Integral {
+                resp.unit = kind.unit_of("J");
+                if kind == ResponseKind::Integral {
                     model.integrals.push(Integral {
                         terms: resp.terms.clone(),
                         scale: r.scale,
@@ -108,7 +99,7 @@ pub(super) fn build_responses(
                     unit = Some(u);
                     resp.outputs.push(s);
                 }
-                resp.unit = r.kind.unit_of(unit.unwrap_or("-"));
+                resp.unit = kind.unit_of(unit.unwrap_or("-"));
             }
         }
         out.push(resp);
@@ -116,9 +107,36 @@ pub(super) fn build_responses(
     Ok(out)
 }
 
-/// The keys that belong to each kind: `sense` with `peak`, `time` with
-/// `value_at` (required, within the output times), `level` (required) and
-/// `direction` with `crossing`, `mode` (required) with `frequency`.
+/// The response's kind with its parameters, from `kind` and the keys that
+/// belong to it: `sense` with `peak`, `time` with `value_at` (required,
+/// within the output times), `level` (required) and `direction` with
+/// `crossing`, `mode` (required; with `of`, one flexible body) with
+/// `frequency`. A key of another kind is refused, naming its kind.
+fn kind_of(key: &str, r: &ResponseSpec, times: &[f64], model: &Model) -> Result<ResponseKind> {
+    check_kind_keys(key, r, times)?;
+    // The required keys are present here (checked above).
+    Ok(match r.kind {
+        ResponseKindName::Integral => ResponseKind::Integral,
+        ResponseKindName::Peak => ResponseKind::Peak {
+            sense: r.sense.unwrap_or_default(),
+        },
+        ResponseKindName::Final => ResponseKind::Final,
+        ResponseKindName::ValueAt => ResponseKind::ValueAt {
+            time: r.time.unwrap_or(0.0),
+        },
+        ResponseKindName::Crossing => ResponseKind::Crossing {
+            level: r.level.unwrap_or(0.0),
+            direction: r.direction.unwrap_or_default(),
+        },
+        ResponseKindName::Frequency => {
+            let (body, mode) = frequency_mode(key, r, model)?;
+            ResponseKind::Frequency { body, mode }
+        }
+    })
+}
+
+/// The keys that belong to each kind ([`kind_of`]): a stray key, or a
+/// missing or out-of-range required one, is an input error.
 fn check_kind_keys(key: &str, r: &ResponseSpec, times: &[f64]) -> Result<()> {
     let kind = r.kind;
     let stray = |k: &str, v: String, owner: &str| {
@@ -128,21 +146,21 @@ fn check_kind_keys(key: &str, r: &ResponseSpec, times: &[f64]) -> Result<()> {
             format!("no `{k}` for kind = \"{kind}\" (it belongs to kind = \"{owner}\")"),
         )
     };
-    if r.sense.is_some() && kind != ResponseKind::Peak {
+    if r.sense.is_some() && kind != ResponseKindName::Peak {
         return Err(stray("sense", format!("{:?}", r.sense), "peak"));
     }
-    if r.direction.is_some() && kind != ResponseKind::Crossing {
+    if r.direction.is_some() && kind != ResponseKindName::Crossing {
         return Err(stray("direction", format!("{:?}", r.direction), "crossing"));
     }
     match (kind, r.time) {
-        (ResponseKind::ValueAt, None) => {
+        (ResponseKindName::ValueAt, None) => {
             return Err(Error::input(
                 format!("{key}.time"),
                 "(missing)",
                 "the time (s) of a value_at response",
             ))
         }
-        (ResponseKind::ValueAt, Some(t)) => {
+        (ResponseKindName::ValueAt, Some(t)) => {
             let (a, b) = (
                 times.first().copied().unwrap_or(0.0),
                 times.last().copied().unwrap_or(0.0),
@@ -159,27 +177,27 @@ fn check_kind_keys(key: &str, r: &ResponseSpec, times: &[f64]) -> Result<()> {
         _ => {}
     }
     match (kind, r.level) {
-        (ResponseKind::Crossing, None) => {
+        (ResponseKindName::Crossing, None) => {
             return Err(Error::input(
                 format!("{key}.level"),
                 "(missing)",
                 "the level crossed, in the unit of the outputs",
             ))
         }
-        (ResponseKind::Crossing, Some(l)) if !l.is_finite() => {
+        (ResponseKindName::Crossing, Some(l)) if !l.is_finite() => {
             return Err(Error::input(format!("{key}.level"), l, "a finite level"))
         }
-        (ResponseKind::Crossing, _) => {}
+        (ResponseKindName::Crossing, _) => {}
         (_, Some(l)) => return Err(stray("level", l.to_string(), "crossing")),
         _ => {}
     }
     match (kind, r.mode) {
-        (ResponseKind::Frequency, None) => Err(Error::input(
+        (ResponseKindName::Frequency, None) => Err(Error::input(
             format!("{key}.mode"),
             "(missing)",
             "the mode (1 = lowest) of a frequency response",
         )),
-        (ResponseKind::Frequency, _) | (_, None) => Ok(()),
+        (ResponseKindName::Frequency, _) | (_, None) => Ok(()),
         (_, Some(m)) => Err(stray("mode", m.to_string(), "frequency")),
     }
 }
@@ -275,14 +293,21 @@ fn scalar_output(model: &Model, flex_names: &[&str], key: &str, q: &str) -> Resu
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mbs::responses::Direction;
+    use crate::mbs::responses::{Direction, Sense};
 
     #[test]
     fn response_units_follow_the_output_and_the_kind() {
+        let peak = ResponseKind::Peak { sense: Sense::Min };
+        let crossing = ResponseKind::Crossing {
+            level: 0.5,
+            direction: Direction::Up,
+        };
+        let frequency = ResponseKind::Frequency { body: 1, mode: 0 };
         assert_eq!(ResponseKind::Integral.unit_of("rad"), "rad*s");
-        assert_eq!(ResponseKind::Peak.unit_of("m"), "m");
-        assert_eq!(ResponseKind::Crossing.unit_of("rad"), "s");
-        assert_eq!(ResponseKind::Frequency.unit_of(""), "Hz");
+        assert_eq!(peak.unit_of("m"), "m");
+        assert_eq!(crossing.unit_of("rad"), "s");
+        assert_eq!(frequency.unit_of(""), "Hz");
+        assert_eq!(ResponseKind::ValueAt { time: 0.1 }.unit_of("m"), "m");
         // The energy form keeps the units it had.
         assert_eq!(
             ResponseKind::Integral.unit_of("J"),

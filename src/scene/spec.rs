@@ -3,7 +3,7 @@
 //! [`super::build`].
 
 use crate::integrate::{Method, SensitivityForm};
-use crate::mbs::responses::{Direction, ResponseKind, Sense};
+use crate::mbs::responses::{Direction, ResponseKindName, Sense};
 use crate::modal::ModeUpdate;
 use serde::Deserialize;
 
@@ -191,7 +191,7 @@ pub struct ResponseSpec {
     /// `integral` (∫ dt), `peak` (extreme over the run), `final` (at the
     /// end time), `value_at` (at `time`), `crossing` (first time the
     /// output crosses `level`, s) or `frequency` (Hz).
-    pub kind: ResponseKind,
+    pub kind: ResponseKindName,
     /// The outputs summed (at least one): energies, or scalar outputs of
     /// one unit (`<joint>.angle|rate|displacement|velocity`,
     /// `<body>.position_x|y|z`, `<marker>.deflection_x|y|z`); for

@@ -13,8 +13,7 @@
 use crate::error::{Error, Result};
 use crate::integrate::{integrate, integrate_sens, Stats};
 use crate::mbs::post::energy::EnergyMonitor;
-use crate::mbs::responses::{critical_points, energy_lanes, ResponseKind, ResponseValue};
-use crate::mbs::series::Sample;
+use crate::mbs::responses::ResponseValue;
 use crate::mbs::Projection;
 use crate::mbs::{Energy, Param, Reaction, System, Workspace};
 use crate::report::csv::{sci, write_table};
@@ -24,6 +23,7 @@ use crate::scene::{Quantity, Scene};
 use num_dual::Dual64;
 use std::path::{Path, PathBuf};
 
+mod responses;
 pub mod sampled;
 pub mod spin;
 pub mod weak;
@@ -124,9 +124,7 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
     let sens_headers = sens_headers(scene, &sens_quantities);
     let mut sens_rows = Vec::new();
     let n = y0.len();
-    // Sampled peak responses (t, value, gradient) and the final
-    // sensitivities (for integral responses).
-    let mut peaks: Vec<Vec<(f64, f64, Vec<f64>)>> = vec![Vec::new(); scene.responses.len()];
+    // The final sensitivities (for integral responses).
     let mut s_end = vec![0.0; n * scene.params.len()];
     let mut sampler = sampled::Sampler::new(&scene.responses);
     let mut spin = spin::SpinWatch::new(&sys);
@@ -143,12 +141,6 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
                 .collect()
         };
         sampler.observe(&sys, &scene.responses, (t, y), &lanes);
-        for (r, series) in scene.responses.iter().zip(peaks.iter_mut()) {
-            if r.kind == ResponseKind::Peak && r.outputs.is_empty() {
-                let (v, g) = energy_lanes(&sys, (&r.terms, r.scale), y, &lanes);
-                series.push((t, v, g));
-            }
-        }
         if !s.is_empty() {
             s_end.copy_from_slice(s);
         }
@@ -187,48 +179,15 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
         y_end.copy_from_slice(y);
         Ok(())
     };
-    let run = if sys.nb() == 0 {
-        // Nothing moves: the state (integrals of zero energies included)
-        // is constant; an integrator would not start on it.
-        scene.options.validate().and_then(|_| {
-            let s0 = vec![0.0; n * scene.params.len()];
-            for &t in &scene.options.times {
-                observe(t, &y0, &s0)?;
-            }
-            Ok(Stats::default())
-        })
-    } else if scene.params.is_empty() {
-        integrate(&sys, &y0, &scene.options, |t, y| observe(t, y, &[]))
-    } else {
-        let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
-        integrate_sens(&sys, &y0, &scene.options, &params, &mut observe)
-    };
-    let (stats, failure) = match run {
-        Ok(stats) => (stats, None),
-        Err(Error::Numerical {
-            place,
-            time,
-            detail,
-        }) => {
-            // A joint-load prestress iteration that did not converge names
-            // its time and bodies.
-            let detail = match sys.counters.prestress_failure.borrow().as_ref() {
-                Some((t, what)) => format!("{detail}; at t = {t} s {what}"),
-                None => detail,
-            };
-            (
-                Stats::default(),
-                Some(Error::Numerical {
-                    place,
-                    time,
-                    detail,
-                }),
-            )
-        }
-        Err(e) => return Err(e),
-    };
+    let run = run_scene(&sys, scene, &y0, &mut observe);
+    let (stats, failure) = failure_of(&sys, run)?;
     let responses = if failure.is_none() {
-        collect_responses(scene, &sys, (&peaks, &sampler), &y_end, &s_end)?
+        let end = responses::RunEnd {
+            sampler: &sampler,
+            y_end: &y_end,
+            s_end: &s_end,
+        };
+        responses::evaluate_all(scene, &sys, &end)?
     } else {
         Vec::new()
     };
@@ -255,6 +214,64 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
         warnings: weak.into_iter().chain(spin.warnings).collect(),
     };
     Ok((sys, sim))
+}
+
+/// Integrate the scene from `y0`, with its sensitivities when it has
+/// parameters, calling `observe(t, y, s)` at every output time. A scene
+/// in which nothing moves is not integrated: its constant state is
+/// observed at the output times.
+fn run_scene(
+    sys: &System,
+    scene: &Scene,
+    y0: &[f64],
+    mut observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+) -> Result<Stats> {
+    if sys.nb() == 0 {
+        // Nothing moves: the state (integrals of zero energies included)
+        // is constant; an integrator would not start on it.
+        scene.options.validate().and_then(|_| {
+            let s0 = vec![0.0; y0.len() * scene.params.len()];
+            for &t in &scene.options.times {
+                observe(t, y0, &s0)?;
+            }
+            Ok(Stats::default())
+        })
+    } else if scene.params.is_empty() {
+        integrate(sys, y0, &scene.options, |t, y| observe(t, y, &[]))
+    } else {
+        let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
+        integrate_sens(sys, y0, &scene.options, &params, &mut observe)
+    }
+}
+
+/// The statistics of a run and the numerical failure that ended it
+/// early, if one did (the rows before it are kept); any other error is
+/// returned.
+fn failure_of(sys: &System, run: Result<Stats>) -> Result<(Stats, Option<Error>)> {
+    match run {
+        Ok(stats) => Ok((stats, None)),
+        Err(Error::Numerical {
+            place,
+            time,
+            detail,
+        }) => {
+            // A joint-load prestress iteration that did not converge names
+            // its time and bodies.
+            let detail = match sys.counters.prestress_failure.borrow().as_ref() {
+                Some((t, what)) => format!("{detail}; at t = {t} s {what}"),
+                None => detail,
+            };
+            Ok((
+                Stats::default(),
+                Some(Error::Numerical {
+                    place,
+                    time,
+                    detail,
+                }),
+            ))
+        }
+        Err(e) => Err(e),
+    }
 }
 
 /// Columns of `history.csv` that hold joint angles (column 0 is time).
@@ -362,94 +379,6 @@ fn output_row(
         }
     }
     row
-}
-
-/// The response values: integrals from the final state (and their
-/// gradients from the final sensitivities `s_end`, lane-major), peaks from
-/// the sampled series at their critical time points.
-fn collect_responses(
-    scene: &Scene,
-    sys: &System,
-    (peaks, sampler): (&[Vec<Sample>], &sampled::Sampler),
-    y_end: &[f64],
-    s_end: &[f64],
-) -> Result<Vec<ResponseValue>> {
-    let n = y_end.len();
-    let io = sys.integral_off();
-    let mut responses = Vec::new();
-    let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
-    for (k, (r, series)) in scene.responses.iter().zip(peaks).enumerate() {
-        let name = r.name.clone();
-        if r.kind == ResponseKind::Frequency {
-            responses.push(sampled::frequency(sys, r, &params)?);
-            continue;
-        }
-        if !r.outputs.is_empty() {
-            responses.push(sampler.reduce(&scene.responses, k)?);
-            continue;
-        }
-        responses.push(match r.kind {
-            ResponseKind::Integral => {
-                let index = r.integral.ok_or_else(|| {
-                    Error::numerical(
-                        "simulate: responses",
-                        format!("{name} has no integrated state"),
-                    )
-                })?;
-                ResponseValue {
-                    name,
-                    kind: r.kind,
-                    value: y_end[io + index],
-                    unit: r.unit.clone(),
-                    time: None,
-                    gradient: (0..scene.params.len())
-                        .map(|i| s_end[i * n + io + index])
-                        .collect(),
-                    critical: Vec::new(),
-                }
-            }
-            ResponseKind::Final => {
-                let lanes: Vec<(&[f64], Param)> = scene
-                    .params
-                    .iter()
-                    .enumerate()
-                    .map(|(i, (_, p))| (&s_end[i * n..(i + 1) * n], *p))
-                    .collect();
-                let (value, gradient) = energy_lanes(sys, (&r.terms, r.scale), y_end, &lanes);
-                ResponseValue {
-                    name,
-                    kind: r.kind,
-                    value,
-                    unit: r.unit.clone(),
-                    time: scene.options.times.last().copied(),
-                    gradient,
-                    critical: Vec::new(),
-                }
-            }
-            ResponseKind::ValueAt | ResponseKind::Crossing | ResponseKind::Frequency => {
-                return Err(Error::numerical(
-                    "simulate: responses",
-                    format!("{name}: a {} response of energies is sampled", r.kind),
-                ))
-            }
-            ResponseKind::Peak => {
-                let critical = critical_points(series);
-                let (t, value, gradient) = critical.first().cloned().ok_or_else(|| {
-                    Error::numerical("simulate: responses", format!("no samples for {name}"))
-                })?;
-                ResponseValue {
-                    name,
-                    kind: r.kind,
-                    value,
-                    unit: r.unit.clone(),
-                    time: Some(t),
-                    gradient,
-                    critical,
-                }
-            }
-        });
-    }
-    Ok(responses)
 }
 
 /// Exact derivatives of the outputs along the state sensitivity

@@ -6,9 +6,10 @@
 //! dual-number evaluation of each output at `y + ε ∂y/∂p` with the design
 //! seed of `p` (so `dX/dθ` and `dΛ/dθ` enter explicitly), as the columns
 //! of `sensitivities.csv`. Joint angles are unwrapped over the series as
-//! in `history.csv`. The series is then reduced by
-//! [`crate::mbs::series`] (integral, extreme, value at a time, crossing;
-//! the final value is the last sample).
+//! in `history.csv`. The series is then reduced by its kind
+//! (`super::responses`, through [`crate::mbs::series`]). A peak of
+//! energies (the energy form) is sampled here too, as the sum of its
+//! energies with their lanes ([`crate::mbs::responses::energy_lanes`]).
 //!
 //! A frequency response is `f_k = scale · √λ_k / (2π)` of a flexible
 //! body's basis, with `df_k/dp = scale · (dλ_k/dp) / (4π √λ_k)` for a
@@ -18,8 +19,8 @@
 //! integration.
 
 use crate::error::{Error, Result};
-use crate::mbs::responses::{critical_extremes, ResponseKind, ResponseValue};
-use crate::mbs::series::{crossing, extreme, trapezoid, value_at, NoCrossing, Sample};
+use crate::mbs::responses::{energy_lanes, ResponseKind, ResponseValue};
+use crate::mbs::series::Sample;
 use crate::mbs::{Energy, Param, System, Workspace};
 use crate::scene::{QuantityKind, Response, ScalarOutput, Scene};
 use num_dual::Dual64;
@@ -83,12 +84,19 @@ fn output_lanes(
     (value, grad)
 }
 
-/// The series of the scene's sampled responses, filled at the output
-/// times.
+/// Whether a response in the energy form has a series: a peak of
+/// energies is located among its samples; an integral of energies is an
+/// integrated state and a final value is read at the end state.
+fn samples_energies(r: &Response) -> bool {
+    matches!(r.kind, ResponseKind::Peak { .. })
+}
+
+/// The series of the scene's sampled responses and of its peaks of
+/// energies, filled at the output times.
 #[derive(Debug, Default)]
 pub struct Sampler {
-    /// Per response of the scene: its samples (empty for the energy form
-    /// and frequencies).
+    /// Per response of the scene: its samples (empty for integrals and
+    /// final values of energies and for frequencies).
     series: Vec<Vec<Sample>>,
     /// Per response and output: the previous value (angle unwrapping).
     prev: Vec<Vec<Option<f64>>>,
@@ -106,7 +114,8 @@ impl Sampler {
         }
     }
 
-    /// Sample every sampled response at `(t, y)` with its lanes.
+    /// Sample every sampled response, and every peak of energies, at
+    /// `(t, y)` with its lanes.
     pub fn observe(
         &mut self,
         sys: &System,
@@ -117,6 +126,10 @@ impl Sampler {
         let turn = 2.0 * std::f64::consts::PI;
         for (k, r) in responses.iter().enumerate() {
             if r.outputs.is_empty() {
+                if samples_energies(r) {
+                    let (v, g) = energy_lanes(sys, (&r.terms, r.scale), y, lanes);
+                    self.series[k].push((t, v, g));
+                }
                 continue;
             }
             let mut value = 0.0;
@@ -139,78 +152,22 @@ impl Sampler {
         }
     }
 
-    /// The value of sampled response `k` of `responses`: its series
-    /// reduced by its kind. A crossing that does not happen, or a series
-    /// without samples, is a numerical error naming the response.
-    pub fn reduce(&self, responses: &[Response], k: usize) -> Result<ResponseValue> {
-        let r = &responses[k];
-        let series = &self.series[k];
-        let fail = |detail: String| {
-            Error::numerical(
-                "simulate: responses",
-                format!("response {}: {detail}", r.name),
-            )
-        };
-        let none = || fail("no samples (no output times)".into());
-        let (time, value, gradient) = match r.kind {
-            ResponseKind::Integral => {
-                let (v, g) = trapezoid(series).ok_or_else(none)?;
-                (None, v, g)
-            }
-            ResponseKind::Peak => {
-                let (t, v, g) = extreme(series, r.sense).ok_or_else(none)?;
-                (Some(t), v, g)
-            }
-            ResponseKind::Final => {
-                let (t, v, g) = series.last().cloned().ok_or_else(none)?;
-                (Some(t), v, g)
-            }
-            ResponseKind::ValueAt => {
-                let (v, g) = value_at(series, r.time).ok_or_else(|| {
-                    fail(format!("time {} s is outside the output times", r.time))
-                })?;
-                (Some(r.time), v, g)
-            }
-            ResponseKind::Crossing => {
-                let (level, dir) = r.level;
-                let (t, g) = crossing(series, level, dir).map_err(|e| match e {
-                    NoCrossing::Never(lo, hi) => fail(format!(
-                        "does not cross level {level} ({dir:?}) between t = {} s and {} s: \
-                         its range over the run is [{lo:e}, {hi:e}] {}",
-                        series.first().map_or(0.0, |s| s.0),
-                        series.last().map_or(0.0, |s| s.0),
-                        r.outputs
-                            .first()
-                            .map_or("", |o| o.quantity.kind.info().unit)
-                    )),
-                    NoCrossing::Flat(t) => fail(format!(
-                        "touches level {level} at t = {t} s with zero slope: the crossing \
-                         time has no derivative there"
-                    )),
-                })?;
-                (Some(t), t, g)
-            }
-            ResponseKind::Frequency => return Err(fail("a frequency is not sampled".into())),
-        };
-        Ok(ResponseValue {
-            name: r.name.clone(),
-            kind: r.kind,
-            value,
-            unit: r.unit.clone(),
-            time,
-            gradient,
-            critical: match r.kind {
-                ResponseKind::Peak => critical_extremes(series, r.sense),
-                _ => Vec::new(),
-            },
-        })
+    /// The series of response `k` (empty for the energy form without a
+    /// series and for frequencies).
+    pub fn series(&self, k: usize) -> &[Sample] {
+        &self.series[k]
     }
 }
 
-/// A frequency response of the built model (module doc), with its
-/// derivative along each sensitivity parameter.
-pub fn frequency(sys: &System, r: &Response, params: &[Param]) -> Result<ResponseValue> {
-    let (b, j) = r.mode;
+/// A frequency response of the built model (module doc): mode `j`
+/// (0-based) of body `b`, with its derivative along each sensitivity
+/// parameter.
+pub fn frequency(
+    sys: &System,
+    r: &Response,
+    (b, j): (usize, usize),
+    params: &[Param],
+) -> Result<ResponseValue> {
     let fail = |detail: String| {
         Error::numerical(
             "simulate: responses",
@@ -259,7 +216,11 @@ pub fn frequencies(scene: &Scene) -> Result<Vec<ResponseValue>> {
     scene
         .responses
         .iter()
-        .filter(|r| r.kind == ResponseKind::Frequency)
-        .map(|r| frequency(&sys, r, &params))
+        .filter_map(|r| match r.kind {
+            ResponseKind::Frequency { body, mode } => {
+                Some(frequency(&sys, r, (body, mode), &params))
+            }
+            _ => None,
+        })
         .collect()
 }

@@ -33,54 +33,120 @@ use crate::mbs::model::{Energy, Param};
 use crate::mbs::system::{System, Workspace};
 use num_dual::Dual64;
 
-/// The kind of a response functional (paper Eqs. 33–34), as written in
-/// `[[scene.responses]] kind`: `integral`, `peak`, `final`, `value_at`,
-/// `crossing` or `frequency`.
+/// The name of a response kind, as written in `[[scene.responses]] kind`
+/// and in `responses.csv`: `integral`, `peak`, `final`, `value_at`,
+/// `crossing` or `frequency` ([`ResponseKind`] carries its parameters).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
+pub enum ResponseKindName {
+    /// [`ResponseKind::Integral`].
+    Integral,
+    /// [`ResponseKind::Peak`].
+    Peak,
+    /// [`ResponseKind::Final`].
+    Final,
+    /// [`ResponseKind::ValueAt`].
+    ValueAt,
+    /// [`ResponseKind::Crossing`].
+    Crossing,
+    /// [`ResponseKind::Frequency`].
+    Frequency,
+}
+
+impl std::fmt::Display for ResponseKindName {
+    /// The name written in study files and `responses.csv`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ResponseKindName::Integral => "integral",
+            ResponseKindName::Peak => "peak",
+            ResponseKindName::Final => "final",
+            ResponseKindName::ValueAt => "value_at",
+            ResponseKindName::Crossing => "crossing",
+            ResponseKindName::Frequency => "frequency",
+        })
+    }
+}
+
+/// The kind of a response functional (paper Eqs. 33–34) with its own
+/// parameters: how the series `scale·Σ y(t)` is reduced to one number,
+/// or a natural frequency. Each kind is evaluated in one place,
+/// `crate::simulate`'s evaluation of responses.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ResponseKind {
     /// `∫ scale·Σ y dt` over the run: an integrated state for energies
     /// (Eq. 33), the trapezoidal rule over the output times otherwise.
     Integral,
-    /// `max_t` (or `min_t`, `sense = "min"`) of `scale·Σ y(t)` at its
-    /// critical time point (Eq. 34).
-    Peak,
+    /// `max_t` (or `min_t`) of `scale·Σ y(t)` at its critical time point
+    /// (Eq. 34).
+    Peak {
+        /// The largest or the smallest value.
+        sense: Sense,
+    },
     /// `scale·Σ y(t_end)`.
     Final,
-    /// `scale·Σ y(t)` at the given `time`, interpolated between output
-    /// times.
-    ValueAt,
+    /// `scale·Σ y(t)` at `time`, interpolated between output times.
+    ValueAt {
+        /// The time (s), within the output times.
+        time: f64,
+    },
     /// The first time (s) at which `scale·Σ y` crosses `level`.
-    Crossing,
+    Crossing {
+        /// The level, in the unit of the outputs.
+        level: f64,
+        /// Which crossings count.
+        direction: Direction,
+    },
     /// A natural frequency `√λ_k / (2π)` (Hz) of a flexible body's modal
     /// basis; no time integration.
-    Frequency,
+    Frequency {
+        /// The body (index in the model).
+        body: usize,
+        /// The 0-based mode of its basis.
+        mode: usize,
+    },
 }
 
 impl std::fmt::Display for ResponseKind {
     /// The name written in study files and `responses.csv`.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            ResponseKind::Integral => "integral",
-            ResponseKind::Peak => "peak",
-            ResponseKind::Final => "final",
-            ResponseKind::ValueAt => "value_at",
-            ResponseKind::Crossing => "crossing",
-            ResponseKind::Frequency => "frequency",
-        })
+        self.name().fmt(f)
     }
 }
 
 impl ResponseKind {
+    /// The kind's name.
+    pub fn name(&self) -> ResponseKindName {
+        match self {
+            ResponseKind::Integral => ResponseKindName::Integral,
+            ResponseKind::Peak { .. } => ResponseKindName::Peak,
+            ResponseKind::Final => ResponseKindName::Final,
+            ResponseKind::ValueAt { .. } => ResponseKindName::ValueAt,
+            ResponseKind::Crossing { .. } => ResponseKindName::Crossing,
+            ResponseKind::Frequency { .. } => ResponseKindName::Frequency,
+        }
+    }
+
+    /// Whether a sum of energies of this kind keeps the energy form
+    /// (integrals as integrated states, the largest value by
+    /// [`critical_points`], the final value from the end state): integrals,
+    /// final values and peaks of the largest value; every other response
+    /// is sampled.
+    pub fn energy_form(&self) -> bool {
+        matches!(
+            self,
+            ResponseKind::Integral | ResponseKind::Final | ResponseKind::Peak { sense: Sense::Max }
+        )
+    }
+
     /// SI unit of a response of this kind over energies (J) with a
     /// dimensionless scale: `J*s` for an integral, `s` for a crossing
     /// time, `Hz` for a frequency, `J` otherwise.
     pub fn unit(&self) -> &'static str {
         match self {
             ResponseKind::Integral => "J*s",
-            ResponseKind::Crossing => "s",
-            ResponseKind::Frequency => "Hz",
-            ResponseKind::Peak | ResponseKind::Final | ResponseKind::ValueAt => "J",
+            ResponseKind::Crossing { .. } => "s",
+            ResponseKind::Frequency { .. } => "Hz",
+            ResponseKind::Peak { .. } | ResponseKind::Final | ResponseKind::ValueAt { .. } => "J",
         }
     }
 
@@ -90,9 +156,11 @@ impl ResponseKind {
     pub fn unit_of(&self, base: &str) -> String {
         match self {
             ResponseKind::Integral => format!("{base}*s"),
-            ResponseKind::Crossing => "s".into(),
-            ResponseKind::Frequency => "Hz".into(),
-            ResponseKind::Peak | ResponseKind::Final | ResponseKind::ValueAt => base.into(),
+            ResponseKind::Crossing { .. } => "s".into(),
+            ResponseKind::Frequency { .. } => "Hz".into(),
+            ResponseKind::Peak { .. } | ResponseKind::Final | ResponseKind::ValueAt { .. } => {
+                base.into()
+            }
         }
     }
 }
@@ -279,6 +347,38 @@ fn refine(series: &[(f64, f64, Vec<f64>)], k: usize) -> (f64, f64, Vec<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every kind's name is the one study files give it (serde's), and
+    /// the name of each kind with its parameters is its own.
+    #[test]
+    fn kind_names_are_the_study_file_names() {
+        #[derive(serde::Deserialize)]
+        struct Spec {
+            kind: ResponseKindName,
+        }
+        let kinds = [
+            ("integral", ResponseKind::Integral),
+            ("peak", ResponseKind::Peak { sense: Sense::Min }),
+            ("final", ResponseKind::Final),
+            ("value_at", ResponseKind::ValueAt { time: 0.25 }),
+            (
+                "crossing",
+                ResponseKind::Crossing {
+                    level: 1.0,
+                    direction: Direction::Down,
+                },
+            ),
+            ("frequency", ResponseKind::Frequency { body: 2, mode: 1 }),
+        ];
+        for (name, kind) in kinds {
+            let spec: Spec = toml::from_str(&format!("kind = \"{name}\"")).unwrap();
+            assert_eq!(spec.kind, kind.name(), "{name}");
+            assert_eq!(kind.to_string(), name);
+        }
+        assert!(ResponseKind::Peak { sense: Sense::Max }.energy_form());
+        assert!(!ResponseKind::Peak { sense: Sense::Min }.energy_form());
+        assert!(!ResponseKind::ValueAt { time: 0.0 }.energy_form());
+    }
 
     #[test]
     fn peak_of_a_sampled_parabola_is_exact() {
