@@ -20,6 +20,7 @@ pub mod kkt;
 pub mod mmfd;
 pub mod mo_testproblems;
 pub mod multiobjective;
+pub mod noise;
 pub mod nsga2;
 pub mod qp;
 pub mod sqp;
