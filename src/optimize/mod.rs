@@ -17,6 +17,7 @@ pub mod cmaes;
 pub mod driver;
 pub mod indicators;
 pub mod kkt;
+pub mod local;
 pub mod mmfd;
 pub mod mo_testproblems;
 pub mod multiobjective;
