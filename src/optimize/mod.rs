@@ -17,11 +17,14 @@ pub mod cmaes;
 pub mod driver;
 pub mod indicators;
 pub mod kkt;
+pub mod local;
 pub mod mmfd;
 pub mod mo_testproblems;
 pub mod multiobjective;
+pub mod noise;
 pub mod nsga2;
 pub mod qp;
+pub mod sqp;
 pub mod testproblems;
 
 /// One design variable: bounds and optional period.
@@ -348,6 +351,9 @@ pub enum Termination {
     Infeasible,
     /// A feasible design reached the requested target objective.
     TargetReached,
+    /// The line search found no decrease of the merit function, twice in
+    /// a row (SQP).
+    LineSearchFailed,
 }
 
 impl std::fmt::Display for Termination {
@@ -362,6 +368,7 @@ impl std::fmt::Display for Termination {
             Termination::Stagnation => "stagnation",
             Termination::Infeasible => "infeasible",
             Termination::TargetReached => "target_reached",
+            Termination::LineSearchFailed => "line_search_failed",
         };
         f.write_str(s)
     }
