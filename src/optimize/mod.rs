@@ -22,6 +22,7 @@ pub mod mo_testproblems;
 pub mod multiobjective;
 pub mod nsga2;
 pub mod qp;
+pub mod sampling;
 pub mod testproblems;
 
 /// One design variable: bounds and optional period.
