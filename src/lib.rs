@@ -92,7 +92,7 @@
 //! [`mbs::model::force`] and [`mbs::forces`]; an output or response in [`scene::quantity`] (parsed
 //! in [`scene::parts`]) and evaluated in [`simulate`]; a study section in
 //! [`sections`] with its entry in [`cli`]; an optimizer in [`optimize`]
-//! behind [`optimize::Problem`], selectable in [`explore::solvers`].
+//! behind [`optimize::Problem`], selectable in [`explore::local::solvers`].
 //!
 //! ## Glossary
 //! FE finite element; FFRF floating frame of reference; CMS component mode

@@ -1,13 +1,40 @@
 //! What a driver command gets from the command line ([`Context`],
-//! [`DriveFlags`]), the directory it writes into and its manifest entry.
+//! [`DriveFlags`], [`Shard`]), the directory it writes into and its manifest entry.
 
-use super::fingerprint::Fingerprint;
-use super::multistart::Shard;
 use crate::error::{Error, Result};
+use crate::explore::persist::fingerprint::Fingerprint;
 use crate::report::manifest::ShardRecord;
 use crate::study::Study;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+
+/// Run every `n`-th start beginning at `index` (`--shard index/count`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// 0-based shard index, `< count`.
+    pub index: usize,
+    /// Number of shards, `>= 1`.
+    pub count: usize,
+}
+
+impl Shard {
+    /// Parse `i/n` with `0 <= i < n`.
+    pub fn parse(s: &str) -> Result<Shard> {
+        let bad = || Error::input("--shard", s, "i/n with integers 0 <= i < n");
+        let (i, n) = s.split_once('/').ok_or_else(bad)?;
+        let index: usize = i.trim().parse().map_err(|_| bad())?;
+        let count: usize = n.trim().parse().map_err(|_| bad())?;
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// Does this shard run start `k`?
+    pub fn owns(&self, k: usize) -> bool {
+        k % self.count == self.index
+    }
+}
 
 /// Flags of the driver commands beyond the common ones.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,9 +89,9 @@ impl Context<'_> {
     /// Update `manifest.json` ([`crate::report::record_command`]) with the
     /// shard, the threads, the resume flag, the study's fingerprint
     /// ([`Fingerprint::of_study`]) and the command's own `detail`
-    /// ([`super::manifest`]).
+    /// ([`crate::explore::persist::manifest`]).
     pub fn manifest<D: Serialize>(&self, dir: &Path, command: &str, detail: D) -> Result<()> {
-        let entry = super::manifest::DriverEntry {
+        let entry = crate::explore::persist::manifest::DriverEntry {
             threads: self.threads,
             resume: self.flags.resume,
             fingerprint: Some(Fingerprint::of_study(self.study)),

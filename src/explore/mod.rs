@@ -1,48 +1,29 @@
-//! Exploration drivers: multistart, evolutionary comparison, design-space
-//! maps, resumable and shardable tables (issue 5).
+//! Exploration: how many optima a ply-angle problem has, which is best,
+//! how likely one start is to find it, what the landscape and the Pareto
+//! front look like, and which designs on a discrete set of angles are best.
 //!
 //! A gradient-based local optimizer (MMFD) finds the optimum of the basin it
-//! starts in; ply-angle problems have many basins. The drivers here answer
-//! "how many optima are there, which is best, and how likely is one start to
-//! find it?" by running the local optimizer from many seeded start points in
-//! parallel ([`multistart`]), merging the results into distinct optima
-//! ([`cluster`]), comparing with an evolutionary search on the same budget
-//! ([`evolve`]) and drawing the landscape ([`map`]).
+//! starts in; ply-angle problems have many basins. Each feature below is a
+//! folder holding the study section it reads, its algorithm and its command:
+//!
+//! | folder | section | algorithm | command |
+//! |---|---|---|---|
+//! | [`problem`] | `[problem]`, `[scene_problem]` | analytic test problems, the scene as a problem (variables, bounds, objectives of a front) | (built by every command: [`problem()`]) |
+//! | [`local`] | `[multistart] method`, `[multistart.mmfd]` | the local solvers, settling a run's end (certificate, polish, rescue), the violation check | (used by the commands) |
+//! | [`multistart`] | `[multistart]`, `[optimum_report]`, `[robustness]`, `[scaling]` | start points, the parallel multistart, clustering into distinct optima, shard merging | `plyscape multistart`, `merge` |
+//! | [`evolve`] | `[evolve]`, `[compare]` | CMA-ES with restarts on the multistart's budget | `plyscape evolve`, `compare` |
+//! | [`front`] | `[front]` | certified Tchebycheff subproblems, NSGA-II, a grid of the box | `[front]` under `plyscape run` |
+//! | [`map`] | `[map]` | f and the constraints on a grid over two variables | `plyscape map` |
+//! | [`discrete`] | `[discrete]` | rounding and polishing, CMA-ES on the set, exhaustive search | `[discrete]` under `plyscape run` |
+//! | [`persist`] | — | `runs.csv` that survives a kill, the typed manifest entries, the study's fingerprint for `--resume` | — |
 //!
 //! Every table is reproducible from the study file: random choices come
 //! from `[study] seed`, rows are sorted by start index, numbers round-trip
 //! exactly, and `manifest.json` records the study text, seed, threads and
-//! crate versions. `runs.csv` survives a kill (see [`tables`]); `--resume`
-//! continues a stopped multistart and `--shard i/n` splits one over
-//! machines, with `plyscape merge` putting the pieces back together.
-//!
-//! Study sections read here ([`config`]): `[problem]`
-//! ([`problems::ProblemSpec`]; with `name = "scene"` also
-//! `[scene_problem]`, [`scene_problem`]), `[multistart]`
-//! ([`MultistartSection`]), `[evolve]` ([`EvolveSection`]), `[compare]` (no
-//! keys), `[map]` ([`MapSection`]), `[scaling]`
-//! ([`scaling::ScalingSection`]), `[optimum_report]`
-//! ([`optimum_report`]: the run from the first start as the paper's
-//! Table 5 and Figs. 10–12, written by the multistart), `[front]`
-//! ([`commands::front`]: the Pareto front of two or three objectives, its
-//! gradient side in [`front`], NSGA-II in [`crate::optimize::nsga2`], the
-//! grid of the box in [`front_grid`], and with `[problem] name = "scene"`
-//! the scene's responses as objectives in [`scene_front`]),
-//! `[robustness]` ([`robustness`]: each certified optimum's worst case
-//! under a tolerance per variable, in `optima.csv`) and `[discrete]`
-//! ([`discrete`], [`commands::discrete`]: the problem on a finite set per
-//! variable, searched exhaustively, by rounding and polishing the
-//! certified optima, and by CMA-ES on the set).
-//!
-//! Layout: the algorithms are [`multistart`], [`cluster`], [`evolve`],
-//! [`map`] and [`sampling`], over the problems of [`problems`] and
-//! [`scene_problem`] and the optimizers named in [`solvers`]; [`config`]
-//! reads the sections into checked plans; [`commands`] holds one file per
-//! driver command (what `plyscape multistart`, `evolve`, `compare` and
-//! `map` do around the algorithms); [`context`] is what a command gets
-//! from the command line; [`manifest`] types the commands' entries in
-//! `manifest.json`; [`merge`](mod@merge) joins the shards of a multistart;
-//! [`tables`] reads and writes the CSV files.
+//! crate versions. `runs.csv` survives a kill ([`persist::tables`]);
+//! `--resume` continues a stopped multistart and `--shard i/n` splits one
+//! over machines, with `plyscape merge` ([`merge()`]) putting the pieces
+//! back together. A command gets the command line as a [`Context`].
 //!
 //! A problem from a study, evaluated with its gradient (Himmelblau's
 //! function has a minimum f = 0 at (3, 2)):
@@ -64,54 +45,42 @@
 //! - **An optimizer**: a local one is a function `(problem, x0, observer)
 //!   -> LocalOutcome` in [`crate::optimize`] behind the
 //!   [`crate::optimize::Problem`] interface; give it a variant of
-//!   [`solvers::LocalMethod`] (the serde name is the study's `[multistart]
-//!   method`) and a match arm in [`solvers::local`]. An evolutionary one is
-//!   a [`evolve::GlobalSolver`] built in [`solvers::global`].
-//! - **A driver command** (a sweep of another kind): its section struct and
-//!   plan in [`config`] (or its own file beside [`scaling`]), its run in a
-//!   new file of [`commands`] taking a [`Context`], its tables through
-//!   [`tables`] and [`crate::report`], its manifest entry as a typed struct
-//!   in [`manifest`] passed to [`Context::manifest`]; the subcommand in
-//!   `crate::cli`'s `Command` and `execute`.
+//!   [`local::solvers::LocalMethod`] (the serde name is the study's
+//!   `[multistart] method`) and a match arm in [`local::solvers::local`].
+//!   An evolutionary one is a [`evolve::GlobalSolver`] built in
+//!   [`evolve::global`].
+//! - **A test problem**: one row of the table in [`problem::problems`].
+//! - **A driver command** (a sweep of another kind): a new folder with its
+//!   section struct and plan (`section.rs`), its algorithm and its run
+//!   taking a [`Context`] (`command.rs`), its tables through
+//!   [`persist::tables`] and [`crate::report`], its manifest entry as a
+//!   typed struct in [`persist::manifest`] passed to [`Context::manifest`];
+//!   the subcommand in `crate::cli`'s `Command` and `execute`.
 //! - **A study section** `plyscape run` does: one entry in
 //!   [`crate::sections::registry::SECTIONS`] (key, check, run); see
 //!   [`crate::sections`].
 
-pub mod cluster;
-pub mod commands;
-pub mod config;
 pub mod context;
 pub mod discrete;
 pub mod evolve;
-pub mod fingerprint;
 pub mod front;
-pub mod front_grid;
-pub mod manifest;
+pub mod local;
 pub mod map;
-pub mod merge;
 pub mod multistart;
-pub mod optimum_report;
-pub mod problems;
-pub mod robustness;
-pub mod sampling;
-pub mod scaling;
-pub mod scene_bounds;
-pub mod scene_front;
-pub mod scene_problem;
-mod scene_vars;
-pub mod settle;
-pub mod solvers;
-pub mod tables;
-pub mod violation;
+pub mod persist;
+pub mod problem;
 
-pub use commands::compare::{comparison_table, run_compare, ComparisonRow};
-pub use commands::evolve::{regime_counts, run_evolve};
-pub use commands::map::run_map;
-pub use commands::multistart::{keep_earlier_runs, run_multistart};
-pub use config::{
-    check_problem, compare_section, evolve_plan, map_section, multistart_plan, multistart_section,
-    problem, schedules, CompareSection, EvolvePlan, EvolveSection, MapSection, MultistartPlan,
-    MultistartSection,
-};
 pub use context::{Context, DriveFlags};
-pub use merge::merge;
+pub use evolve::command::{regime_counts, run_evolve};
+pub use evolve::compare::{comparison_table, run_compare, ComparisonRow};
+pub use evolve::section::{
+    compare_section, evolve_plan, schedules, CompareSection, EvolvePlan, EvolveSection,
+};
+pub use map::command::run_map;
+pub use map::section::{map_section, MapSection};
+pub use multistart::command::{keep_earlier_runs, run_multistart};
+pub use multistart::merge::merge;
+pub use multistart::section::{
+    multistart_plan, multistart_section, MultistartPlan, MultistartSection,
+};
+pub use problem::build::{check_problem, problem};

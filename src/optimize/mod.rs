@@ -24,6 +24,7 @@ pub mod multiobjective;
 pub mod noise;
 pub mod nsga2;
 pub mod qp;
+pub mod sampling;
 pub mod sqp;
 pub mod testproblems;
 

@@ -7,7 +7,8 @@
 //! read back gives the same `f64` bits) or [`sci`] (fixed significant
 //! digits, for histories). Units go in the header cells (`t [s]`).
 //! Appending tables (resumable sweeps) write whole lines made by
-//! [`csv_line`].
+//! [`csv_line`] and read back only their whole lines ([`read_csv_lines`]:
+//! a torn last line is left for the caller to cut).
 
 use crate::error::{Error, Result};
 use std::io::Write;
@@ -109,6 +110,56 @@ impl Table {
         write_bytes_atomic(&self.path, &bytes)?;
         Ok(self.path)
     }
+}
+
+/// The whole lines of a resumable CSV table (`runs.csv`, a map's table).
+pub struct CsvLines {
+    /// Length of the file (bytes).
+    pub len: usize,
+    /// Length of its whole lines (up to the last newline).
+    pub keep: usize,
+    /// The data records after the header, each with the byte where its
+    /// line starts (where a torn last line is cut).
+    pub rows: Vec<(csv::StringRecord, usize)>,
+}
+
+/// Read a table's whole lines (`None` when the file does not exist); a
+/// first line other than `header` is refused as "header .. `what`".
+pub fn read_csv_lines(path: &Path, header: &[String], what: &str) -> Result<Option<CsvLines>> {
+    let bytes = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(Error::io(path, e)),
+    };
+    let keep = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(&bytes[..keep]);
+    let mut rows = Vec::new();
+    for r in reader.records() {
+        let r = r.map_err(|e| Error::csv(path, e))?;
+        let at = r.position().map_or(0, |p| p.byte() as usize);
+        rows.push((r, at));
+    }
+    if let Some((first, _)) = rows.first() {
+        if first.iter().ne(header.iter().map(String::as_str)) {
+            return Err(Error::csv(
+                path,
+                format!(
+                    "header {:?} {what} (expected {:?})",
+                    first.iter().collect::<Vec<_>>().join(","),
+                    header.join(",")
+                ),
+            ));
+        }
+        rows.remove(0);
+    }
+    Ok(Some(CsvLines {
+        len: bytes.len(),
+        keep,
+        rows,
+    }))
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 //! The file is [`Manifest`] serialized through [`serde_json::Value`], so its
 //! keys come out sorted as they always did; each command's entry under
 //! `commands` is kept as JSON, since every command writes its own typed
-//! entry (the exploration drivers' are in `explore::manifest`).
+//! entry (the exploration drivers' are in `explore::persist::manifest`).
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};

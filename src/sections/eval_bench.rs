@@ -35,7 +35,7 @@
 
 use super::stats::median;
 use crate::error::Result;
-use crate::explore::scene_problem::{EvalProfile, SceneProblem};
+use crate::explore::problem::scene_problem::{EvalProfile, SceneProblem};
 use crate::integrate::{Method, SensitivityForm};
 use crate::optimize::Problem;
 use crate::report::clock::{load_average, thread_cpu_seconds};

@@ -22,7 +22,7 @@
 
 use super::stats::median;
 use crate::error::Result;
-use crate::explore::scene_problem::SceneProblem;
+use crate::explore::problem::scene_problem::SceneProblem;
 use crate::modal::ModeUpdate;
 use crate::optimize::{Evaluation, Problem};
 use crate::report::csv::{num, Table};
@@ -218,10 +218,10 @@ pub const OPTIMIZE_HEADERS: [&str; 10] = [
 /// One MMFD run from the start per approach.
 fn optimize_rows(name: &str, p: &mut SceneProblem) -> Result<Vec<Vec<String>>> {
     // DOT's settings as they are, CTMIN included (the paper's runs).
-    let solver = crate::explore::solvers::local(
-        crate::explore::solvers::LocalMethod::Mmfd,
+    let solver = crate::explore::local::solvers::local(
+        crate::explore::local::solvers::LocalMethod::Mmfd,
         &Default::default(),
-        crate::explore::solvers::MmfdPreset::Dot,
+        crate::explore::local::solvers::MmfdPreset::Dot,
         crate::optimize::mmfd::MmfdOptions::dot().ctmin,
     )?;
     let start = p.start().to_vec();

@@ -120,17 +120,18 @@ pub static SECTIONS: &[Section] = &[
     },
     Section {
         key: "scaling",
-        check: |s| explore::scaling::check(s).map(|_| ()),
+        check: |s| explore::multistart::scaling::check(s).map(|_| ()),
         run: Some(|cfg| {
-            explore::scaling::run_scaling(&cfg.explore(DriveFlags::default())).map(|_| ())
+            explore::multistart::scaling::run_scaling(&cfg.explore(DriveFlags::default()))
+                .map(|_| ())
         }),
         uses_problem: true,
     },
     Section {
         key: "discrete",
-        check: explore::commands::discrete::check,
+        check: explore::discrete::command::check,
         run: Some(|cfg| {
-            explore::commands::discrete::run_discrete(&cfg.explore(DriveFlags::default()))
+            explore::discrete::command::run_discrete(&cfg.explore(DriveFlags::default()))
                 .map(|_| ())
         }),
         uses_problem: true,
@@ -143,7 +144,7 @@ pub static SECTIONS: &[Section] = &[
     },
     Section {
         key: "front",
-        check: |s| explore::commands::front::check(s).map(|_| ()),
+        check: |s| explore::front::command::check(s).map(|_| ()),
         run: Some(run_front),
         uses_problem: false,
     },
@@ -209,13 +210,13 @@ pub static SECTIONS: &[Section] = &[
     // Read and written by the multistart.
     Section {
         key: "robustness",
-        check: |s| explore::robustness::section(s).map(|_| ()),
+        check: |s| explore::multistart::robustness::section(s).map(|_| ()),
         run: None,
         uses_problem: true,
     },
     Section {
-        key: explore::optimum_report::KEY,
-        check: |s| explore::optimum_report::check(s).map(|_| ()),
+        key: explore::multistart::optimum_report::KEY,
+        check: |s| explore::multistart::optimum_report::check(s).map(|_| ()),
         run: None,
         uses_problem: true,
     },
@@ -231,7 +232,7 @@ pub fn section(key: &str) -> Option<&'static Section> {
 pub fn run_front(cfg: &RunConfig) -> Result<()> {
     let t0 = std::time::Instant::now();
     let dir = cfg.study.output_dir(&cfg.out)?;
-    let report = explore::commands::front::run_front(&cfg.study, &dir, cfg.threads, cfg.quiet)?;
+    let report = explore::front::command::run_front(&cfg.study, &dir, cfg.threads, cfg.quiet)?;
     let mut entry = serde_json::Map::new();
     entry.insert("wall_seconds".into(), t0.elapsed().as_secs_f64().into());
     for mf in &report.methods {

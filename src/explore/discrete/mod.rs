@@ -1,4 +1,4 @@
-//! Discrete designs (`[discrete]`, issue 26): ply angles as manufacturers
+//! Discrete designs (`[discrete]`, [`lattice::DiscreteSection`]): ply angles as manufacturers
 //! lay them up, on a finite set per variable (`values = [-45, 0, 45, 90]`
 //! or `step = 15.0` from the lower bound), searched three ways and written
 //! side by side in `discrete.csv`:
@@ -41,7 +41,11 @@
 //! designs it asked for, its cost had it run alone, and `samples` the
 //! designs asked for with repeats (CMA-ES samples often round to a design
 //! seen before).
+//!
+//! The command is `[discrete]` under `plyscape run`
+//! ([`command::run_discrete`]), after the study's multistart.
 
+pub mod command;
 pub mod lattice;
 pub mod search;
 

@@ -84,7 +84,7 @@ fn comparison_names_the_global_minimum() {
     assert!(hits >= 15, "{hits} of 16 starts certified");
 
     // Periodic2: the unique global minimum f = -5 at theta1 = +-90 (seam),
-    // theta2 = -30 (closed form, explore::problems::Periodic2).
+    // theta2 = -30 (closed form, explore::problem::problems::Periodic2).
     let s = study("p", &text("p", "periodic2", ""));
     let rows = explore::run_compare(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
     for r in &rows {

@@ -1,5 +1,5 @@
 //! Critical time points of a peak constraint
-//! (`[[scene_problem.constraints]] critical_points`, explore::scene_bounds,
+//! (`[[scene_problem.constraints]] critical_points`, explore::problem::scene_bounds,
 //! mbs::responses::critical_points) on a coarse SAR scene (8 mesh
 //! divisions, 4 modes per panel, 0–3 s at rtol 1e-10; the shipped
 //! studies use 32, 14, rtol 1e-6): the peak-U3 bound with three
@@ -9,7 +9,7 @@
 //! of the problem's own `evaluate`.
 
 use crate::common::sar::{coarse_sar, replace};
-use plyscape::explore::scene_problem::SceneProblem;
+use plyscape::explore::problem::scene_problem::SceneProblem;
 use plyscape::optimize::Problem;
 use plyscape::study::Study;
 

@@ -1,5 +1,5 @@
 //! Design variables of every kind in the scene problem
-//! (`explore::scene_problem`, `[[scene_problem.variables]]`): eight
+//! (`explore::problem::scene_problem`, `[[scene_problem.variables]]`): eight
 //! independent ply angles (studies/sar_explore8.toml: every ply of panels
 //! 2 and 3 free, unsymmetric stacks) and ply angles with scene parameters
 //! (studies/sar_codesign.toml: the actuator's damping and one slope of its

@@ -3,11 +3,11 @@
 
 use crate::common::explore::{column, ctx, study, table_without};
 use crate::common::temp_dir;
-use plyscape::explore::commands::discrete::run_discrete;
+use plyscape::explore::discrete::command::run_discrete;
 use plyscape::explore::{self, DriveFlags};
 
 /// `h(d; ε) = −cos 2d − ε cos 4d` of the periodic2 problem
-/// (`explore::problems::Periodic2`, d in degrees here).
+/// (`explore::problem::problems::Periodic2`, d in degrees here).
 fn h(d: f64, eps: f64) -> f64 {
     let r = d.to_radians();
     -(2.0 * r).cos() - eps * (4.0 * r).cos()

@@ -84,7 +84,7 @@ fn a_seed_gives_the_same_front_on_any_thread_count() {
 fn front_input_errors_name_the_key() {
     let base = "[problem]\nname = \"zdt1\"\n[front]\n";
     let err = |text: &str| {
-        plyscape::explore::commands::front::check(&study("bad", text))
+        plyscape::explore::front::command::check(&study("bad", text))
             .err()
             .unwrap()
             .to_string()

@@ -237,7 +237,7 @@ fn merged_shards_equal_the_unsharded_run() {
         );
     }
     let merged = table_without(&sharded.join("h/optima.csv"), &[]);
-    for c in plyscape::explore::robustness::COLUMNS {
+    for c in plyscape::explore::multistart::robustness::COLUMNS {
         assert!(
             merged[0].iter().any(|h| h == c),
             "{c} missing: {:?}",

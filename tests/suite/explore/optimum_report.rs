@@ -1,4 +1,4 @@
-//! `[optimum_report]` (explore::optimum_report): the multistart's run from
+//! `[optimum_report]` (explore::multistart::optimum_report): the multistart's run from
 //! its first start as the paper's Table 5 and Figs. 10–12. The history is
 //! the run's own (its last row is the run's row in `runs.csv`), the summary
 //! row repeats the run's numbers with the start's f and the reduction, and

@@ -45,7 +45,7 @@ fn a_changed_evaluation_is_refused_with_what_changed_and_more_starts_resume() {
     let fp = &m["commands"]["multistart"]["fingerprint"];
     assert_eq!(
         fp["evaluation_version"],
-        plyscape::explore::fingerprint::EVALUATION_VERSION
+        plyscape::explore::persist::fingerprint::EVALUATION_VERSION
     );
     assert_eq!(fp["parts"]["solver"].as_str().unwrap().len(), 16);
 
@@ -117,7 +117,7 @@ fn a_changed_evaluation_is_refused_with_what_changed_and_more_starts_resume() {
         text.replace(
             &format!(
                 "\"evaluation_version\": {}",
-                plyscape::explore::fingerprint::EVALUATION_VERSION
+                plyscape::explore::persist::fingerprint::EVALUATION_VERSION
             ),
             "\"evaluation_version\": 0",
         ),
@@ -128,7 +128,7 @@ fn a_changed_evaluation_is_refused_with_what_changed_and_more_starts_resume() {
         .to_string();
     let changed = format!(
         "code changed (evaluation version 0 → {})",
-        plyscape::explore::fingerprint::EVALUATION_VERSION
+        plyscape::explore::persist::fingerprint::EVALUATION_VERSION
     );
     assert!(e.contains(&changed), "{e}");
 }

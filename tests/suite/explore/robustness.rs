@@ -5,8 +5,8 @@
 use crate::common::explore::{column, ctx, study, table_without};
 use crate::common::temp_dir;
 use plyscape::error::Result;
-use plyscape::explore::problems::Hs22;
-use plyscape::explore::robustness::{assess, COLUMNS};
+use plyscape::explore::multistart::robustness::{assess, COLUMNS};
+use plyscape::explore::problem::problems::Hs22;
 use plyscape::explore::{self, DriveFlags};
 use plyscape::optimize::{Evaluation, Problem, Variable};
 

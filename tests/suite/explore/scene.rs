@@ -1,4 +1,4 @@
-//! The scene problem (`[problem] name = "scene"`, explore::scene_problem)
+//! The scene problem (`[problem] name = "scene"`, explore::problem::scene_problem)
 //! on a coarse version of studies/sar_optimize.toml made by text
 //! replacement (8 mesh divisions, 4 modes, 0–0.5 s, tight integrator
 //! tolerances) so that one evaluation takes a fraction of a second: its
@@ -143,7 +143,7 @@ fn design_as_numbers_matches_the_text_road() {
         1,
     );
     let study = Study::parse("sar_optimize.toml", &staggered(&untied)).unwrap();
-    let p = plyscape::explore::scene_problem::SceneProblem::from_study(&study).unwrap();
+    let p = plyscape::explore::problem::scene_problem::SceneProblem::from_study(&study).unwrap();
     let [(psi_s, _), (u3_s, _)] = responses_from_text([55.0, -55.0]);
     let x = [40.0, -25.0];
     let [(psi, dpsi), (u3, du3)] = responses_from_text(x);

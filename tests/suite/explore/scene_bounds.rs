@@ -1,5 +1,5 @@
 //! Absolute constraint bounds of a scene problem
-//! (`[[scene_problem.constraints]] upper`, `lower`, explore::scene_bounds)
+//! (`[[scene_problem.constraints]] upper`, `lower`, explore::problem::scene_bounds)
 //! on a frequency-only problem (no integration): a free composite panel
 //! whose outer ply angle is the variable. Maximizing the first frequency
 //! (minimizing −f1) under `upper = U` ends on the bound, minimizing it

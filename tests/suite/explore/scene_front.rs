@@ -1,4 +1,4 @@
-//! `[front]` on a scene (`[problem] name = "scene"`, explore::scene_front)
+//! `[front]` on a scene (`[problem] name = "scene"`, explore::problem::scene_front)
 //! and `[front] grid`: the objectives written in front.csv are the
 //! responses of a direct simulation of each design, in their units; the
 //! grid's hypervolume row against a closed form.
@@ -7,7 +7,7 @@ use crate::common::explore::{column, study, table_without};
 use crate::common::sar::{coarse_sar, replace};
 use crate::common::temp_dir;
 use plyscape::cli::{run_study, RunConfig};
-use plyscape::explore::scene_problem::SceneProblem;
+use plyscape::explore::problem::scene_problem::SceneProblem;
 use plyscape::study::Study;
 
 fn run(study: &Study, out: &std::path::Path) {
@@ -141,7 +141,7 @@ fn grid_row_has_the_hypervolume_of_the_grid_front() {
 fn scene_front_input_errors_name_the_key() {
     let text = small_sar_front();
     let err = |t: &str| {
-        plyscape::explore::commands::front::check(&study("bad", t))
+        plyscape::explore::front::command::check(&study("bad", t))
             .err()
             .unwrap()
             .to_string()

@@ -24,7 +24,7 @@ fn analytic_studies_run_and_find_their_known_optima() {
     let dir = tmp.path().to_path_buf();
     // Known optima: Himmelblau f* = 0 (Himmelblau 1972); HS 22 f* = 1 at
     // (1, 1) (Hock & Schittkowski 1981); Periodic2 f* = -5 (closed form in
-    // explore::problems::Periodic2).
+    // explore::problem::problems::Periodic2).
     for (file, f_star, tol) in [
         ("studies/himmelblau.toml", 0.0, 1e-6),
         ("studies/hs_constrained.toml", 1.0, 1e-6),
@@ -163,8 +163,8 @@ fn sar_explore_is_sar_optimize_with_64_starts_and_both_schedules() {
     assert_eq!(
         (ms.method, ms.sampler),
         (
-            plyscape::explore::solvers::LocalMethod::Mmfd,
-            plyscape::explore::sampling::Sampler::Lhs
+            plyscape::explore::local::solvers::LocalMethod::Mmfd,
+            plyscape::explore::multistart::sampling::Sampler::Lhs
         )
     );
     assert_eq!(ms.points, [[55.0, -55.0]]);
@@ -200,6 +200,8 @@ fn sar_discrete_is_sar_explore_on_15_degree_steps() {
     for v in &d.variables {
         assert_eq!(v.values.as_deref(), Some(&set[..]), "{}", v.name);
     }
-    let r = plyscape::explore::robustness::section(&s).unwrap().unwrap();
+    let r = plyscape::explore::multistart::robustness::section(&s)
+        .unwrap()
+        .unwrap();
     assert_eq!(r.tolerance, [2.0, 2.0]);
 }

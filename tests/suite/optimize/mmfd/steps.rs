@@ -84,14 +84,14 @@ fn sar_from_55_minus_55_in_16_function_and_5_gradient_calls() {
 /// torus, every run that ends infeasible ends at a stationary point of the
 /// violation (its Kuhn–Tucker test, `optimize::kkt`), and MMFD reaches the
 /// feasible set from at least as many starts as a pure steepest descent on
-/// the violation (`explore::violation::descend`) from the same starts.
+/// the violation (`explore::local::violation::descend`) from the same starts.
 /// Before restorations that stall switched to descent on the violation, a
 /// stall rule (three Newton restorations lowering the violation by less
 /// than 1 %) ended runs at non-stationary points here (residuals up to
 /// 1.8e-2). Measured: 44 and 32 of 144 starts reach the feasible set.
 #[test]
 fn restoration_ends_only_where_the_violation_is_stationary() {
-    use plyscape::explore::violation::descend;
+    use plyscape::explore::local::violation::descend;
     use plyscape::optimize::kkt::{certify_at, KktTolerances};
     let p = tp::ripple();
     let d = MmfdOptions::default();

@@ -1,0 +1,451 @@
+//! The gradient side of a Pareto front: a parallel multistart of
+//! scalarized subproblems, each solved by MMFD with the objectives' exact
+//! gradients and settled (certified, polished) as a multistart run is
+//! ([`crate::explore::local::settle`]).
+//!
+//! 1. **Anchors** (one per objective `i`, in parallel): minimize `f_i` from
+//!    the problem's start design and `anchor_starts − 1` seeded uniform
+//!    random designs, and keep the best end (certified first, then lowest
+//!    `f_i`); then, lexicographically, minimize the sum
+//!    of the other objectives subject to `f_i <= f_i* + τ·max(1, |f_i*|)`
+//!    with `τ = 1e-4` (both [`EpsilonConstraint`] problems), from the first
+//!    run's end, and once more from the start design when that run does not
+//!    end certified (e.g. an end on ZDT1's `x1 = 0`, where `∂f2/∂x1` is
+//!    unbounded); both runs are counted. The anchors give the ideal point `z_j = min_i f_j(a_i)`
+//!    and the payoff-table nadir `N_j = max_i f_j(a_i)`; the ranges are
+//!    `s_j = N_j − z_j` (1 where that vanishes).
+//! 2. **Subproblems** (in parallel): the augmented reference-point
+//!    Tchebycheff problem ([`Tchebycheff`], `ρ = 1e-4`) for reference
+//!    points `r = (m − 1)·λ` on the simplex lattice of the `m`
+//!    objectives (Das & Dennis 1998) in normalized objectives: for two
+//!    objectives `λ = (k/(K+1), 1 − k/(K+1))`, `k = 1..K` (the segment
+//!    between the anchors, whose ends are the anchors); for three the
+//!    lattice with the most points `≤ K`, edges included, so that the
+//!    front's corners beyond the anchors' triangle are reached. Each starts
+//!    from the anchors' designs weighted by `λ` (wrapped into the box; the
+//!    problem's start design when an anchor is not certified) with `t` at
+//!    its smallest feasible value, `t ∈ [−m − 1, max(t0, 0) + 1]`, and
+//!    once more from the start design when that run does not end
+//!    certified (both counted).
+//! 3. **The front**: the ends certified `converged` (feasible, Kuhn–Tucker)
+//!    of the lexicographic anchors and the subproblems, evaluated once more
+//!    for their objectives, and of those the non-dominated ones (equal
+//!    points once).
+//!
+//! Every evaluation is counted: the anchors', the subproblems' (with their
+//! certificates and polishes) and the final objective evaluations.
+
+use crate::error::{Error, Result};
+use crate::explore::local::settle::EndPolicy;
+use crate::explore::local::solvers::LocalSolver;
+use crate::explore::multistart::driver::one_run;
+use crate::explore::persist::tables::{class_name, RunRecord};
+use crate::optimize::kkt::EndClass;
+use crate::optimize::mmfd::MmfdOptions;
+use crate::optimize::mo_testproblems::simplex_lattice;
+use crate::optimize::multiobjective::{
+    non_dominated, EpsilonConstraint, MultiProblem, Tchebycheff,
+};
+use crate::optimize::{NoObserver, Observer, Problem};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Relative cap `τ` of the lexicographic anchors.
+pub const ANCHOR_CAP: f64 = 1e-4;
+/// Augmentation `ρ` of the Tchebycheff subproblems.
+pub const RHO: f64 = 1e-4;
+
+/// What the gradient side needs besides the problem.
+#[derive(Debug, Clone)]
+pub struct GradientSettings {
+    /// Number of subproblems `K` (at most; see the module doc).
+    pub subproblems: usize,
+    /// Worker threads.
+    pub threads: usize,
+    /// MMFD's options for every subproblem.
+    pub mmfd: MmfdOptions,
+    /// Certificate and polish of every end.
+    pub end: EndPolicy,
+    /// Starts of each anchor's first run: the start design, then uniform
+    /// random designs (>= 1).
+    pub anchor_starts: usize,
+    /// Seed of those random starts.
+    pub seed: u64,
+}
+
+/// One settled end of the gradient side.
+#[derive(Debug, Clone)]
+pub struct SubproblemEnd {
+    /// `anchor-<objective>`, `lexicographic-<objective>` or
+    /// `subproblem-<k>`.
+    pub label: String,
+    /// The run (its design includes `t` for a subproblem).
+    pub run: RunRecord,
+    /// The end is certified `converged` (feasible, Kuhn–Tucker).
+    pub certified: bool,
+    /// The objectives at the end's design (minimized orientation), for a
+    /// certified end that enters the front (the lexicographic anchors and
+    /// the subproblems).
+    pub f: Option<Vec<f64>>,
+}
+
+/// The gradient side's result.
+#[derive(Debug, Clone)]
+pub struct GradientFront {
+    /// Non-dominated certified designs and their objectives (minimized
+    /// orientation), in the order of the ends.
+    pub points: Vec<(Vec<f64>, Vec<f64>)>,
+    /// Every end, anchors first.
+    pub ends: Vec<SubproblemEnd>,
+    /// Ideal point from the anchors.
+    pub ideal: Vec<f64>,
+    /// Payoff-table nadir from the anchors.
+    pub nadir: Vec<f64>,
+    /// Function calls, all included.
+    pub function_calls: usize,
+    /// Gradient calls, all included.
+    pub gradient_calls: usize,
+    /// Wall time \[s\].
+    pub wall_seconds: f64,
+}
+
+impl GradientFront {
+    /// How many ends are certified `converged`.
+    pub fn certified(&self) -> usize {
+        self.ends.iter().filter(|e| e.certified).count()
+    }
+}
+
+/// The normalized reference points of the module doc for `m` objectives
+/// and at most `k` subproblems.
+pub fn reference_points(m: usize, k: usize) -> Vec<Vec<f64>> {
+    let scale = (m - 1) as f64;
+    if m == 2 {
+        return (1..=k)
+            .map(|i| {
+                let l = i as f64 / (k + 1) as f64;
+                vec![scale * l, scale * (1.0 - l)]
+            })
+            .collect();
+    }
+    let mut h = 1;
+    while simplex_lattice(m, h + 1).len() <= k {
+        h += 1;
+    }
+    simplex_lattice(m, h)
+        .into_iter()
+        .map(|l| l.iter().map(|v| scale * v).collect())
+        .collect()
+}
+
+/// The start of the subproblem with reference point `r`: the anchors'
+/// designs weighted by `λ = r/(m − 1)` (wrapped into the box), when every
+/// anchor is certified.
+fn between_anchors(
+    problem: &dyn MultiProblem,
+    anchors: &[Option<Vec<f64>>],
+    r: &[f64],
+) -> Option<Vec<f64>> {
+    let m = anchors.len();
+    let xs: Vec<&Vec<f64>> = anchors.iter().map(|a| a.as_ref()).collect::<Option<_>>()?;
+    let vars = problem.variables();
+    Some(
+        (0..vars.len())
+            .map(|j| {
+                let v: f64 = xs
+                    .iter()
+                    .zip(r)
+                    .map(|(x, l)| x[j] * l / (m - 1) as f64)
+                    .sum();
+                vars[j].wrap(v)
+            })
+            .collect(),
+    )
+}
+
+/// One settled MMFD run of `p` from `x0`.
+fn solve(p: &dyn Problem, s: &GradientSettings, index: usize, x0: &[f64]) -> RunRecord {
+    let options = s.mmfd.clone();
+    let solver: &LocalSolver = &move |p: &dyn Problem, x0: &[f64], o: &mut dyn Observer| {
+        crate::optimize::mmfd::minimize(p, x0, &options, o)
+    };
+    one_run(p, solver, &s.end, index, x0, &mut NoObserver)
+}
+
+/// Is the run's end certified (converged and feasible to the tolerance)?
+fn certified(run: &RunRecord, tol: f64) -> bool {
+    run.certificate
+        .as_ref()
+        .is_some_and(|c| c.class == EndClass::Converged && c.max_g <= tol)
+        && run.result.is_some()
+}
+
+/// The objectives at a certified end's design (its first `n` values),
+/// counted into `calls`.
+fn objectives(
+    problem: &dyn MultiProblem,
+    run: &RunRecord,
+    tol: f64,
+    calls: &mut usize,
+) -> Result<Option<Vec<f64>>> {
+    if !certified(run, tol) {
+        return Ok(None);
+    }
+    let n = problem.variables().len();
+    let x = &run.result.as_ref().expect("certified runs have a result").x[..n];
+    *calls += 1;
+    let e = problem.evaluate(x, false)?;
+    Ok(e.f.iter().all(|v| v.is_finite()).then_some(e.f))
+}
+
+/// Build the front's gradient side (see the module doc).
+pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Result<GradientFront> {
+    let t0 = Instant::now();
+    let tol = s.end.tolerances.feasibility;
+    let m = problem.objective_names().len();
+    if !(2..=3).contains(&m) {
+        return Err(Error::input(
+            "objectives",
+            format!("({m} objectives)"),
+            "2 or 3 objectives",
+        ));
+    }
+    let x0 = problem.start();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(s.threads)
+        .build()
+        .map_err(|e| Error::input("threads", s.threads, format!("a usable count ({e})")))?;
+    let names = problem.objective_names();
+    // 1. Anchors from every start, the best of each objective, and its
+    // lexicographic refinement.
+    let mut starts = vec![x0.clone()];
+    let mut rng = ChaCha8Rng::seed_from_u64(s.seed);
+    for _ in 1..s.anchor_starts.max(1) {
+        starts.push(
+            (problem.variables().iter())
+                .map(|v| v.wrap(v.lower + rng.random::<f64>() * (v.upper - v.lower)))
+                .collect(),
+        );
+    }
+    let pairs: Vec<(usize, usize)> = (0..m)
+        .flat_map(|i| (0..starts.len()).map(move |k| (i, k)))
+        .collect();
+    let firsts: Vec<RunRecord> = pool.install(|| {
+        pairs
+            .par_iter()
+            .map(|&(i, k)| {
+                let mut w = vec![0.0; m];
+                w[i] = 1.0;
+                solve(
+                    &EpsilonConstraint::new(problem, w, vec![]),
+                    s,
+                    i,
+                    &starts[k],
+                )
+            })
+            .collect()
+    });
+    // The best first run per objective: certified first, then lowest f.
+    let best: Vec<RunRecord> = (0..m)
+        .map(|i| {
+            let runs = &firsts[i * starts.len()..(i + 1) * starts.len()];
+            let key = |r: &RunRecord| {
+                let f = r.result.as_ref().map_or(f64::INFINITY, |x| x.f);
+                (
+                    !certified(r, tol),
+                    if f.is_nan() { f64::INFINITY } else { f },
+                )
+            };
+            runs.iter()
+                .min_by(|a, b| {
+                    let (ka, kb) = (key(a), key(b));
+                    ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+                })
+                .expect("at least one start")
+                .clone()
+        })
+        .collect();
+    let anchors: Vec<RunRecord> = pool.install(|| {
+        (0..m)
+            .into_par_iter()
+            .map(|i| {
+                let first = &best[i];
+                let fi = first.result.as_ref().map(|r| r.f);
+                let second = match (fi, &first.result) {
+                    (Some(fi), Some(end)) if fi.is_finite() => {
+                        let scale = fi.abs().max(1.0);
+                        let w = (0..m).map(|j| if j == i { 0.0 } else { 1.0 }).collect();
+                        let cap = vec![(i, fi + ANCHOR_CAP * scale, scale)];
+                        let p = EpsilonConstraint::new(problem, w, cap);
+                        let from_end = solve(&p, s, i, &end.x);
+                        if certified(&from_end, tol) {
+                            from_end
+                        } else {
+                            let mut again = solve(&p, s, i, &x0);
+                            again.function_calls += from_end.function_calls;
+                            again.gradient_calls += from_end.gradient_calls;
+                            again
+                        }
+                    }
+                    _ => first.clone(),
+                };
+                second
+            })
+            .collect()
+    });
+    let mut extra_calls = 0;
+    let mut ends = Vec::new();
+    for ((i, k), first) in pairs.iter().zip(firsts) {
+        ends.push(SubproblemEnd {
+            label: format!("anchor-{}-start-{k}", names[*i]),
+            certified: certified(&first, tol),
+            run: first,
+            f: None,
+        });
+    }
+    let mut anchor_x: Vec<Option<Vec<f64>>> = vec![None; m];
+    for (i, second) in anchors.into_iter().enumerate() {
+        let f = objectives(problem, &second, tol, &mut extra_calls)?;
+        if f.is_some() {
+            anchor_x[i] = second.result.as_ref().map(|r| r.x.clone());
+        }
+        ends.push(SubproblemEnd {
+            label: format!("lexicographic-{}", names[i]),
+            certified: certified(&second, tol),
+            run: second,
+            f,
+        });
+    }
+    let anchor_f: Vec<&Vec<f64>> = ends.iter().filter_map(|e| e.f.as_ref()).collect();
+    if anchor_f.is_empty() {
+        return Err(Error::numerical(
+            "explore::front",
+            format!(
+                "no anchor (single-objective optimum) was certified: {}",
+                ends.iter()
+                    .map(|e| format!("{} {} ({})", e.label, class_name(&e.run), e.run.exit))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        ));
+    }
+    let ideal: Vec<f64> = (0..m)
+        .map(|j| anchor_f.iter().map(|f| f[j]).fold(f64::INFINITY, f64::min))
+        .collect();
+    let nadir: Vec<f64> = (0..m)
+        .map(|j| {
+            anchor_f
+                .iter()
+                .map(|f| f[j])
+                .fold(f64::NEG_INFINITY, f64::max)
+        })
+        .collect();
+    let scale: Vec<f64> = ideal
+        .iter()
+        .zip(&nadir)
+        .map(|(z, n)| {
+            let s = n - z;
+            if s > 1e-12 * z.abs().max(1.0) {
+                s
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    // 2. The subproblems.
+    let refs = reference_points(m, s.subproblems);
+    let runs: Vec<Result<(RunRecord, usize)>> = pool.install(|| {
+        refs.par_iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let t_probe = Tchebycheff::new(
+                    problem,
+                    (ideal.clone(), scale.clone()),
+                    r.clone(),
+                    RHO,
+                    (-(m as f64) - 1.0, f64::MAX / 4.0),
+                )?;
+                let x_start = between_anchors(problem, &anchor_x, r).unwrap_or_else(|| x0.clone());
+                // (x, t0) from the anchors' blend and from the start design
+                // (one evaluation each, counted); t's upper bound admits both.
+                let from_blend = t_probe.start(&x_start)?;
+                let from_x0 = t_probe.start(&x0)?;
+                let t_hi = from_blend[x0.len()].max(from_x0[x0.len()]).max(0.0) + 1.0;
+                let p = Tchebycheff::new(
+                    problem,
+                    (ideal.clone(), scale.clone()),
+                    r.clone(),
+                    RHO,
+                    (-(m as f64) - 1.0, t_hi),
+                )?;
+                let run = solve(&p, s, m + k, &from_blend);
+                if certified(&run, tol) || x_start == x0 {
+                    return Ok((run, 2));
+                }
+                // Once more from the start design (counted together).
+                let mut again = solve(&p, s, m + k, &from_x0);
+                again.function_calls += run.function_calls;
+                again.gradient_calls += run.gradient_calls;
+                Ok((again, 2))
+            })
+            .collect()
+    });
+    for (k, run) in runs.into_iter().enumerate() {
+        let (run, probes) = run?;
+        extra_calls += probes;
+        let f = objectives(problem, &run, tol, &mut extra_calls)?;
+        ends.push(SubproblemEnd {
+            label: format!("subproblem-{k}"),
+            certified: certified(&run, tol),
+            run,
+            f,
+        });
+    }
+    // 3. The non-dominated certified ends.
+    let n = problem.variables().len();
+    let kept: Vec<(Vec<f64>, Vec<f64>)> = ends
+        .iter()
+        .filter_map(|e| {
+            let f = e.f.clone()?;
+            Some((e.run.result.as_ref()?.x[..n].to_vec(), f))
+        })
+        .collect();
+    let fs: Vec<Vec<f64>> = kept.iter().map(|c| c.1.clone()).collect();
+    let points = non_dominated(&fs)
+        .into_iter()
+        .map(|i| kept[i].clone())
+        .collect();
+    // Extra calls: the subproblems' start evaluations and the final
+    // objective evaluations.
+    let function_calls = ends.iter().map(|e| e.run.function_calls).sum::<usize>() + extra_calls;
+    let gradient_calls = ends.iter().map(|e| e.run.gradient_calls).sum();
+    Ok(GradientFront {
+        points,
+        ends,
+        ideal,
+        nadir,
+        function_calls,
+        gradient_calls,
+        wall_seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_points_cover_the_simplex() {
+        let r = reference_points(2, 3);
+        assert_eq!(r, vec![vec![0.25, 0.75], vec![0.5, 0.5], vec![0.75, 0.25]]);
+        // Three objectives, at most 20 points: the lattice with h = 4 has
+        // C(6, 2) = 15 points (h = 5 would have 21), each summing to 2.
+        let r = reference_points(3, 20);
+        assert_eq!(r.len(), 15);
+        assert!(r
+            .iter()
+            .all(|p| (p.iter().sum::<f64>() - 2.0).abs() < 1e-12));
+    }
+}
