@@ -30,6 +30,26 @@ pub trait LocalSolver: Sync + Send {
     ) -> Result<LocalOutcome>;
 }
 
+/// A closure `(problem, x0, observer) -> outcome` is a local solver too
+/// (name `custom`): tests and callers with a one-off optimizer.
+impl<F> LocalSolver for F
+where
+    F: Fn(&dyn Problem, &[f64], &mut dyn Observer) -> Result<LocalOutcome> + Sync + Send,
+{
+    fn name(&self) -> &str {
+        "custom"
+    }
+
+    fn minimize(
+        &self,
+        problem: &dyn Problem,
+        x0: &[f64],
+        observer: &mut dyn Observer,
+    ) -> Result<LocalOutcome> {
+        self(problem, x0, observer)
+    }
+}
+
 impl LocalSolver for MmfdOptions {
     fn name(&self) -> &str {
         "mmfd"

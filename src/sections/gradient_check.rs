@@ -229,7 +229,7 @@ fn optimize_rows(name: &str, p: &mut SceneProblem) -> Result<Vec<Vec<String>>> {
     for update in [ModeUpdate::Updated, ModeUpdate::Fixed] {
         p.set_mode_update(update);
         let t = Instant::now();
-        let o = solver(p, &start, &mut crate::optimize::NoObserver)?;
+        let o = solver.minimize(p, &start, &mut crate::optimize::NoObserver)?;
         let wall = t.elapsed().as_secs_f64();
         let text = |x: &[f64]| x.iter().map(|v| num(*v)).collect::<Vec<_>>().join(" ");
         rows.push(vec![

@@ -46,7 +46,7 @@ use crate::optimize::mo_testproblems::simplex_lattice;
 use crate::optimize::multiobjective::{
     non_dominated, EpsilonConstraint, MultiProblem, Tchebycheff,
 };
-use crate::optimize::{NoObserver, Observer, Problem};
+use crate::optimize::{NoObserver, Problem};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -167,10 +167,7 @@ fn between_anchors(
 
 /// One settled MMFD run of `p` from `x0`.
 fn solve(p: &dyn Problem, s: &GradientSettings, index: usize, x0: &[f64]) -> RunRecord {
-    let options = s.mmfd.clone();
-    let solver: &LocalSolver = &move |p: &dyn Problem, x0: &[f64], o: &mut dyn Observer| {
-        crate::optimize::mmfd::minimize(p, x0, &options, o)
-    };
+    let solver: &dyn LocalSolver = &s.mmfd;
     one_run(p, solver, &s.end, index, x0, &mut NoObserver)
 }
 

@@ -44,7 +44,8 @@
 use super::violation;
 use crate::error::Result;
 use crate::optimize::kkt::{self, Certificate, EndClass, KktTolerances};
-use crate::optimize::mmfd::{self, MmfdOptions};
+use crate::optimize::local::LocalSolver;
+use crate::optimize::mmfd::MmfdOptions;
 use crate::optimize::{Counted, IterRecord, LocalOutcome, NoObserver, Observer, Problem};
 
 /// What happens at the end of every local run.
@@ -295,7 +296,7 @@ fn settle_end(
         last: outcome.iterations,
     };
     let options = MmfdOptions::polish_for(tol);
-    let polished = mmfd::minimize(&counted, &outcome.x, &options, &mut continued);
+    let polished = LocalSolver::minimize(&options, &counted, &outcome.x, &mut continued);
     let last = continued.last;
     let polished = polished.and_then(|p| {
         let o = LocalOutcome {

@@ -17,15 +17,12 @@
 //! BIPOP restarts, or both one after another (`[evolve] restarts`).
 
 use crate::error::{Error, Result};
+pub use crate::optimize::local::LocalSolver;
 use crate::optimize::mmfd::MmfdOptions;
+use crate::optimize::sqp::SqpOptions;
 use crate::optimize::{
     Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination,
 };
-
-/// A local optimizer: from `x0` on `problem` to a local outcome, its
-/// iteration records to the observer.
-pub type LocalSolver<'a> =
-    dyn Fn(&dyn Problem, &[f64], &mut dyn Observer) -> Result<LocalOutcome> + Sync + 'a;
 
 /// The local optimizers, by the names study files use
 /// (`[multistart] method`).
@@ -37,6 +34,9 @@ pub enum LocalMethod {
     Mmfd,
     /// Projected steepest descent ([`steepest`]).
     Steepest,
+    /// Sequential quadratic programming (`optimize::sqp`) with its
+    /// defaults and the study's feasibility tolerance.
+    Sqp,
 }
 
 impl LocalMethod {
@@ -46,6 +46,7 @@ impl LocalMethod {
         match self {
             LocalMethod::Mmfd => "mmfd",
             LocalMethod::Steepest => "steepest",
+            LocalMethod::Sqp => "sqp",
         }
     }
 }
@@ -131,24 +132,39 @@ impl MmfdSettings {
 }
 
 /// The local solver `method` (MMFD with `mmfd`'s settings over `preset`,
-/// CTMIN = `feasibility`).
+/// CTMIN = `feasibility`; SQP with its defaults and that feasibility
+/// tolerance). This match is the one place a study's method name becomes
+/// a solver.
 pub fn local(
     method: LocalMethod,
     mmfd: &MmfdSettings,
     preset: MmfdPreset,
     feasibility: f64,
-) -> Result<Box<LocalSolver<'static>>> {
-    let options = mmfd.options(preset, feasibility);
+) -> Result<Box<dyn LocalSolver>> {
     Ok(match method {
-        LocalMethod::Steepest => {
-            Box::new(|p: &dyn Problem, x0: &[f64], obs: &mut dyn Observer| steepest(p, x0, obs))
-        }
-        LocalMethod::Mmfd => {
-            Box::new(move |p: &dyn Problem, x0: &[f64], obs: &mut dyn Observer| {
-                crate::optimize::mmfd::minimize(p, x0, &options, obs)
-            })
-        }
+        LocalMethod::Steepest => Box::new(Steepest),
+        LocalMethod::Mmfd => Box::new(mmfd.options(preset, feasibility)),
+        LocalMethod::Sqp => Box::new(SqpOptions::default().with_feasibility(feasibility)),
     })
+}
+
+/// Projected steepest descent ([`steepest`]) as a [`LocalSolver`].
+#[derive(Debug, Clone, Copy)]
+pub struct Steepest;
+
+impl LocalSolver for Steepest {
+    fn name(&self) -> &str {
+        "steepest"
+    }
+
+    fn minimize(
+        &self,
+        problem: &dyn Problem,
+        x0: &[f64],
+        observer: &mut dyn Observer,
+    ) -> Result<LocalOutcome> {
+        steepest(problem, x0, observer)
+    }
 }
 
 /// The record of a steepest-descent design (no constraints, no active

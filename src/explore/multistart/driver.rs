@@ -105,7 +105,7 @@ impl Report {
 /// polish's iteration records go to `observer`.
 pub fn one_run(
     problem: &dyn Problem,
-    solver: &LocalSolver,
+    solver: &dyn LocalSolver,
     end: &EndPolicy,
     start: usize,
     x0: &[f64],
@@ -116,7 +116,9 @@ pub fn one_run(
     // A panic inside one run (a solver bug) becomes that run's error
     // instead of ending a long campaign.
     let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        solver(&counted, x0, observer).map(|o| settle(&counted, Some(x0), o, end, observer))
+        solver
+            .minimize(&counted, x0, observer)
+            .map(|o| settle(&counted, Some(x0), o, end, observer))
     }))
     .unwrap_or_else(|p| {
         let msg = p
@@ -171,7 +173,7 @@ pub fn one_run(
 /// its own), writing `runs.csv` and `optima.csv` into `dir`.
 pub fn run(
     problem: &dyn Problem,
-    solver: &LocalSolver,
+    solver: &dyn LocalSolver,
     starts: &[Vec<f64>],
     settings: &Settings,
     dir: &Path,
@@ -462,7 +464,7 @@ mod tests {
     #[test]
     fn failing_and_panicking_runs_become_rows_with_an_error() {
         let p = crate::optimize::testproblems::himmelblau();
-        let fails: &LocalSolver = &|_: &dyn Problem, _: &[f64], _: &mut dyn Observer| {
+        let fails: &dyn LocalSolver = &|_: &dyn Problem, _: &[f64], _: &mut dyn Observer| {
             Err(Error::numerical("test", "singular"))
         };
         let end = crate::explore::local::settle::EndPolicy {
@@ -472,7 +474,7 @@ mod tests {
         };
         let row = one_run(&p, fails, &end, 3, &[0.0, 1.0], &mut NoObserver);
         assert!(row.result.is_none() && row.exit.contains("singular"));
-        let panics: &LocalSolver = &|q: &dyn Problem, x: &[f64], _: &mut dyn Observer| {
+        let panics: &dyn LocalSolver = &|q: &dyn Problem, x: &[f64], _: &mut dyn Observer| {
             q.evaluate(x, true)?;
             panic!("index out of bounds")
         };

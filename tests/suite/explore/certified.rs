@@ -91,3 +91,36 @@ fn stopped_runs_are_counted_and_never_listed_as_optima() {
     let certified: usize = r.optima.iter().map(|o| o.count).sum();
     assert_eq!(certified, r.classes.converged);
 }
+
+/// `[multistart] method = "sqp"` on the same 20 HS 100 starts: every run
+/// certified at the one optimum f* (to 1e-6), with fewer function calls
+/// in all than MMFD with DOT's settings and the polish spend there.
+#[test]
+fn hs100_with_sqp_certifies_every_run_for_fewer_calls() {
+    let tmp = temp_dir("cert-hs100-sqp");
+    let dir = tmp.path().to_path_buf();
+    let calls = |extra: &str, name: &str| -> (usize, f64, usize) {
+        let s = study(
+            name,
+            &hs100(extra).replace(
+                "name = \"hs100\"\nseed",
+                &format!("name = \"{name}\"\nseed"),
+            ),
+        );
+        let r = explore::run_multistart(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();
+        let runs = table_without(&dir.join(name).join("runs.csv"), &[]);
+        let total: usize = column(&runs, "function_calls")
+            .iter()
+            .map(|c| c.parse::<usize>().unwrap())
+            .sum();
+        let o = table_without(&dir.join(name).join("optima.csv"), &[]);
+        let f: f64 = column(&o, "f")[0].parse().unwrap();
+        (total, f, r.classes.converged)
+    };
+    let (sqp, f, converged) = calls("method = \"sqp\"\n", "hs100_sqp");
+    let (mmfd, _, _) = calls("", "hs100_mmfd");
+    eprintln!("HS 100, 20 starts: SQP {sqp} function calls, MMFD + polish {mmfd}");
+    assert_eq!(converged, 20);
+    assert!((f - HS100_F).abs() <= 1e-6 * HS100_F, "f = {f}");
+    assert!(sqp < mmfd, "SQP {sqp} calls, MMFD {mmfd}");
+}
