@@ -145,7 +145,7 @@ impl DriveArgs {
             ..Default::default()
         };
         if let Some(s) = &self.shard {
-            f.shard = crate::explore::multistart::driver::Shard::parse(s)?;
+            f.shard = crate::explore::multistart::Shard::parse(s)?;
         }
         Ok(f)
     }

@@ -8,7 +8,7 @@
 //!
 //! | folder | section | algorithm | command |
 //! |---|---|---|---|
-//! | [`problem`] | `[problem]`, `[scene_problem]` | analytic test problems, the scene as a problem (variables, bounds, objectives of a front) | (built by every command: [`problem()`]) |
+//! | [`problem`](mod@problem) | `[problem]`, `[scene_problem]` | analytic test problems, the scene as a problem (variables, bounds, objectives of a front) | (built by every command: [`problem()`]) |
 //! | [`local`] | `[multistart] method`, `[multistart.mmfd]` | the local solvers, settling a run's end (certificate, polish, rescue), the violation check | (used by the commands) |
 //! | [`multistart`] | `[multistart]`, `[optimum_report]`, `[robustness]`, `[scaling]` | start points, the parallel multistart, clustering into distinct optima, shard merging | `plyscape multistart`, `merge` |
 //! | [`evolve`] | `[evolve]`, `[compare]` | CMA-ES with restarts on the multistart's budget | `plyscape evolve`, `compare` |

@@ -162,6 +162,56 @@ pub fn read_csv_lines(path: &Path, header: &[String], what: &str) -> Result<Opti
     }))
 }
 
+/// A table appended one whole line at a time (one `write_all` of the line,
+/// then a flush), so a killed process leaves at worst a torn last line.
+pub struct Appender {
+    file: std::fs::File,
+    path: std::path::PathBuf,
+}
+
+impl Appender {
+    /// Open `path` for appending (`fresh`: emptied first); `header` is
+    /// written when the file is empty or new.
+    pub fn open(path: &Path, header: &[String], fresh: bool) -> Result<Appender> {
+        let mut file = std::fs::OpenOptions::new()
+            .create(true)
+            .write(true)
+            .append(!fresh)
+            .truncate(fresh)
+            .open(path)
+            .map_err(|e| Error::io(path, e))?;
+        let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+        if len == 0 {
+            file.write_all(&csv_line(header)?)
+                .map_err(|e| Error::io(path, e))?;
+        }
+        Ok(Appender {
+            file,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Append one row as a single write and flush it.
+    pub fn row(&mut self, fields: &[String]) -> Result<()> {
+        let line = csv_line(fields)?;
+        self.file
+            .write_all(&line)
+            .and_then(|_| self.file.flush())
+            .map_err(|e| Error::io(&self.path, e))
+    }
+}
+
+/// Cut `path` to its first `keep` bytes (its whole lines, as
+/// [`read_csv_lines`] counts them) and sync it to disk.
+pub fn cut_torn_line(path: &Path, keep: usize) -> Result<()> {
+    let f = std::fs::OpenOptions::new()
+        .write(true)
+        .open(path)
+        .map_err(|e| Error::io(path, e))?;
+    f.set_len(keep as u64).map_err(|e| Error::io(path, e))?;
+    f.sync_all().map_err(|e| Error::io(path, e))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

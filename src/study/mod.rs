@@ -10,6 +10,7 @@
 //! Every error names the file, the key, the value and what was expected.
 
 pub mod memory;
+pub mod toml_value;
 
 use crate::error::{Error, Result};
 use serde::de::DeserializeOwned;

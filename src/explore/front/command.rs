@@ -396,23 +396,9 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
         }
         None => None,
     };
-    let all: Vec<Vec<f64>> = methods
-        .iter()
-        .flat_map(|mf| mf.points.iter().map(|p| p.1.clone()))
-        .collect();
-    let union: Vec<Vec<f64>> = non_dominated(&all)
-        .into_iter()
-        .map(|i| all[i].clone())
-        .collect();
     let signs: Vec<f64> = (0..m).map(|k| problem.sign(k)).collect();
-    let reference = reference_point(&problem, &section, &union)?;
     let analytic = problem.known_front();
-    for mf in &mut methods {
-        let f: Vec<Vec<f64>> = mf.points.iter().map(|p| p.1.clone()).collect();
-        mf.hypervolume = hypervolume(&f, &reference)?;
-        mf.igd_union = igd(&f, &union);
-        mf.igd_analytic = analytic.as_ref().and_then(|a| igd(&f, a));
-    }
+    let reference = score(&problem, &section, analytic.as_deref(), &mut methods)?;
     let report = FrontReport {
         objectives: problem.objective_names(),
         methods,
@@ -428,23 +414,56 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
         dir,
     )?;
     if !quiet {
-        for mf in &report.methods {
-            println!(
-                "{}: {} points, {} function + {} gradient calls{}, {:.2} s, hypervolume {}, IGD to the union {}, to the analytic front {}",
-                mf.method,
-                mf.points.len(),
-                mf.function_calls,
-                mf.gradient_calls,
-                mf.simulations.map(|s| format!(" ({s} simulations)")).unwrap_or_default(),
-                mf.wall_seconds,
-                num(mf.hypervolume),
-                field(mf.igd_union),
-                field(mf.igd_analytic),
-            );
-        }
-        println!("wrote {}", dir.join("front.csv").display());
+        print_methods(&report, dir);
     }
     Ok(report)
+}
+
+/// The indicators of every method's front: the hypervolume to the
+/// reference point, the IGD to the union of all methods' non-dominated
+/// points and to the `analytic` front (when the problem knows it).
+/// Returns the reference point.
+fn score(
+    problem: &Oriented,
+    section: &FrontSection,
+    analytic: Option<&[Vec<f64>]>,
+    methods: &mut [MethodFront],
+) -> Result<Vec<f64>> {
+    let all: Vec<Vec<f64>> = methods
+        .iter()
+        .flat_map(|mf| mf.points.iter().map(|p| p.1.clone()))
+        .collect();
+    let union: Vec<Vec<f64>> = non_dominated(&all)
+        .into_iter()
+        .map(|i| all[i].clone())
+        .collect();
+    let reference = reference_point(problem, section, &union)?;
+    for mf in methods.iter_mut() {
+        let f: Vec<Vec<f64>> = mf.points.iter().map(|p| p.1.clone()).collect();
+        mf.hypervolume = hypervolume(&f, &reference)?;
+        mf.igd_union = igd(&f, &union);
+        mf.igd_analytic = analytic.and_then(|a| igd(&f, a));
+    }
+    Ok(reference)
+}
+
+/// One line per method on stdout, and where `front.csv` went.
+fn print_methods(report: &FrontReport, dir: &Path) {
+    for mf in &report.methods {
+        println!(
+            "{}: {} points, {} function + {} gradient calls{}, {:.2} s, hypervolume {}, IGD to the union {}, to the analytic front {}",
+            mf.method,
+            mf.points.len(),
+            mf.function_calls,
+            mf.gradient_calls,
+            mf.simulations.map(|s| format!(" ({s} simulations)")).unwrap_or_default(),
+            mf.wall_seconds,
+            num(mf.hypervolume),
+            field(mf.igd_union),
+            field(mf.igd_analytic),
+        );
+    }
+    println!("wrote {}", dir.join("front.csv").display());
 }
 
 fn field(v: Option<f64>) -> String {

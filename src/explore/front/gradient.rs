@@ -217,15 +217,7 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
     let names = problem.objective_names();
     // 1. Anchors from every start, the best of each objective, and its
     // lexicographic refinement.
-    let mut starts = vec![x0.clone()];
-    let mut rng = ChaCha8Rng::seed_from_u64(s.seed);
-    for _ in 1..s.anchor_starts.max(1) {
-        starts.push(
-            (problem.variables().iter())
-                .map(|v| v.wrap(v.lower + rng.random::<f64>() * (v.upper - v.lower)))
-                .collect(),
-        );
-    }
+    let starts = anchor_starts(problem, s, &x0);
     let pairs: Vec<(usize, usize)> = (0..m)
         .flat_map(|i| (0..starts.len()).map(move |k| (i, k)))
         .collect();
@@ -244,52 +236,13 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
             })
             .collect()
     });
-    // The best first run per objective: certified first, then lowest f.
     let best: Vec<RunRecord> = (0..m)
-        .map(|i| {
-            let runs = &firsts[i * starts.len()..(i + 1) * starts.len()];
-            let key = |r: &RunRecord| {
-                let f = r.result.as_ref().map_or(f64::INFINITY, |x| x.f);
-                (
-                    !certified(r, tol),
-                    if f.is_nan() { f64::INFINITY } else { f },
-                )
-            };
-            runs.iter()
-                .min_by(|a, b| {
-                    let (ka, kb) = (key(a), key(b));
-                    ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
-                })
-                .expect("at least one start")
-                .clone()
-        })
+        .map(|i| best_first(&firsts[i * starts.len()..(i + 1) * starts.len()], tol))
         .collect();
     let anchors: Vec<RunRecord> = pool.install(|| {
         (0..m)
             .into_par_iter()
-            .map(|i| {
-                let first = &best[i];
-                let fi = first.result.as_ref().map(|r| r.f);
-                let second = match (fi, &first.result) {
-                    (Some(fi), Some(end)) if fi.is_finite() => {
-                        let scale = fi.abs().max(1.0);
-                        let w = (0..m).map(|j| if j == i { 0.0 } else { 1.0 }).collect();
-                        let cap = vec![(i, fi + ANCHOR_CAP * scale, scale)];
-                        let p = EpsilonConstraint::new(problem, w, cap);
-                        let from_end = solve(&p, s, i, &end.x);
-                        if certified(&from_end, tol) {
-                            from_end
-                        } else {
-                            let mut again = solve(&p, s, i, &x0);
-                            again.function_calls += from_end.function_calls;
-                            again.gradient_calls += from_end.gradient_calls;
-                            again
-                        }
-                    }
-                    _ => first.clone(),
-                };
-                second
-            })
+            .map(|i| lexicographic(problem, s, i, &best[i], &x0))
             .collect()
     });
     let mut extra_calls = 0;
@@ -328,6 +281,115 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
             ),
         ));
     }
+    let (ideal, nadir, scale) = ideal_and_nadir(&anchor_f, m);
+    // 2. The subproblems.
+    let refs = reference_points(m, s.subproblems);
+    let runs: Vec<Result<(RunRecord, usize)>> = pool.install(|| {
+        refs.par_iter()
+            .enumerate()
+            .map(|(k, r)| subproblem(problem, s, (k, r), (&ideal, &scale), &anchor_x, &x0))
+            .collect()
+    });
+    for (k, run) in runs.into_iter().enumerate() {
+        let (run, probes) = run?;
+        extra_calls += probes;
+        let f = objectives(problem, &run, tol, &mut extra_calls)?;
+        ends.push(SubproblemEnd {
+            label: format!("subproblem-{k}"),
+            certified: certified(&run, tol),
+            run,
+            f,
+        });
+    }
+    // 3. The non-dominated certified ends.
+    let points = non_dominated_ends(problem.variables().len(), &ends);
+    // Extra calls: the subproblems' start evaluations and the final
+    // objective evaluations.
+    let function_calls = ends.iter().map(|e| e.run.function_calls).sum::<usize>() + extra_calls;
+    let gradient_calls = ends.iter().map(|e| e.run.gradient_calls).sum();
+    Ok(GradientFront {
+        points,
+        ends,
+        ideal,
+        nadir,
+        function_calls,
+        gradient_calls,
+        wall_seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// The anchors' starts: the problem's start design `x0`, then
+/// `anchor_starts − 1` seeded uniform random designs.
+fn anchor_starts(problem: &dyn MultiProblem, s: &GradientSettings, x0: &[f64]) -> Vec<Vec<f64>> {
+    let mut starts = vec![x0.to_vec()];
+    let mut rng = ChaCha8Rng::seed_from_u64(s.seed);
+    for _ in 1..s.anchor_starts.max(1) {
+        starts.push(
+            (problem.variables().iter())
+                .map(|v| v.wrap(v.lower + rng.random::<f64>() * (v.upper - v.lower)))
+                .collect(),
+        );
+    }
+    starts
+}
+
+/// The best of one objective's first anchor runs: certified first, then
+/// lowest f.
+fn best_first(runs: &[RunRecord], tol: f64) -> RunRecord {
+    let key = |r: &RunRecord| {
+        let f = r.result.as_ref().map_or(f64::INFINITY, |x| x.f);
+        (
+            !certified(r, tol),
+            if f.is_nan() { f64::INFINITY } else { f },
+        )
+    };
+    runs.iter()
+        .min_by(|a, b| {
+            let (ka, kb) = (key(a), key(b));
+            ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+        })
+        .expect("at least one start")
+        .clone()
+}
+
+/// The lexicographic anchor of objective `i`: the sum of the other
+/// objectives subject to `f_i <= f_i* + τ·max(1, |f_i*|)`, from the end of
+/// `first`, and once more from `x0` (calls counted together) when that
+/// run is not certified; `first` itself when it has no finite `f_i*`.
+fn lexicographic(
+    problem: &dyn MultiProblem,
+    s: &GradientSettings,
+    i: usize,
+    first: &RunRecord,
+    x0: &[f64],
+) -> RunRecord {
+    let tol = s.end.tolerances.feasibility;
+    let m = problem.objective_names().len();
+    let fi = first.result.as_ref().map(|r| r.f);
+    match (fi, &first.result) {
+        (Some(fi), Some(end)) if fi.is_finite() => {
+            let scale = fi.abs().max(1.0);
+            let w = (0..m).map(|j| if j == i { 0.0 } else { 1.0 }).collect();
+            let cap = vec![(i, fi + ANCHOR_CAP * scale, scale)];
+            let p = EpsilonConstraint::new(problem, w, cap);
+            let from_end = solve(&p, s, i, &end.x);
+            if certified(&from_end, tol) {
+                from_end
+            } else {
+                let mut again = solve(&p, s, i, x0);
+                again.function_calls += from_end.function_calls;
+                again.gradient_calls += from_end.gradient_calls;
+                again
+            }
+        }
+        _ => first.clone(),
+    }
+}
+
+/// The ideal point `z_j = min_i f_j(a_i)`, the payoff-table nadir
+/// `N_j = max_i f_j(a_i)` of the anchors' objectives, and the ranges
+/// `N_j − z_j` (1 where a range is below `1e-12 max(1, |z_j|)`).
+fn ideal_and_nadir(anchor_f: &[&Vec<f64>], m: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let ideal: Vec<f64> = (0..m)
         .map(|j| anchor_f.iter().map(|f| f[j]).fold(f64::INFINITY, f64::min))
         .collect();
@@ -351,57 +413,57 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
             }
         })
         .collect();
-    // 2. The subproblems.
-    let refs = reference_points(m, s.subproblems);
-    let runs: Vec<Result<(RunRecord, usize)>> = pool.install(|| {
-        refs.par_iter()
-            .enumerate()
-            .map(|(k, r)| {
-                let t_probe = Tchebycheff::new(
-                    problem,
-                    (ideal.clone(), scale.clone()),
-                    r.clone(),
-                    RHO,
-                    (-(m as f64) - 1.0, f64::MAX / 4.0),
-                )?;
-                let x_start = between_anchors(problem, &anchor_x, r).unwrap_or_else(|| x0.clone());
-                // (x, t0) from the anchors' blend and from the start design
-                // (one evaluation each, counted); t's upper bound admits both.
-                let from_blend = t_probe.start(&x_start)?;
-                let from_x0 = t_probe.start(&x0)?;
-                let t_hi = from_blend[x0.len()].max(from_x0[x0.len()]).max(0.0) + 1.0;
-                let p = Tchebycheff::new(
-                    problem,
-                    (ideal.clone(), scale.clone()),
-                    r.clone(),
-                    RHO,
-                    (-(m as f64) - 1.0, t_hi),
-                )?;
-                let run = solve(&p, s, m + k, &from_blend);
-                if certified(&run, tol) || x_start == x0 {
-                    return Ok((run, 2));
-                }
-                // Once more from the start design (counted together).
-                let mut again = solve(&p, s, m + k, &from_x0);
-                again.function_calls += run.function_calls;
-                again.gradient_calls += run.gradient_calls;
-                Ok((again, 2))
-            })
-            .collect()
-    });
-    for (k, run) in runs.into_iter().enumerate() {
-        let (run, probes) = run?;
-        extra_calls += probes;
-        let f = objectives(problem, &run, tol, &mut extra_calls)?;
-        ends.push(SubproblemEnd {
-            label: format!("subproblem-{k}"),
-            certified: certified(&run, tol),
-            run,
-            f,
-        });
+    (ideal, nadir, scale)
+}
+
+/// Subproblem `k` with reference weights `r`: the Tchebycheff problem
+/// normalised by `(ideal, scale)`, from the anchors' blend and once more
+/// from `x0` when that run is not certified; with the 2 probe evaluations
+/// of its start.
+fn subproblem(
+    problem: &dyn MultiProblem,
+    s: &GradientSettings,
+    (k, r): (usize, &Vec<f64>),
+    (ideal, scale): (&[f64], &[f64]),
+    anchor_x: &[Option<Vec<f64>>],
+    x0: &[f64],
+) -> Result<(RunRecord, usize)> {
+    let tol = s.end.tolerances.feasibility;
+    let m = problem.objective_names().len();
+    let t_probe = Tchebycheff::new(
+        problem,
+        (ideal.to_vec(), scale.to_vec()),
+        r.clone(),
+        RHO,
+        (-(m as f64) - 1.0, f64::MAX / 4.0),
+    )?;
+    let x_start = between_anchors(problem, anchor_x, r).unwrap_or_else(|| x0.to_vec());
+    // (x, t0) from the anchors' blend and from the start design
+    // (one evaluation each, counted); t's upper bound admits both.
+    let from_blend = t_probe.start(&x_start)?;
+    let from_x0 = t_probe.start(x0)?;
+    let t_hi = from_blend[x0.len()].max(from_x0[x0.len()]).max(0.0) + 1.0;
+    let p = Tchebycheff::new(
+        problem,
+        (ideal.to_vec(), scale.to_vec()),
+        r.clone(),
+        RHO,
+        (-(m as f64) - 1.0, t_hi),
+    )?;
+    let run = solve(&p, s, m + k, &from_blend);
+    if certified(&run, tol) || x_start == x0 {
+        return Ok((run, 2));
     }
-    // 3. The non-dominated certified ends.
-    let n = problem.variables().len();
+    // Once more from the start design (counted together).
+    let mut again = solve(&p, s, m + k, &from_x0);
+    again.function_calls += run.function_calls;
+    again.gradient_calls += run.gradient_calls;
+    Ok((again, 2))
+}
+
+/// The non-dominated certified ends: (design, objectives) of the ends
+/// with objectives, the first `n` coordinates of each design.
+fn non_dominated_ends(n: usize, ends: &[SubproblemEnd]) -> Vec<(Vec<f64>, Vec<f64>)> {
     let kept: Vec<(Vec<f64>, Vec<f64>)> = ends
         .iter()
         .filter_map(|e| {
@@ -410,23 +472,10 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
         })
         .collect();
     let fs: Vec<Vec<f64>> = kept.iter().map(|c| c.1.clone()).collect();
-    let points = non_dominated(&fs)
+    non_dominated(&fs)
         .into_iter()
         .map(|i| kept[i].clone())
-        .collect();
-    // Extra calls: the subproblems' start evaluations and the final
-    // objective evaluations.
-    let function_calls = ends.iter().map(|e| e.run.function_calls).sum::<usize>() + extra_calls;
-    let gradient_calls = ends.iter().map(|e| e.run.gradient_calls).sum();
-    Ok(GradientFront {
-        points,
-        ends,
-        ideal,
-        nadir,
-        function_calls,
-        gradient_calls,
-        wall_seconds: t0.elapsed().as_secs_f64(),
-    })
+        .collect()
 }
 
 #[cfg(test)]

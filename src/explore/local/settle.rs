@@ -46,7 +46,9 @@ use crate::error::Result;
 use crate::optimize::kkt::{self, Certificate, EndClass, KktTolerances};
 use crate::optimize::local::LocalSolver;
 use crate::optimize::mmfd::MmfdOptions;
-use crate::optimize::{Counted, IterRecord, LocalOutcome, NoObserver, Observer, Problem};
+use crate::optimize::{
+    Counted, IterRecord, LocalOutcome, NoObserver, Observer, Problem, Termination,
+};
 
 /// What happens at the end of every local run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,9 +71,102 @@ pub struct Settled {
     /// Its certificate (`None` when it could not be computed; the reason is
     /// in `polish`).
     pub certificate: Option<Certificate>,
-    /// How the polish ended: its termination, `kept: ...` when the solver's
-    /// end was better, `error: ...`; empty when no polish ran.
-    pub polish: String,
+    /// How the polish of the solver's end went.
+    pub polish: PolishEnd,
+    /// What the rescue did (step 3 of the module doc); `None` when it did
+    /// not run.
+    pub rescue: Option<Rescue>,
+}
+
+impl Settled {
+    /// The `polish` column of `runs.csv`: the polish's text, then the
+    /// rescue's after `; ` (empty when neither ran).
+    pub fn note(&self) -> String {
+        let polish = self.polish.text();
+        match &self.rescue {
+            None => polish,
+            Some(r) if polish.is_empty() => r.text(),
+            Some(r) => format!("{polish}; {}", r.text()),
+        }
+    }
+}
+
+/// How the polish of a run's end went.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PolishEnd {
+    /// No polish ran: the end is converged, the polish is off, or descent
+    /// on the violation cannot go on from an infeasible end.
+    NotRun,
+    /// The polish's end replaced the solver's; how the polish stopped.
+    Replaced(Termination),
+    /// The solver's end was kept: the polish ended worse (how it stopped,
+    /// and its f).
+    Kept(Termination, f64),
+    /// The polish failed (the error's message).
+    Failed(String),
+    /// The certificate at the solver's end could not be computed (the
+    /// error's message); no polish ran.
+    CertificateFailed(String),
+}
+
+impl PolishEnd {
+    /// Its text in `runs.csv` (empty for [`PolishEnd::NotRun`]).
+    pub fn text(&self) -> String {
+        match self {
+            PolishEnd::NotRun => String::new(),
+            PolishEnd::Replaced(t) => t.to_string(),
+            PolishEnd::Kept(t, f) => format!("kept: the polish ended worse ({t}, f = {f})"),
+            PolishEnd::Failed(e) => format!("error: {e}"),
+            PolishEnd::CertificateFailed(e) => format!("error: certificate: {e}"),
+        }
+    }
+}
+
+/// What the rescue of an infeasible end did; `calls` are the descent's
+/// (function, gradient) calls.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Rescue {
+    /// The descent on the violation failed (the error's message).
+    Failed(String),
+    /// The descent ended infeasible too, at this largest constraint.
+    StayedInfeasible {
+        /// `max_j g_j` at the descent's end.
+        max_g: f64,
+        /// The descent's calls.
+        calls: (usize, usize),
+    },
+    /// The descent reached the feasible set; its end was settled again.
+    Reached {
+        /// The descent's calls.
+        calls: (usize, usize),
+        /// The polish from the descent's end.
+        then: PolishEnd,
+    },
+}
+
+impl Rescue {
+    /// Its text in `runs.csv`'s `polish` column.
+    pub fn text(&self) -> String {
+        match self {
+            Rescue::Failed(e) => format!("rescue: error: {e}"),
+            Rescue::StayedInfeasible { max_g, calls } => format!(
+                "rescue: the descent on the violation from the start ended infeasible too \
+                 (max g = {max_g:.3e}, {} f + {} g)",
+                calls.0, calls.1
+            ),
+            Rescue::Reached { calls, then } => {
+                let then = match then.text().as_str() {
+                    "" => String::new(),
+                    p => format!("; then {p}"),
+                };
+                format!(
+                    "rescued: the descent on the violation from the start reached the feasible \
+                     set ({} f + {} g){then}",
+                    calls.0, calls.1
+                )
+            }
+        }
+    }
 }
 
 /// Passes the polish's records on as continuations of the run: iteration
@@ -186,15 +281,11 @@ fn rescue(
     let tol = policy.tolerances.feasibility;
     let descent = violation::descend(&counted, x0, tol);
     let calls = (counted.function_calls(), counted.gradient_calls());
-    let said = |s: &str| match settled.polish.as_str() {
-        "" => s.to_string(),
-        p => format!("{p}; {s}"),
-    };
     let (x, e, iterations) = match descent {
         Ok(d) => d,
         Err(e) => {
             return Settled {
-                polish: said(&format!("rescue: error: {e}")),
+                rescue: Some(Rescue::Failed(e.to_string())),
                 ..settled
             }
         }
@@ -203,13 +294,8 @@ fn rescue(
     let o = &settled.outcome;
     let (f_calls, g_calls) = (o.function_calls + calls.0, o.gradient_calls + calls.1);
     if max_g > tol {
-        let note = format!(
-            "rescue: the descent on the violation from the start ended infeasible too \
-             (max g = {max_g:.3e}, {} f + {} g)",
-            calls.0, calls.1
-        );
         return Settled {
-            polish: said(&note),
+            rescue: Some(Rescue::StayedInfeasible { max_g, calls }),
             outcome: LocalOutcome {
                 function_calls: f_calls,
                 gradient_calls: g_calls,
@@ -230,16 +316,12 @@ fn rescue(
         termination: o.termination.clone(),
     };
     let again = settle_end(problem, reached, policy, observer);
-    let then = match again.polish.as_str() {
-        "" => String::new(),
-        p => format!("; then {p}"),
-    };
     Settled {
-        polish: said(&format!(
-            "rescued: the descent on the violation from the start reached the feasible set \
-             ({} f + {} g){then}",
-            calls.0, calls.1
-        )),
+        polish: settled.polish,
+        rescue: Some(Rescue::Reached {
+            calls,
+            then: again.polish,
+        }),
         ..again
     }
 }
@@ -264,7 +346,8 @@ fn settle_end(
             return Settled {
                 outcome,
                 certificate: None,
-                polish: format!("error: certificate: {e}"),
+                polish: PolishEnd::CertificateFailed(e.to_string()),
+                rescue: None,
             }
         }
     };
@@ -284,7 +367,8 @@ fn settle_end(
                 ..outcome
             },
             certificate: Some(first),
-            polish: String::new(),
+            polish: PolishEnd::NotRun,
+            rescue: None,
         };
     }
     let before = (counted.function_calls(), counted.gradient_calls());
@@ -313,7 +397,8 @@ fn settle_end(
     let (polish, c) = match polished {
         Ok((t, o, c, after)) if no_worse(&o, &outcome, tol.feasibility, options.noise) => {
             return Settled {
-                polish: t.to_string(),
+                polish: PolishEnd::Replaced(t),
+                rescue: None,
                 outcome: LocalOutcome {
                     function_calls: after.0,
                     gradient_calls: after.1,
@@ -322,11 +407,8 @@ fn settle_end(
                 certificate: Some(c),
             }
         }
-        Ok((t, o, _, _)) => (
-            format!("kept: the polish ended worse ({t}, f = {})", o.f),
-            o.iterations,
-        ),
-        Err(e) => (format!("error: {e}"), last),
+        Ok((t, o, _, _)) => (PolishEnd::Kept(t, o.f), o.iterations),
+        Err(e) => (PolishEnd::Failed(e.to_string()), last),
     };
     // The solver's end stays the result: recorded once more after the
     // polish's iterations, so that the history ends at the result.
@@ -351,6 +433,7 @@ fn settle_end(
         outcome: end,
         certificate: Some(first),
         polish,
+        rescue: None,
     }
 }
 
@@ -394,7 +477,6 @@ pub fn strictly_feasible(
 mod tests {
     use super::*;
     use crate::optimize::testproblems::islands;
-    use crate::optimize::Termination;
 
     const X_STAR: f64 = 2.109_381_364_946_409_5; // sqrt(2 + sqrt(6))
 
@@ -427,10 +509,11 @@ mod tests {
         assert!((0.5 + X_STAR * X_STAR - 0.25 * X_STAR.powi(4)).abs() < 1e-12);
         // Without the polish: feasible, not stationary.
         let s = settle(&p, None, end(&p, 2.5), &policy(false), &mut NoObserver);
-        let c = s.certificate.unwrap();
+        let c = s.certificate.clone().unwrap();
         assert_eq!(c.class, EndClass::Stopped);
         assert_eq!(c.kt_residual, Some(1.0), "all of ∇f is left: {c:?}");
-        assert!(s.polish.is_empty());
+        assert_eq!((&s.polish, &s.rescue), (&PolishEnd::NotRun, &None));
+        assert_eq!(s.note(), "");
         // With it: on the constraint, certified, the multiplier 1/|g'(x*)|.
         let s = settle(&p, None, end(&p, 2.5), &policy(true), &mut NoObserver);
         let c = s.certificate.as_ref().unwrap();
@@ -445,11 +528,8 @@ mod tests {
         );
         // The solver's exit stays, the polish's is reported beside it.
         assert_eq!(s.outcome.termination, Termination::RelativeChange);
-        assert!(
-            !s.polish.is_empty() && !s.polish.starts_with("error"),
-            "{}",
-            s.polish
-        );
+        assert!(matches!(s.polish, PolishEnd::Replaced(_)), "{s:?}");
+        assert_eq!(s.note(), s.polish.text());
     }
 
     #[test]
@@ -459,7 +539,11 @@ mod tests {
         let c = s.certificate.unwrap();
         assert_eq!(c.class, EndClass::Infeasible);
         assert_eq!(c.violation_stationary, Some(true));
-        assert!(s.polish.is_empty(), "no polish from a stationary violation");
+        assert_eq!(
+            s.polish,
+            PolishEnd::NotRun,
+            "no polish from a stationary violation"
+        );
         // Off the minimum of the violation: not stationary, and the polish
         // (MMFD's feasibility moves) reaches the feasible set.
         let s = settle(&p, None, end(&p, 1.9), &policy(false), &mut NoObserver);
@@ -468,7 +552,7 @@ mod tests {
         assert_eq!(
             s.certificate.unwrap().class,
             EndClass::Converged,
-            "{}",
+            "{:?}",
             s.polish
         );
         assert!((s.outcome.x[0] - X_STAR).abs() < 1e-6);
@@ -489,14 +573,19 @@ mod tests {
         let c = s.certificate.as_ref().unwrap();
         assert_eq!(c.class, EndClass::Converged, "{s:?}");
         assert!((s.outcome.x[0] - X_STAR).abs() < 1e-6, "{s:?}");
-        assert!(s.polish.starts_with("rescued"), "{}", s.polish);
+        assert!(matches!(s.rescue, Some(Rescue::Reached { .. })), "{s:?}");
+        assert!(s.note().starts_with("rescued: the descent"), "{}", s.note());
         // The descent's and the polish's calls count with the run's 10 + 3.
         assert!(s.outcome.function_calls > 10 && s.outcome.gradient_calls > 3);
         // From 0.3 the descent ends at x = 0 too: still infeasible, said so.
         let s = settle(&p, Some(&[0.3]), end(&p, 0.0), &rescuing, &mut NoObserver);
         assert_eq!(s.certificate.as_ref().unwrap().class, EndClass::Infeasible);
         assert_eq!(s.outcome.x, vec![0.0]);
-        assert!(s.polish.contains("ended infeasible too"), "{}", s.polish);
+        assert!(
+            matches!(s.rescue, Some(Rescue::StayedInfeasible { .. })),
+            "{s:?}"
+        );
+        assert!(s.note().contains("ended infeasible too"), "{}", s.note());
         // Without the rescue the end stays as the solver left it.
         let s = settle(
             &p,

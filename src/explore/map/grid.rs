@@ -11,13 +11,11 @@
 //! parallel (rayon, one evaluation per task) and written in grid order.
 
 use crate::error::{Error, Result};
-use crate::explore::persist::tables::{csv_line, num};
+use crate::explore::persist::tables::num;
 use crate::optimize::{Evaluation, Problem};
 use crate::report::csv::read_csv_lines;
 use crate::report::{heat_map, HeatMap, Progress};
 use rayon::prelude::*;
-use std::io::Write;
-use std::ops::Not;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -179,12 +177,7 @@ fn read_cells(
         });
     }
     if keep < lines.len {
-        let f = std::fs::OpenOptions::new()
-            .write(true)
-            .open(path)
-            .map_err(|e| Error::io(path, e))?;
-        f.set_len(keep as u64).map_err(|e| Error::io(path, e))?;
-        f.sync_all().map_err(|e| Error::io(path, e))?;
+        crate::report::csv::cut_torn_line(path, keep)?;
         eprintln!(
             "warning: {}: removed a torn last line ({} bytes) left by an interrupted map; \
              that cell is evaluated again",
@@ -269,23 +262,11 @@ pub fn run(
                 ));
             }
         }
-        let mut file = std::fs::OpenOptions::new()
-            .create(true)
-            .write(true)
-            .append(cells.is_empty().not())
-            .truncate(cells.is_empty())
-            .open(&path)
-            .map_err(|e| Error::io(&path, e))?;
-        if cells.is_empty() {
-            file.write_all(&csv_line(&head)?)
-                .map_err(|e| Error::io(&path, e))?;
-        }
+        let mut table = crate::report::csv::Appender::open(&path, &head, cells.is_empty())?;
         progress.set(progress_pos(&out, res) + cells.len() as u64, "");
         let first = cells.len();
         evaluate_from(problem, &pool, first, res * res, &design, |c, e| {
-            file.write_all(&csv_line(&row(xs[c / res], ys[c % res], &e, m))?)
-                .and_then(|_| file.flush())
-                .map_err(|err| Error::io(&path, err))?;
+            table.row(&row(xs[c / res], ys[c % res], &e, m))?;
             cells.push(e);
             progress.inc(&format!("slice {}/{}", out.len() + 1, req.pairs.len()));
             Ok(())

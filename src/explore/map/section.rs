@@ -46,19 +46,12 @@ pub fn map_section(study: &Study) -> Result<MapSection> {
 mod tests {
     use super::*;
 
-    fn study(text: &str) -> Study {
-        Study::parse("plan.toml", text).unwrap()
-    }
-
-    const HIMMELBLAU: &str = "[study]\nseed = 7\n[problem]\nname = \"himmelblau\"\n";
-
     #[test]
     fn map_section_defaults_and_bounds() {
-        let sec = map_section(&study(HIMMELBLAU)).unwrap();
+        let study = |text: &str| Study::parse("plan.toml", text).unwrap();
+        let sec = map_section(&study("[problem]\nname = \"himmelblau\"\n")).unwrap();
         assert_eq!((sec.resolution, sec.pairs), (61, None));
-        let e = map_section(&study(&format!("{HIMMELBLAU}[map]\nresolution = 1\n")))
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("map.resolution"), "{e}");
+        let e = map_section(&study("[map]\nresolution = 1\n")).unwrap_err();
+        assert!(e.to_string().contains("map.resolution"), "{e}");
     }
 }

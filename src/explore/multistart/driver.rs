@@ -136,10 +136,11 @@ pub fn one_run(
     let mut polish = String::new();
     let (result, exit, iterations) = match out {
         Ok(s) => {
+            let note = s.note();
             let o = s.outcome;
             if o.f.is_finite() && o.x.iter().chain(&o.g).all(|v| v.is_finite()) {
+                polish = note;
                 certificate = s.certificate;
-                polish = s.polish;
                 let exit = o.termination.to_string();
                 let result = RunResult {
                     x: o.x,
@@ -169,6 +170,76 @@ pub fn one_run(
     }
 }
 
+/// The rows of an earlier `runs.csv` to continue from (`settings.resume`,
+/// each checked against `starts` and the shard), or none: without resume
+/// an earlier file is removed.
+fn earlier_runs(
+    problem: &dyn Problem,
+    starts: &[Vec<f64>],
+    settings: &Settings,
+    path: &Path,
+) -> Result<BTreeMap<usize, RunRecord>> {
+    let (vars, m) = (problem.variables(), problem.n_constraints());
+    let mut done: BTreeMap<usize, RunRecord> = BTreeMap::new();
+    if settings.resume {
+        for row in read_runs(path, vars, m)?.rows {
+            check_row(&row, starts, settings.shard, path)?;
+            if done.insert(row.start, row.clone()).is_some() {
+                return Err(Error::csv(
+                    path,
+                    format!("start {} appears twice", row.start),
+                ));
+            }
+        }
+    } else if path.exists() {
+        std::fs::remove_file(path).map_err(|e| Error::io(path, e))?;
+    }
+    Ok(done)
+}
+
+/// May start `k` be launched: the runs finished below `k` have not used
+/// `max_evaluations` up, and `max_wall_seconds` has not passed since `t0`.
+fn may_launch(
+    settings: &Settings,
+    k: usize,
+    finished_evals: &Mutex<BTreeMap<usize, usize>>,
+    t0: Instant,
+) -> bool {
+    if let Some(b) = settings.max_evaluations {
+        let used: usize = finished_evals
+            .lock()
+            .expect("no panics")
+            .range(..k)
+            .map(|(_, e)| e)
+            .sum();
+        if used >= b {
+            return false;
+        }
+    }
+    !settings
+        .max_wall_seconds
+        .is_some_and(|w| t0.elapsed().as_secs_f64() >= w)
+}
+
+/// The run from start `k` at `x0`, with its iteration history when it is
+/// `settings.history_start`.
+fn run_start(
+    problem: &dyn Problem,
+    solver: &LocalSolver,
+    settings: &Settings,
+    k: usize,
+    x0: &[f64],
+) -> (RunRecord, Option<TimedHistory>) {
+    if settings.history_start == Some(k) {
+        let mut h = TimedHistory::start();
+        let row = one_run(problem, solver, &settings.end, k, x0, &mut h);
+        (row, Some(h))
+    } else {
+        let row = one_run(problem, solver, &settings.end, k, x0, &mut NoObserver);
+        (row, None)
+    }
+}
+
 /// Run the multistart from `starts` (all of the study's; the shard picks
 /// its own), writing `runs.csv` and `optima.csv` into `dir`.
 pub fn run(
@@ -185,20 +256,7 @@ pub fn run(
     let mine: Vec<usize> = (0..starts.len())
         .filter(|&k| settings.shard.owns(k))
         .collect();
-    let mut done: BTreeMap<usize, RunRecord> = BTreeMap::new();
-    if settings.resume {
-        for row in read_runs(&path, vars, m)?.rows {
-            check_row(&row, starts, settings.shard, &path)?;
-            if done.insert(row.start, row.clone()).is_some() {
-                return Err(Error::csv(
-                    &path,
-                    format!("start {} appears twice", row.start),
-                ));
-            }
-        }
-    } else if path.exists() {
-        std::fs::remove_file(&path).map_err(|e| Error::io(&path, e))?;
-    }
+    let mut done = earlier_runs(problem, starts, settings, &path)?;
     let todo: Vec<usize> = mine
         .iter()
         .copied()
@@ -237,43 +295,11 @@ pub fn run(
                         }
                         let i = next.fetch_add(1, Ordering::SeqCst);
                         let Some(&k) = todo.get(i) else { break };
-                        if let Some(b) = settings.max_evaluations {
-                            let used: usize = finished_evals
-                                .lock()
-                                .expect("no panics")
-                                .range(..k)
-                                .map(|(_, e)| e)
-                                .sum();
-                            if used >= b {
-                                stop.store(true, Ordering::SeqCst);
-                                break;
-                            }
-                        }
-                        if settings
-                            .max_wall_seconds
-                            .is_some_and(|w| t0.elapsed().as_secs_f64() >= w)
-                        {
+                        if !may_launch(settings, k, finished_evals, t0) {
                             stop.store(true, Ordering::SeqCst);
                             break;
                         }
-                        let (row, history) = if settings.history_start == Some(k) {
-                            let mut h = TimedHistory::start();
-                            let row =
-                                one_run(problem, solver, &settings.end, k, &starts[k], &mut h);
-                            (row, Some(h))
-                        } else {
-                            (
-                                one_run(
-                                    problem,
-                                    solver,
-                                    &settings.end,
-                                    k,
-                                    &starts[k],
-                                    &mut NoObserver,
-                                ),
-                                None,
-                            )
-                        };
+                        let (row, history) = run_start(problem, solver, settings, k, &starts[k]);
                         finished_evals
                             .lock()
                             .expect("no panics")

@@ -19,7 +19,6 @@ use crate::optimize::kkt::{Certificate, EndClass};
 use crate::optimize::Variable;
 use crate::report::csv::read_csv_lines;
 pub use crate::report::csv::{csv_line, num, write_atomic, write_bytes_atomic};
-use std::io::Write;
 use std::path::Path;
 
 /// The result of a run that did not fail.
@@ -329,12 +328,7 @@ pub struct ReadRuns {
 pub fn read_runs(path: &Path, vars: &[Variable], m: usize) -> Result<ReadRuns> {
     let (read, keep) = scan_runs(path, vars, m)?;
     if read.repaired_bytes > 0 {
-        let f = std::fs::OpenOptions::new()
-            .write(true)
-            .open(path)
-            .map_err(|e| Error::io(path, e))?;
-        f.set_len(keep as u64).map_err(|e| Error::io(path, e))?;
-        f.sync_all().map_err(|e| Error::io(path, e))?;
+        crate::report::csv::cut_torn_line(path, keep)?;
         eprintln!(
             "warning: {}: removed a torn last line ({} bytes) left by an interrupted run; that start will run again",
             path.display(),
@@ -388,8 +382,7 @@ pub fn scan_runs(path: &Path, vars: &[Variable], m: usize) -> Result<(ReadRuns, 
 
 /// Appends complete lines to `runs.csv`, flushing after each.
 pub struct RunsAppender {
-    file: std::fs::File,
-    path: std::path::PathBuf,
+    table: crate::report::csv::Appender,
     n: usize,
     m: usize,
 }
@@ -397,31 +390,14 @@ pub struct RunsAppender {
 impl RunsAppender {
     /// Open for appending; writes the header if the file is empty or new.
     pub fn open(path: &Path, vars: &[Variable], m: usize) -> Result<Self> {
-        let mut file = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .map_err(|e| Error::io(path, e))?;
-        let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
-        if len == 0 {
-            file.write_all(&csv_line(&runs_header(vars, m))?)
-                .map_err(|e| Error::io(path, e))?;
-        }
-        Ok(RunsAppender {
-            file,
-            path: path.to_path_buf(),
-            n: vars.len(),
-            m,
-        })
+        let table = crate::report::csv::Appender::open(path, &runs_header(vars, m), false)?;
+        let n = vars.len();
+        Ok(RunsAppender { table, n, m })
     }
 
     /// Append one row as a single write and flush it.
     pub fn append(&mut self, row: &RunRecord) -> Result<()> {
-        let line = csv_line(&row.fields(self.n, self.m))?;
-        self.file
-            .write_all(&line)
-            .and_then(|_| self.file.flush())
-            .map_err(|e| Error::io(&self.path, e))
+        self.table.row(&row.fields(self.n, self.m))
     }
 }
 

@@ -10,7 +10,7 @@
 //!   problem ([`scene_problem`]: ply angles and other design variables in
 //!   their SI units (degrees for angles), responses of a simulation as
 //!   objective and constraints, exact gradients by forward sensitivities),
-//!   its variables ([`scene_vars`], private) and bounds
+//!   its variables (`scene_vars`, private) and bounds
 //!   ([`scene_bounds`]); several responses as the objectives of a Pareto
 //!   front ([`scene_front`]).
 //! - Command: none of its own; every driver builds the study's problem

@@ -28,7 +28,7 @@ use std::time::{Duration, Instant};
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProblemSpec {
-    /// A name from [`PROBLEM_NAMES`].
+    /// A name from [`TEST_PROBLEMS`] (or `scene`).
     pub name: String,
     /// Number of variables (only `rosenbrock`, `rastrigin`; default 2).
     pub dimension: Option<usize>,
@@ -49,27 +49,104 @@ fn default_cost_mode() -> String {
     "spin".into()
 }
 
-/// Names accepted by [`ProblemSpec::build_multi`] (the problems of
-/// `optimize::mo_testproblems`, for `[front]`).
-pub const MULTI_PROBLEM_NAMES: &str = "zdt1, zdt2, zdt3, dtlz2, scene (with [scene_problem])";
+/// How a named test problem is built.
+#[derive(Clone, Copy)]
+pub enum Constructor {
+    /// One objective, a fixed number of variables.
+    Single(fn() -> Box<dyn Problem>),
+    /// One objective, `[problem] dimension` variables (default 2).
+    Sized(fn(usize) -> Box<dyn Problem>),
+    /// Several objectives, for `[front]` (`optimize::mo_testproblems`).
+    Multi(fn() -> Box<dyn MultiProblem>),
+}
 
-/// Names accepted by [`ProblemSpec::build`].
-pub const PROBLEM_NAMES: &str =
-    "himmelblau, rosenbrock, rastrigin, hs21, hs22, hs35, hs43, hs76, hs100, disc, seam, periodic2, scene (with [scene_problem])";
+/// A test problem by the name study files use.
+#[derive(Clone, Copy)]
+pub struct TestProblem {
+    /// The name (`[problem] name`).
+    pub name: &'static str,
+    /// Its constructor, which also says whether it has one objective.
+    pub build: Constructor,
+}
+
+/// Every test problem, in the order error messages list them: the one
+/// list of names; [`ProblemSpec::build`], [`ProblemSpec::build_multi`] and
+/// their error messages read it.
+pub const TEST_PROBLEMS: &[TestProblem] = {
+    use crate::optimize::mo_testproblems as mo;
+    use Constructor::{Multi, Single, Sized};
+    const fn entry(name: &'static str, build: Constructor) -> TestProblem {
+        TestProblem { name, build }
+    }
+    &[
+        entry("himmelblau", Single(|| Box::new(tp::himmelblau()))),
+        entry("rosenbrock", Sized(|n| Box::new(tp::rosenbrock(n)))),
+        entry("rastrigin", Sized(|n| Box::new(tp::rastrigin(n)))),
+        entry("hs21", Single(|| Box::new(tp::hs21()))),
+        entry("hs22", Single(|| Box::new(Hs22::new()))),
+        entry("hs35", Single(|| Box::new(tp::hs35()))),
+        entry("hs43", Single(|| Box::new(tp::hs43()))),
+        entry("hs76", Single(|| Box::new(tp::hs76()))),
+        entry("hs100", Single(|| Box::new(tp::hs100()))),
+        entry("disc", Single(|| Box::new(tp::disc()))),
+        entry("seam", Single(|| Box::new(tp::seam()))),
+        entry("periodic2", Single(|| Box::new(Periodic2::new()))),
+        entry("zdt1", Multi(|| Box::new(mo::zdt1()))),
+        entry("zdt2", Multi(|| Box::new(mo::zdt2()))),
+        entry("zdt3", Multi(|| Box::new(mo::zdt3()))),
+        entry("dtlz2", Multi(|| Box::new(mo::dtlz2()))),
+    ]
+};
+
+/// The names of the test problems whose constructor `pick` accepts,
+/// joined by `sep`.
+fn names(pick: fn(&Constructor) -> bool, sep: &str) -> String {
+    let list: Vec<&str> = TEST_PROBLEMS
+        .iter()
+        .filter(|t| pick(&t.build))
+        .map(|t| t.name)
+        .collect();
+    list.join(sep)
+}
+
+/// The names [`ProblemSpec::build`] accepts, as its error message lists
+/// them (`scene` is built from the study by `explore::problem`).
+pub fn problem_names() -> String {
+    let single = |c: &Constructor| !matches!(c, Constructor::Multi(_));
+    format!("{}, scene (with [scene_problem])", names(single, ", "))
+}
+
+/// The names [`ProblemSpec::build_multi`] accepts (and `scene` for
+/// `[front]`), as its error message lists them.
+pub fn multi_problem_names() -> String {
+    let multi = |c: &Constructor| matches!(c, Constructor::Multi(_));
+    format!("{}, scene (with [scene_problem])", names(multi, ", "))
+}
+
+/// The row of `name` in [`TEST_PROBLEMS`].
+fn lookup(name: &str) -> Option<Constructor> {
+    TEST_PROBLEMS
+        .iter()
+        .find(|t| t.name == name)
+        .map(|t| t.build)
+}
 
 impl ProblemSpec {
     /// Build the named multi-objective problem (`[front]`): one of
-    /// [`MULTI_PROBLEM_NAMES`], with none of the single-objective keys
+    /// [`multi_problem_names`], with none of the single-objective keys
     /// (`dimension`, `bounds`, `cost_ms`). Errors name the key within the
     /// `[problem]` section.
     pub fn build_multi(&self) -> Result<Box<dyn MultiProblem>> {
-        let p = crate::optimize::mo_testproblems::by_name(&self.name).ok_or_else(|| {
-            Error::input(
+        let Some(Constructor::Multi(build)) = lookup(&self.name) else {
+            return Err(Error::input(
                 "name",
                 format!("\"{}\"", self.name),
-                format!("a problem with several objectives for [front]: {MULTI_PROBLEM_NAMES}"),
-            )
-        })?;
+                format!(
+                    "a problem with several objectives for [front]: {}",
+                    multi_problem_names()
+                ),
+            ));
+        };
         let unused = [
             ("dimension", self.dimension.is_some()),
             ("bounds", self.bounds.is_some()),
@@ -82,7 +159,7 @@ impl ProblemSpec {
                 format!("no `{key}` for {} (its size and box are fixed)", self.name),
             ));
         }
-        Ok(Box::new(p))
+        Ok(build())
     }
 
     /// Build the named problem (wrapped in [`Costly`] when `cost_ms > 0`).
@@ -106,48 +183,40 @@ impl ProblemSpec {
                 ))
             }
         };
-        let sized = matches!(self.name.as_str(), "rosenbrock" | "rastrigin");
+        let entry = lookup(&self.name);
+        let sized = matches!(entry, Some(Constructor::Sized(_)));
         if self.dimension.is_some() && !sized {
+            let takers = names(|c| matches!(c, Constructor::Sized(_)), " and ");
             return Err(Error::input(
                 "dimension",
                 self.dimension.unwrap_or(0),
-                "no `dimension` (only rosenbrock and rastrigin take one)",
+                format!("no `dimension` (only {takers} take one)"),
             ));
         }
         let n = self.dimension.unwrap_or(2);
         if sized && !(2..=64).contains(&n) {
             return Err(Error::input("dimension", n, "2 <= dimension <= 64"));
         }
-        let inner: Box<dyn Problem> = match self.name.as_str() {
-            "himmelblau" => Box::new(tp::himmelblau()),
-            "rosenbrock" => Box::new(tp::rosenbrock(n)),
-            "rastrigin" => Box::new(tp::rastrigin(n)),
-            "hs21" => Box::new(tp::hs21()),
-            "hs35" => Box::new(tp::hs35()),
-            "hs43" => Box::new(tp::hs43()),
-            "hs76" => Box::new(tp::hs76()),
-            "hs100" => Box::new(tp::hs100()),
-            "disc" => Box::new(tp::disc()),
-            "seam" => Box::new(tp::seam()),
-            "hs22" => Box::new(Hs22::new()),
-            "periodic2" => Box::new(Periodic2::new()),
-            multi @ ("zdt1" | "zdt2" | "zdt3" | "dtlz2") => return Err(Error::input(
+        let inner: Box<dyn Problem> = match entry {
+            Some(Constructor::Single(build)) => build(),
+            Some(Constructor::Sized(build)) => build(n),
+            Some(Constructor::Multi(_)) => return Err(Error::input(
                 "name",
-                format!("\"{multi}\""),
+                format!("\"{}\"", self.name),
                 "a single-objective problem here: it has several objectives, use it with [front]",
             )),
-            "scene" => {
+            None if self.name == "scene" => {
                 return Err(Error::input(
                     "name",
                     "\"scene\"",
                     "a study: build scene problems with explore::problem(study)",
                 ))
             }
-            other => {
+            None => {
                 return Err(Error::input(
                     "name",
-                    format!("\"{other}\""),
-                    format!("one of {PROBLEM_NAMES}"),
+                    format!("\"{}\"", self.name),
+                    format!("one of {}", problem_names()),
                 ))
             }
         };
@@ -459,6 +528,35 @@ mod tests {
         ] {
             assert!((p.evaluate(&x, false).unwrap().f - f).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn the_name_lists_come_from_the_table() {
+        assert_eq!(
+            problem_names(),
+            "himmelblau, rosenbrock, rastrigin, hs21, hs22, hs35, hs43, hs76, hs100, disc, \
+             seam, periodic2, scene (with [scene_problem])"
+        );
+        assert_eq!(
+            multi_problem_names(),
+            "zdt1, zdt2, zdt3, dtlz2, scene (with [scene_problem])"
+        );
+        let spec = |name: &str, dimension| ProblemSpec {
+            name: name.into(),
+            dimension,
+            cost_ms: 0.0,
+            cost_mode: "spin".into(),
+            bounds: None,
+        };
+        for t in TEST_PROBLEMS {
+            let multi = matches!(t.build, Constructor::Multi(_));
+            assert_eq!(spec(t.name, None).build().is_ok(), !multi, "{}", t.name);
+            assert_eq!(spec(t.name, None).build_multi().is_ok(), multi);
+        }
+        let e = spec("hs21", Some(3)).build().err().unwrap().to_string();
+        assert!(e.contains("only rosenbrock and rastrigin take one"), "{e}");
+        let p = spec("rastrigin", Some(3)).build().unwrap();
+        assert_eq!(p.variables().len(), 3);
     }
 
     #[test]

@@ -13,4 +13,5 @@ mod robustness;
 mod scene;
 mod scene_bounds;
 mod scene_front;
+mod shards;
 mod studies;
