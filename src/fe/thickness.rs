@@ -1,6 +1,5 @@
 //! Derivatives of the reduced stiffness and lumped mass with respect to the
-//! thickness of groups of plies (issue 26, ply thickness as a design
-//! variable).
+//! thickness of groups of plies (ply thickness as a design variable).
 //!
 //! A group's variable is the common thickness `s` \[m\] of its plies. The
 //! element stiffness `K_e = A Gᵀ C_e(s) G + γ_d(s) K_drill` depends on `s`

@@ -1,4 +1,4 @@
-//! Flexible multibody kernel (issue 3): rigid spatial bodies with Euler
+//! Flexible multibody kernel: rigid spatial bodies with Euler
 //! parameters, floating-frame flexible bodies with modal coordinates
 //! (paper Eqs. 5–6; bases from closed-form beams `crate::beams` or from
 //! composite panels `crate::panels::panel_basis`), markers (on flexible

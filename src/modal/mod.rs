@@ -61,8 +61,8 @@
 //! Rayleigh–Ritz the rest), `λ'` for 2 variables < 4 ms, `λ'` + `X'` for 2
 //! variables 113 ms (14 `LDLᵀ` at ≈ 7 ms). A 10,092-DOF 3-DOF/node 9-point
 //! block grid (nnz(L) = 9.0e5, closer to a shell): symbolic 9.4 ms,
-//! 14 modes 91 ms, `λ'` + `X'` 199 ms. The targets of issue 2 (20 ms and
-//! 100 ms on the paper panel) are not reached on these matrices: the
+//! 14 modes 91 ms, `λ'` + `X'` 199 ms. The targets of 20 ms and
+//! 100 ms on the paper panel are not reached on these matrices: the
 //! Lanczos solves (≈ 6 per wanted mode at tol 1e-10 on a clustered
 //! spectrum) and the `k` numeric `LDLᵀ` of the updated-mode derivatives
 //! dominate. Cheaper options, not implemented: `tol = 1e-8` (78 instead of
@@ -71,7 +71,7 @@
 //! preconditioned CG on the shift-invert factor instead of `k`
 //! factorizations.
 //!
-//! Issue 2 (SAR panel 3, 4152 DOFs at 32 divisions, nnz(L) = 2.8e5, same
+//! On SAR panel 3 (4152 DOFs at 32 divisions, nnz(L) = 2.8e5, same
 //! VM, `studies/panel_convergence.toml`): K assembly + 14 modes ≈ 20 ms and
 //! K, K', K'' + 14 modes + `λ'`, `X'` for 2 variables ≈ 96 ms (before the
 //! pre-permuted factor, block gather products, block first GMRES step,

@@ -15,8 +15,9 @@
 //! [`QuantityKind`] variant with its row of [`QuantityKind::info`] (name,
 //! subject, unit, columns, sensitivities) and its evaluation in
 //! [`crate::simulate`]; a new response kind is a
-//! [`crate::mbs::responses::ResponseKind`] variant and its evaluation in
-//! [`crate::simulate`].
+//! [`crate::mbs::responses::ResponseKind`] variant with its own
+//! parameters, read from its keys in [`responses`], and its one
+//! evaluation in [`crate::simulate`].
 //!
 //!
 //! ```toml

@@ -1,5 +1,5 @@
 //! `[eval_bench]`: what one design evaluation of a scene problem costs and
-//! where its time goes (issue 14's benchmark).
+//! where its time goes.
 //!
 //! For every listed study with a scene problem (`[problem] name = "scene"`),
 //! every integration method listed in `methods` (default: the problem's

@@ -1,5 +1,5 @@
 //! `[gradient_check]`: what the fixed-mode approximation costs in gradient
-//! accuracy against what it saves in time (issue 11).
+//! accuracy against what it saves in time.
 //!
 //! The ply-angle gradients of a scene problem go through the mode
 //! derivatives of its panels. The updated-mode approach (paper Eq. 18)

@@ -225,7 +225,7 @@ fn may_launch(
 /// `settings.history_start`.
 fn run_start(
     problem: &dyn Problem,
-    solver: &LocalSolver,
+    solver: &dyn LocalSolver,
     settings: &Settings,
     k: usize,
     x0: &[f64],
