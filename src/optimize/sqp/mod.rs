@@ -414,7 +414,7 @@ impl Sqp {
             .map(|(g, a)| g + dot(a, d))
             .collect();
         let dphi = dot(&cur.grad_f, d) + penalty(&self.mu, &lin) - penalty(&self.mu, &cur.g);
-        if !(dphi < 0.0) {
+        if dphi.is_nan() || dphi >= 0.0 {
             return Ok(None);
         }
         let mut alpha = 1.0;
@@ -469,7 +469,7 @@ impl Sqp {
         let sv = nalgebra::DVector::from_column_slice(&s);
         let bs = &self.b * &sv;
         let sbs = sv.dot(&bs);
-        if !(sbs > 0.0) || !sy.is_finite() {
+        if sbs.is_nan() || sbs <= 0.0 || !sy.is_finite() {
             return;
         }
         let theta = if sy >= 0.2 * sbs {
@@ -484,7 +484,7 @@ impl Sqp {
                 .map(|(a, b)| theta * a + (1.0 - theta) * b),
         );
         let sr = sv.dot(&r);
-        if !(sr > 0.0) {
+        if sr.is_nan() || sr <= 0.0 {
             return;
         }
         self.b += &r * r.transpose() / sr - &bs * bs.transpose() / sbs;
