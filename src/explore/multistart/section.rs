@@ -269,7 +269,7 @@ mod tests {
         );
         for (key, bad, names) in [
             ("sampler", "halton", "`lhs`, `sobol`, `uniform`"),
-            ("method", "bfgs", "`mmfd` or `steepest`"),
+            ("method", "bfgs", "`mmfd`, `steepest`, `sqp`"),
         ] {
             let s = study(&format!(
                 "{HIMMELBLAU}[multistart]\nstarts = 4\n{key} = \"{bad}\"\n"
