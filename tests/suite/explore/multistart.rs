@@ -273,8 +273,8 @@ fn bad_study_input_gets_a_clear_error() {
     );
     assert_eq!(
         e,
-        "bad.toml: `multistart.method` = \"bfgs\": expected `mmfd` or `steepest` \
-         (unknown variant `bfgs`)"
+        "bad.toml: `multistart.method` = \"bfgs\": expected one of `mmfd`, `steepest`, \
+         `sqp` (unknown variant `bfgs`)"
     );
     let e = message_of(&format!("{base}starts = 4\nstrats = 5\n"));
     assert!(e.contains("multistart") && e.contains("strats"), "{e}");
