@@ -8,7 +8,9 @@
 //! iteration counter like the executor does. The solvers hold the last
 //! [`IterRecord`]; only this loop passes it on.
 
-use super::{Counted, Evaluation, IterRecord, Observer, Problem};
+use super::{
+    Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination, Variable,
+};
 use crate::error::{Error, Result};
 use argmin::core::{IterState, Problem as ArgminProblem, Solver, State};
 
@@ -102,4 +104,77 @@ where
         }
     }
     Ok(state)
+}
+
+/// The argmin problem the solvers of this crate step on.
+pub type Ap<'a> = ArgminProblem<Counted<'a>>;
+
+/// The design variables of the wrapped problem (none if argmin has taken
+/// the problem out, which it does not while a solver step runs).
+pub fn variables<'p>(problem: &'p Ap<'_>) -> &'p [Variable] {
+    problem.problem.as_ref().map_or(&[], |c| c.variables())
+}
+
+/// Evaluate `x` through argmin's counting (`cost_count` or
+/// `gradient_count`) and check the evaluation ([`check_evaluation`], its
+/// failures numerical errors at `place`).
+pub fn evaluate(
+    problem: &mut Ap<'_>,
+    x: &[f64],
+    gradients: bool,
+    place: &str,
+) -> Result<Evaluation> {
+    let key = if gradients {
+        "gradient_count"
+    } else {
+        "cost_count"
+    };
+    let ev = problem
+        .problem(key, |c| {
+            c.evaluate(x, gradients).map_err(argmin::core::Error::from)
+        })
+        .map_err(from_argmin)?;
+    let m = constraint_count(problem);
+    check_evaluation(&ev, x, m, gradients, place)?;
+    Ok(ev)
+}
+
+/// Function and gradient calls of the wrapped problem so far.
+pub fn counts(problem: &Ap<'_>) -> (usize, usize) {
+    problem
+        .problem
+        .as_ref()
+        .map(|c| (c.function_calls(), c.gradient_calls()))
+        .unwrap_or((0, 0))
+}
+
+/// The end of a local run at `(x, f, g)` after `iterations`, with the
+/// calls of `problem`: constraints with `g_j >= active_from` and the
+/// non-periodic variables on a bound are counted active; no termination
+/// means the iteration limit.
+pub fn local_outcome(
+    problem: &Ap<'_>,
+    (x, f, g): (Vec<f64>, f64, Vec<f64>),
+    active_from: f64,
+    iterations: usize,
+    termination: Option<Termination>,
+) -> LocalOutcome {
+    let (function_calls, gradient_calls) = counts(problem);
+    let active_side_constraints = variables(problem)
+        .iter()
+        .zip(&x)
+        .filter(|(v, &xi)| v.period.is_none() && (xi <= v.lower || xi >= v.upper))
+        .count();
+    let active_constraints = g.iter().filter(|&&gj| gj >= active_from).count();
+    LocalOutcome {
+        x,
+        f,
+        g,
+        iterations,
+        function_calls,
+        gradient_calls,
+        active_constraints,
+        active_side_constraints,
+        termination: termination.unwrap_or(Termination::MaxIterations),
+    }
 }

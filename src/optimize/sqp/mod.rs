@@ -48,9 +48,7 @@
 
 use super::driver::{self, OptState, Recorded};
 use super::kkt::{self, KktTolerances};
-use super::{
-    Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination, Variable,
-};
+use super::{Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination};
 use crate::error::{Error, Result};
 use argmin::core::{
     Problem as ArgminProblem, Solver, State, TerminationReason, TerminationStatus, KV,
@@ -160,34 +158,10 @@ impl Point {
     }
 }
 
-type Ap<'a> = ArgminProblem<Counted<'a>>;
-
-fn variables<'p>(problem: &'p Ap<'_>) -> &'p [Variable] {
-    problem.problem.as_ref().map_or(&[], |c| c.variables())
-}
+use driver::{counts, variables, Ap};
 
 fn evaluate(problem: &mut Ap<'_>, x: &[f64], gradients: bool) -> Result<Evaluation> {
-    let key = if gradients {
-        "gradient_count"
-    } else {
-        "cost_count"
-    };
-    let ev = problem
-        .problem(key, |c| {
-            c.evaluate(x, gradients).map_err(argmin::core::Error::from)
-        })
-        .map_err(driver::from_argmin)?;
-    let m = driver::constraint_count(problem);
-    driver::check_evaluation(&ev, x, m, gradients, "optimize::sqp")?;
-    Ok(ev)
-}
-
-fn counts(problem: &Ap<'_>) -> (usize, usize) {
-    problem
-        .problem
-        .as_ref()
-        .map(|c| (c.function_calls(), c.gradient_calls()))
-        .unwrap_or((0, 0))
+    driver::evaluate(problem, x, gradients, "optimize::sqp")
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -590,32 +564,17 @@ pub fn minimize(
     let mut solver = Sqp::new(problem, x0, options.clone())?;
     let mut ap = ArgminProblem::new(Counted::new(problem));
     driver::run(&mut solver, &mut ap, OptState::new(), observer)?;
-    let (fc, gc) = counts(&ap);
     let p = solver
         .current
         .clone()
         .ok_or_else(|| Error::numerical("optimize::sqp", "no iteration was run"))?;
-    let vars = problem.variables();
-    let active_side = vars
-        .iter()
-        .zip(&p.x)
-        .filter(|(v, &x)| v.period.is_none() && (x <= v.lower || x >= v.upper))
-        .count();
-    let active =
-        p.g.iter()
-            .filter(|&&g| g >= -options.tolerances.active)
-            .count();
-    Ok(LocalOutcome {
-        x: p.x,
-        f: p.f,
-        g: p.g,
-        iterations: solver.iteration,
-        function_calls: fc,
-        gradient_calls: gc,
-        active_constraints: active,
-        active_side_constraints: active_side,
-        termination: solver.termination.unwrap_or(Termination::MaxIterations),
-    })
+    Ok(driver::local_outcome(
+        &ap,
+        (p.x, p.f, p.g),
+        -options.tolerances.active,
+        solver.iteration,
+        solver.termination,
+    ))
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::optimize::testproblems::{self, Analytic};
-use crate::optimize::NoObserver;
+use crate::optimize::{NoObserver, Variable};
 
 /// HS 22: `f = (x1 − 2)² + (x2 − 1)²`, `x1 + x2 <= 2`, `x1² <= x2`;
 /// optimum (1, 1), f* = 1 (HS 22), both constraints active.
