@@ -6,7 +6,10 @@
 
 use crate::error::Result;
 use crate::explore::{self, DriveFlags};
-use crate::study::Study;
+use crate::study::keys::{self, KeyProbe};
+use crate::study::{Study, StudyMeta};
+use serde::de::DeserializeOwned;
+use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 /// A resolved run: the study and the common options of the command line.
@@ -50,6 +53,10 @@ pub fn max_threads(cores: usize) -> usize {
 pub struct Section {
     /// The table's name in study files.
     pub key: &'static str,
+    /// Record the keys the section accepts (its serde type, probed by
+    /// [`keys::probe`]): the key reference of the docs is checked against
+    /// these.
+    pub keys: fn(&KeyProbe, &str),
     /// Read the section into its typed form and check it as far as that
     /// needs no computation (unknown keys, wrong types, bad values).
     pub check: fn(&Study) -> Result<()>,
@@ -61,10 +68,11 @@ pub struct Section {
     pub uses_problem: bool,
 }
 
-/// A section that holds data for others, checked by them.
-const fn data(key: &'static str) -> Section {
+/// A section that holds data for others, checked by them, read into `T`.
+const fn data<T: DeserializeOwned>(key: &'static str) -> Section {
     Section {
         key,
+        keys: keys::probe::<T>,
         check: |_| Ok(()),
         run: None,
         uses_problem: false,
@@ -77,18 +85,21 @@ const fn data(key: &'static str) -> Section {
 pub static SECTIONS: &[Section] = &[
     Section {
         key: "modes",
+        keys: keys::probe::<super::modes::ModesSpec>,
         check: |s| super::modes::check(s).map(|_| ()),
         run: Some(run_modes),
         uses_problem: false,
     },
     Section {
         key: "scene",
+        keys: keys::probe::<crate::scene::spec::SceneSpec>,
         check: |s| crate::scene::ScenePlan::new(s).map(|_| ()),
         run: Some(run_scene),
         uses_problem: false,
     },
     Section {
         key: "multistart",
+        keys: keys::probe::<explore::MultistartSection>,
         check: |s| explore::multistart_section(s).map(|_| ()),
         // Under [compare] the multistart runs as part of the comparison,
         // under [scaling] once per thread count.
@@ -102,6 +113,7 @@ pub static SECTIONS: &[Section] = &[
     },
     Section {
         key: "evolve",
+        keys: keys::probe::<explore::EvolveSection>,
         check: |s| explore::evolve_plan(s).map(|_| ()),
         // Under [compare] the evolution runs as part of the comparison.
         run: Some(|cfg| {
@@ -114,12 +126,14 @@ pub static SECTIONS: &[Section] = &[
     },
     Section {
         key: "compare",
+        keys: keys::probe::<explore::CompareSection>,
         check: |s| explore::compare_section(s).map(|_| ()),
         run: Some(|cfg| explore::run_compare(&cfg.explore(DriveFlags::default())).map(|_| ())),
         uses_problem: true,
     },
     Section {
         key: "scaling",
+        keys: keys::probe::<explore::multistart::scaling::ScalingSection>,
         check: |s| explore::multistart::scaling::check(s).map(|_| ()),
         run: Some(|cfg| {
             explore::multistart::scaling::run_scaling(&cfg.explore(DriveFlags::default()))
@@ -129,6 +143,7 @@ pub static SECTIONS: &[Section] = &[
     },
     Section {
         key: "discrete",
+        keys: keys::probe::<explore::discrete::DiscreteSection>,
         check: explore::discrete::command::check,
         run: Some(|cfg| {
             explore::discrete::command::run_discrete(&cfg.explore(DriveFlags::default()))
@@ -138,30 +153,35 @@ pub static SECTIONS: &[Section] = &[
     },
     Section {
         key: "map",
+        keys: keys::probe::<explore::MapSection>,
         check: |s| explore::map_section(s).map(|_| ()),
         run: Some(|cfg| explore::run_map(&cfg.explore(DriveFlags::default())).map(|_| ())),
         uses_problem: true,
     },
     Section {
         key: "front",
+        keys: keys::probe::<explore::front::command::FrontSection>,
         check: |s| explore::front::command::check(s).map(|_| ()),
         run: Some(run_front),
         uses_problem: false,
     },
     Section {
         key: "kernel_bench",
+        keys: keys::probe::<super::kernel_bench::BenchSpec>,
         check: |s| super::kernel_bench::check(s).map(|_| ()),
         run: Some(|c| super::kernel_bench::run_kernel_bench(&c.study, &c.out, c.quiet).map(|_| ())),
         uses_problem: false,
     },
     Section {
         key: "events_bench",
+        keys: keys::probe::<super::events_bench::EventsSpec>,
         check: |s| super::events_bench::check(s).map(|_| ()),
         run: Some(|c| super::events_bench::run_events_bench(&c.study, &c.out, c.quiet).map(|_| ())),
         uses_problem: false,
     },
     Section {
         key: "scene_convergence",
+        keys: keys::probe::<super::scene_convergence::ConvergenceSpec>,
         check: |s| super::scene_convergence::check(s).map(|_| ()),
         run: Some(|c| {
             super::scene_convergence::run_scene_convergence(&c.study, &c.out, c.quiet).map(|_| ())
@@ -170,6 +190,7 @@ pub static SECTIONS: &[Section] = &[
     },
     Section {
         key: "eval_bench",
+        keys: keys::probe::<super::eval_bench::EvalBenchSpec>,
         check: |s| super::eval_bench::check(s).map(|_| ()),
         run: Some(|c| {
             super::eval_bench::run_eval_bench_section(&c.study, &c.out, c.quiet).map(|_| ())
@@ -178,6 +199,7 @@ pub static SECTIONS: &[Section] = &[
     },
     Section {
         key: "gradient_check",
+        keys: keys::probe::<super::gradient_check::GradientCheckSpec>,
         check: |s| super::gradient_check::check(s).map(|_| ()),
         run: Some(|c| {
             super::gradient_check::run_gradient_check(&c.study, &c.out, c.quiet).map(|_| ())
@@ -186,6 +208,7 @@ pub static SECTIONS: &[Section] = &[
     },
     Section {
         key: "sens_bench",
+        keys: keys::probe::<super::sens_bench::SensBenchSpec>,
         check: |s| super::sens_bench::check(s).map(|_| ()),
         run: Some(|c| {
             super::sens_bench::run_sens_bench_section(&c.study, &c.out, c.quiet).map(|_| ())
@@ -194,6 +217,7 @@ pub static SECTIONS: &[Section] = &[
     },
     Section {
         key: "support_compare",
+        keys: keys::probe::<super::support_compare::CompareSpec>,
         check: |s| super::support_compare::check(s).map(|_| ()),
         run: Some(|c| {
             super::support_compare::run_support_compare(&c.study, &c.out, c.quiet).map(|_| ())
@@ -203,24 +227,38 @@ pub static SECTIONS: &[Section] = &[
     // Data: the drivers' problem (checked through `uses_problem`), the
     // panels and their convergence grid (read by [modes] and scenes), the
     // scene problem's design (read with [problem] name = "scene").
-    data("problem"),
-    data("panels"),
-    data("convergence"),
-    data("scene_problem"),
+    data::<explore::problem::problems::ProblemSpec>("problem"),
+    data::<Vec<crate::fe::spec::PanelSpec>>("panels"),
+    data::<super::modes::ConvergenceSpec>("convergence"),
+    data::<explore::problem::scene_problem::SceneProblemSpec>("scene_problem"),
     // Read and written by the multistart.
     Section {
         key: "robustness",
+        keys: keys::probe::<explore::multistart::robustness::RobustnessSection>,
         check: |s| explore::multistart::robustness::section(s).map(|_| ()),
         run: None,
         uses_problem: true,
     },
     Section {
-        key: explore::multistart::optimum_report::KEY,
+        key: "optimum_report",
+        keys: keys::probe::<explore::multistart::optimum_report::OptimumReportSection>,
         check: |s| explore::multistart::optimum_report::check(s).map(|_| ()),
         run: None,
         uses_problem: true,
     },
 ];
+
+/// Every key a study file accepts, as dotted paths (`scene.bodies.name`),
+/// and the top-level tables: `[study]` and every section of [`SECTIONS`],
+/// probed through their serde types.
+pub fn accepted_keys() -> (BTreeSet<String>, BTreeSet<String>) {
+    let probe = KeyProbe::default();
+    keys::probe::<StudyMeta>(&probe, "study");
+    for s in SECTIONS {
+        (s.keys)(&probe, s.key);
+    }
+    probe.into_keys()
+}
 
 /// The section called `key`, if there is one.
 pub fn section(key: &str) -> Option<&'static Section> {

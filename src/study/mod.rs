@@ -9,6 +9,7 @@
 //!
 //! Every error names the file, the key, the value and what was expected.
 
+pub mod keys;
 pub mod memory;
 pub mod toml_value;
 

@@ -5,6 +5,7 @@ mod common;
 mod docs_reference;
 mod docs_validation;
 mod explore;
+mod extension_points;
 mod fe;
 mod golden;
 mod integrate;
