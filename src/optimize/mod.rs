@@ -162,6 +162,17 @@ pub trait Problem: Sync {
     fn last_evaluated(&self) -> Option<Vec<f64>> {
         None
     }
+    /// The relative integration tolerance of a problem whose evaluation
+    /// integrates a motion (`None`: a closed form, exact to rounding).
+    fn tolerance(&self) -> Option<f64> {
+        None
+    }
+    /// Integrate at the relative tolerance `rtol` from now on, the
+    /// absolute tolerance following at the problem's own ratio atol/rtol;
+    /// `false` (and nothing changed) for a problem that integrates nothing.
+    fn set_tolerance(&mut self, _rtol: f64) -> bool {
+        false
+    }
 }
 
 /// Counts every evaluation of the wrapped problem, as DOT (the paper's

@@ -72,13 +72,21 @@ impl Noise {
 /// ECNoise on the values `f_i = f(x + i h p)`, `i = 0..m` (m + 1 >= 4
 /// values; Moré and Wild use 7–9).
 pub fn ecnoise(values: &[f64]) -> Noise {
+    ecnoise_scaled(values, 0.0)
+}
+
+/// [`ecnoise`] with the "h too large" spread test relative to
+/// `max(|f|, scale)` instead of `|f|`: a constraint is compared with the
+/// feasibility tolerance in absolute terms and is near 0 where it matters,
+/// so its values' spread is judged against `scale` = 1.
+pub fn ecnoise_scaled(values: &[f64], scale: f64) -> Noise {
     let nf = values.len();
     let (lo, hi) = values
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    if nf < 4 || (hi - lo) > 0.1 * hi.abs().max(lo.abs()) {
+    if nf < 4 || (hi - lo) > 0.1 * hi.abs().max(lo.abs()).max(scale) {
         return Noise::StepTooLarge;
     }
     let mut table = values.to_vec();
@@ -117,18 +125,18 @@ pub fn ecnoise(values: &[f64]) -> Noise {
     Noise::StepTooLarge
 }
 
-/// The noise of f and of every constraint of `problem` at `x`, from
-/// `points` function-only evaluations at `x + i h p` (`i = 0..points`),
-/// with `p` a unit direction in the range-scaled variables and `h` the
-/// scaled step (a step of 1 spans a variable's range). Returns the
-/// estimate for f first, then one per constraint.
-pub fn measure(
+/// The difference table's values: `points` function-only evaluations of
+/// `problem` at `x + i h p` (`i = 0..points`), with `p` a direction in the
+/// range-scaled variables and `h` the scaled step (a step of 1 spans a
+/// variable's range). One column per function: f first, then each
+/// constraint.
+pub fn table(
     problem: &dyn Problem,
     x: &[f64],
     direction: &[f64],
     h: f64,
     points: usize,
-) -> Result<Vec<Noise>> {
+) -> Result<Vec<Vec<f64>>> {
     let vars = problem.variables();
     if x.len() != vars.len() || direction.len() != vars.len() {
         return Err(Error::input(
@@ -189,7 +197,196 @@ pub fn measure(
             c.push(*g);
         }
     }
-    Ok(columns.iter().map(|c| ecnoise(c)).collect())
+    Ok(columns)
+}
+
+/// The noise of f and of every constraint of `problem` at `x` from one
+/// table ([`table`]): the estimate for f first, then one per constraint.
+pub fn measure(
+    problem: &dyn Problem,
+    x: &[f64],
+    direction: &[f64],
+    h: f64,
+    points: usize,
+) -> Result<Vec<Noise>> {
+    let columns = table(problem, x, direction, h, points)?;
+    Ok(columns
+        .iter()
+        .enumerate()
+        .map(|(k, c)| ecnoise_scaled(c, if k == 0 { 0.0 } else { 1.0 }))
+        .collect())
+}
+
+/// How [`estimate`] measures: the table's size, its first step and how
+/// often the step may be changed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NoiseOptions {
+    /// Evaluations per table (at least 4; Moré and Wild use 7–9; default 8).
+    pub points: usize,
+    /// The first scaled step h (a step of 1 spans a variable's range;
+    /// default 1e-4, 0.018° on a 180° ply angle: wide enough to cross the
+    /// changes of an adaptive step sequence, narrow against the
+    /// curvature).
+    pub step: f64,
+    /// Further tables after a failed one, each with the step changed by
+    /// Moré and Wild's factor 100 (up for "h too small", down for "h too
+    /// large"; default 2).
+    pub retries: usize,
+}
+
+impl Default for NoiseOptions {
+    fn default() -> Self {
+        NoiseOptions {
+            points: 8,
+            step: 1e-4,
+            retries: 2,
+        }
+    }
+}
+
+/// The noise of f and of every constraint at one design.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measured {
+    /// The design \[variables' units\].
+    pub x: Vec<f64>,
+    /// f at the design.
+    pub f: f64,
+    /// The constraints at the design.
+    pub g: Vec<f64>,
+    /// The estimate for f.
+    pub noise_f: Noise,
+    /// The estimate for each constraint.
+    pub noise_g: Vec<Noise>,
+    /// The scaled step of each table evaluated, in order.
+    pub steps: Vec<f64>,
+    /// Function-only evaluations spent.
+    pub evaluations: usize,
+    /// The first-order level σ_1 = sqrt(½ mean (Δf)²) of f in the table
+    /// with the smallest step: noise and trend together, an upper bound.
+    pub first_order_f: f64,
+}
+
+/// A unit direction in the range-scaled variables, drawn from `seed`
+/// (components uniform in [−1, 1], normalized; Moré and Wild take a random
+/// direction so that no coordinate is favoured).
+pub fn direction(n: usize, seed: u64) -> Vec<f64> {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut p: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..=1.0)).collect();
+    let norm = p.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if norm > 0.0 {
+        p.iter_mut().for_each(|v| *v /= norm);
+    } else if let Some(v) = p.first_mut() {
+        *v = 1.0;
+    }
+    p
+}
+
+/// ECNoise at `x` along the direction drawn from `seed` (f judged by
+/// Moré and Wild's spread test, the constraints by [`ecnoise_scaled`]
+/// with scale 1), with retries:
+/// a table of `options.points` evaluations at the step `options.step`;
+/// while f's estimate fails, another table with the step multiplied by 100
+/// ("h too small") or divided by 100 ("h too large"), at most
+/// `options.retries` more. Each function keeps the first level any table
+/// gave it, else the failure of the last table. Each component of the
+/// direction of a bounded variable points to the farther bound (the table
+/// runs into the box, not out of it).
+pub fn estimate(
+    problem: &dyn Problem,
+    x: &[f64],
+    seed: u64,
+    options: &NoiseOptions,
+) -> Result<Measured> {
+    let vars = problem.variables();
+    let mut p = direction(vars.len(), seed);
+    for ((pk, v), &xk) in p.iter_mut().zip(vars).zip(x) {
+        let (up, down) = (v.upper - xk, xk - v.lower);
+        if v.period.is_none() && ((*pk > 0.0 && up < down) || (*pk < 0.0 && down < up)) {
+            *pk = -*pk;
+        }
+    }
+    let n = 1 + problem.n_constraints();
+    let mut found: Vec<Option<Noise>> = vec![None; n];
+    let mut last = vec![Noise::StepTooLarge; n];
+    let (mut steps, mut evaluations) = (Vec::new(), 0);
+    let (mut f0, mut g0) = (f64::NAN, Vec::new());
+    let (mut h, mut first_order_f, mut narrowest) = (options.step, f64::NAN, f64::INFINITY);
+    for _ in 0..=options.retries {
+        let columns = table(problem, x, &p, h, options.points)?;
+        evaluations += options.points;
+        steps.push(h);
+        if f0.is_nan() {
+            f0 = columns[0][0];
+            g0 = columns[1..].iter().map(|c| c[0]).collect();
+        }
+        if h < narrowest {
+            narrowest = h;
+            first_order_f = first_order(&columns[0]);
+        }
+        for (k, c) in columns.iter().enumerate() {
+            last[k] = ecnoise_scaled(c, if k == 0 { 0.0 } else { 1.0 });
+            if found[k].is_none() && last[k].sigma().is_some() {
+                found[k] = Some(last[k]);
+            }
+        }
+        h *= match found[0].unwrap_or(last[0]) {
+            Noise::Level { .. } => break,
+            Noise::StepTooSmall => 100.0,
+            Noise::StepTooLarge => 0.01,
+        };
+    }
+    let pick = |k: usize| found[k].unwrap_or(last[k]);
+    Ok(Measured {
+        x: x.to_vec(),
+        f: f0,
+        g: g0,
+        noise_f: pick(0),
+        noise_g: (1..n).map(pick).collect(),
+        steps,
+        evaluations,
+        first_order_f,
+    })
+}
+
+/// σ_1 = sqrt(½ mean (Δf)²) of one column.
+fn first_order(values: &[f64]) -> f64 {
+    let d: Vec<f64> = values.windows(2).map(|w| w[1] - w[0]).collect();
+    (0.5 * d.iter().map(|v| v * v).sum::<f64>() / d.len().max(1) as f64).sqrt()
+}
+
+impl Measured {
+    /// σ_f relative to `max(|f|, tiny)`, when measured.
+    pub fn relative_f(&self) -> Option<f64> {
+        self.noise_f
+            .sigma()
+            .map(|s| s / self.f.abs().max(f64::MIN_POSITIVE))
+    }
+
+    /// The largest σ of the constraints (absolute: constraints are
+    /// normalized), when every one was measured; `None` without
+    /// constraints or when one failed.
+    pub fn max_g(&self) -> Option<f64> {
+        let sigmas: Option<Vec<f64>> = self.noise_g.iter().map(|n| n.sigma()).collect();
+        sigmas.and_then(|s| s.into_iter().reduce(f64::max))
+    }
+
+    /// The rise of f that a stop among designs within the noise tolerates,
+    /// relative to `max(|f|, 1)`: 3σ_f (the difference of two values with
+    /// noise σ has the deviation √2σ, and stays within 3σ ≈ 2.1·√2σ about
+    /// 96 % of the time for Gaussian noise). Where f is smooth at every
+    /// step tried ("h too small"), nothing is tolerated; where no step
+    /// resolved the noise ("h too large"), the first-order level of the
+    /// narrowest table is the bound (it holds the trend as well as the
+    /// noise, so it errs high).
+    pub fn allowance(&self) -> f64 {
+        let scale = self.f.abs().max(1.0);
+        match self.noise_f {
+            Noise::Level { sigma, .. } => 3.0 * sigma / scale,
+            Noise::StepTooSmall => 0.0,
+            Noise::StepTooLarge => self.first_order_f / scale,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -264,6 +461,81 @@ mod tests {
                 assert!((sigma - 2f64.sqrt() * c).abs() < 1e-6 * c, "{sigma}");
             }
             other => panic!("{other:?}"),
+        }
+    }
+
+    /// A piecewise constant f: a smooth part plus a value drawn afresh in
+    /// each cell of width `cell` (the way an adaptive integrator's result
+    /// jumps where its step sequence changes), and a smooth constraint.
+    struct Jumpy {
+        vars: Vec<crate::optimize::Variable>,
+        cell: f64,
+        amplitude: f64,
+    }
+
+    impl Problem for Jumpy {
+        fn variables(&self) -> &[crate::optimize::Variable] {
+            &self.vars
+        }
+        fn n_constraints(&self) -> usize {
+            1
+        }
+        fn evaluate(&self, x: &[f64], _: bool) -> Result<crate::optimize::Evaluation> {
+            let cell = (x[0] / self.cell).floor() as i64 as u64;
+            let u = uniform(cell.wrapping_mul(2654435761).wrapping_add(17), 1)[0];
+            Ok(crate::optimize::Evaluation {
+                f: 1.0 + self.amplitude * u,
+                g: vec![x[0] - 0.9],
+                grad_f: None,
+                grad_g: None,
+            })
+        }
+    }
+
+    /// Inside one cell the values do not change ("h too small"); the
+    /// retry with a step 100 times larger puts every point in a cell of
+    /// its own and recovers σ = a/√12 within a factor 3. The linear
+    /// constraint's only noise is rounding: its level is that of
+    /// `f64::EPSILON` times its size.
+    #[test]
+    fn estimate_widens_the_step_until_the_noise_shows() {
+        let problem = Jumpy {
+            vars: vec![crate::optimize::Variable::bounded("x", 0.0, 1.0).unwrap()],
+            cell: 1e-3,
+            amplitude: 1e-6,
+        };
+        let sigma = 1e-6 / 12f64.sqrt();
+        let options = NoiseOptions {
+            points: 8,
+            step: 1e-5,
+            retries: 2,
+        };
+        let m = estimate(&problem, &[0.3], 7, &options).unwrap();
+        assert_eq!(m.steps, vec![1e-5, 1e-3]);
+        assert_eq!(m.evaluations, 16);
+        let est = m.noise_f.sigma().expect("a level");
+        assert!(est > sigma / 3.0 && est < 3.0 * sigma, "{est}");
+        let g_sigma = m.noise_g[0].sigma().expect("a level");
+        assert!(g_sigma < 4.0 * f64::EPSILON, "{:?}", m.noise_g);
+        assert!((m.allowance() - 3.0 * est / m.f.abs().max(1.0)).abs() < 1e-18);
+        assert_eq!(m.relative_f(), Some(est / m.f));
+    }
+
+    /// The direction is a unit vector, the same for the same seed; at
+    /// either bound the table runs into the box.
+    #[test]
+    fn the_direction_is_seeded_and_stays_inside_the_bounds() {
+        let p = direction(3, 11);
+        assert_eq!(p, direction(3, 11));
+        assert!((p.iter().map(|v| v * v).sum::<f64>() - 1.0).abs() < 1e-15);
+        let problem = Jumpy {
+            vars: vec![crate::optimize::Variable::bounded("x", 0.0, 1.0).unwrap()],
+            cell: 1e-3,
+            amplitude: 1e-6,
+        };
+        for x in [1e-9, 1.0 - 1e-9] {
+            let m = estimate(&problem, &[x], 3, &NoiseOptions::default()).unwrap();
+            assert!(m.evaluations >= 8);
         }
     }
 }

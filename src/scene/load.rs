@@ -102,6 +102,13 @@ impl ScenePlan {
         self.spec.integrator.method = method;
     }
 
+    /// Integrate with the tolerances `rtol` and `atol` from now on
+    /// (overrides `[scene.integrator]`).
+    pub fn set_tolerances(&mut self, rtol: f64, atol: f64) {
+        self.spec.integrator.rtol = rtol;
+        self.spec.integrator.atol = atol;
+    }
+
     /// Integrate forward sensitivities in `form` from now on (overrides
     /// `[scene.integrator] sensitivity_form`).
     pub fn set_sensitivity_form(&mut self, form: SensitivityForm) {

@@ -31,6 +31,7 @@ pub mod events_bench;
 pub mod gradient_check;
 pub mod kernel_bench;
 pub mod modes;
+pub mod noise;
 pub mod registry;
 pub mod scene_convergence;
 pub mod sens_bench;

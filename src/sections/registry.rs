@@ -224,6 +224,13 @@ pub static SECTIONS: &[Section] = &[
         }),
         uses_problem: false,
     },
+    Section {
+        key: "noise",
+        keys: keys::probe::<super::noise::NoiseSpec>,
+        check: |s| super::noise::check(s).map(|_| ()),
+        run: Some(|c| super::noise::run_noise(&c.study, &c.out, c.quiet).map(|_| ())),
+        uses_problem: true,
+    },
     // Data: the drivers' problem (checked through `uses_problem`), the
     // panels and their convergence grid (read by [modes] and scenes), the
     // scene problem's design (read with [problem] name = "scene").

@@ -102,7 +102,9 @@ pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
     let budget = ms.function_calls + plan.starts.filter_evaluations;
     let evs = run_evolve(ctx, Some(budget))?;
     let dir = ctx.dir()?;
-    let policy = plan.section.end_policy();
+    let policy = plan
+        .section
+        .end_policy(ms.noise.unwrap_or(settle::DEFAULT_NOISE));
     let tolerance = policy.tolerances.feasibility;
     let base = ComparisonRow {
         method: format!("multistart-{}", plan.section.method.name()),

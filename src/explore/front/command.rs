@@ -313,6 +313,7 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
             tolerances,
             polish: true,
             rescue: true,
+            noise: crate::explore::local::settle::DEFAULT_NOISE,
         },
         anchor_starts: section.anchor_starts,
         seed: study.meta.seed,

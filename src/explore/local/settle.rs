@@ -17,7 +17,8 @@
 //!    violation cannot leave it, which is the answer for that start.
 //!    The polish's result replaces the solver's unless it is worse
 //!    (feasible before and not after, or higher f at equal feasibility by
-//!    more than the polish's noise allowance, 1e-6 of `max(|f|, 1)`).
+//!    more than the noise allowance [`EndPolicy::noise`] of
+//!    `max(|f|, 1)`).
 //! 3. When the end is still infeasible and the rescue is on
 //!    (`[multistart] rescue`, default true): the pure descent on the
 //!    violation from the run's start ([`violation::descend`], the
@@ -50,6 +51,11 @@ use crate::optimize::{
     Counted, IterRecord, LocalOutcome, NoObserver, Observer, Problem, Termination,
 };
 
+/// The noise allowance of runs that do not measure their noise
+/// (`[multistart] noise` not `"measured"`): 1e-6 of `max(|f|, 1)`, about
+/// 3σ of the SAR evaluation at rtol 1e-6 (σ = 2.8e-7 of f, `[noise]`).
+pub const DEFAULT_NOISE: f64 = 1e-6;
+
 /// What happens at the end of every local run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EndPolicy {
@@ -61,6 +67,12 @@ pub struct EndPolicy {
     /// Rescue infeasible ends by the pure descent on the violation from
     /// the run's start (`[multistart] rescue`; step 3 of the module doc).
     pub rescue: bool,
+    /// The rise of f, relative to `max(|f|, 1)`, that designs within the
+    /// evaluation's noise may show: the polish's slope search tolerates it,
+    /// and the polish's end replaces the solver's unless it is higher by
+    /// more (`[multistart] noise`: measured by ECNoise, see
+    /// [`crate::optimize::noise::Measured::allowance`], or given).
+    pub noise: f64,
 }
 
 /// A settled run end.
@@ -379,7 +391,10 @@ fn settle_end(
         gradient_calls: calls.1,
         last: outcome.iterations,
     };
-    let options = MmfdOptions::polish_for(tol);
+    let options = MmfdOptions {
+        noise: policy.noise,
+        ..MmfdOptions::polish_for(tol)
+    };
     let polished = LocalSolver::minimize(&options, &counted, &outcome.x, &mut continued);
     let last = continued.last;
     let polished = polished.and_then(|p| {
@@ -500,6 +515,7 @@ mod tests {
             tolerances: KktTolerances::default(),
             polish,
             rescue: false,
+            noise: 1e-6,
         }
     }
 

@@ -3,14 +3,16 @@
 //! printed, the manifest entry, and the `[optimum_report]` of the first
 //! start when the study asks for it.
 
-use super::section::{multistart_plan, MultistartPlan};
+use super::section::{multistart_plan, MultistartPlan, NoiseAllowance};
 use super::{driver, optimum_report, robustness};
 use crate::error::{Error, Result};
 use crate::explore::context::Context;
+use crate::explore::local::settle::DEFAULT_NOISE;
 use crate::explore::local::{solvers, violation};
 use crate::explore::persist::fingerprint;
-use crate::explore::persist::manifest::{MultistartCounts, MultistartEntry};
+use crate::explore::persist::manifest::{MultistartCounts, MultistartEntry, NoiseRecord};
 use crate::explore::problem::build::problem;
+use crate::optimize::noise::{estimate, Measured, NoiseOptions};
 use crate::optimize::Problem;
 use std::path::{Path, PathBuf};
 
@@ -48,6 +50,7 @@ pub fn multistart_with(
         section.preset,
         section.feasibility_tolerance,
     )?;
+    let noise = noise_allowance(ctx, problem, plan)?;
     let report_plan = optimum_report::prepare(ctx, problem, plan)?;
     let settings = driver::Settings {
         threads: ctx.threads,
@@ -58,7 +61,7 @@ pub fn multistart_with(
         shard: ctx.flags.shard,
         quiet: ctx.quiet,
         history_start: report_plan.as_ref().map(|_| optimum_report::REPORTED_START),
-        end: section.end_policy(),
+        end: section.end_policy(noise.0),
     };
     let report = driver::run(
         problem,
@@ -82,6 +85,8 @@ pub fn multistart_with(
             classes: report.classes,
             feasibility_tolerance: section.feasibility_tolerance,
             violation_checks: checks,
+            rtol: problem.tolerance(),
+            noise: noise.1.as_ref().map(NoiseRecord::of),
         }),
     };
     ctx.manifest(&dir, "multistart", done)?;
@@ -94,6 +99,34 @@ pub fn multistart_with(
         p.finish(ctx, &dir, problem, plan, &report)?;
     }
     Ok(report)
+}
+
+/// `[multistart] noise`: the allowance given, or ECNoise's at the first
+/// start (3σ of f; [`crate::optimize::noise::Measured::allowance`]) with
+/// the measurement.
+fn noise_allowance(
+    ctx: &Context,
+    problem: &dyn Problem,
+    plan: &MultistartPlan,
+) -> Result<(f64, Option<Measured>)> {
+    let x0 = match (plan.section.noise, plan.starts.points.first()) {
+        (NoiseAllowance::Given(v), _) => return Ok((v, None)),
+        (NoiseAllowance::Measured(_), None) => return Ok((DEFAULT_NOISE, None)),
+        (NoiseAllowance::Measured(_), Some(x0)) => x0,
+    };
+    let m = estimate(problem, x0, ctx.study.meta.seed, &NoiseOptions::default())?;
+    if !ctx.quiet {
+        let level = match m.relative_f() {
+            Some(r) => format!("{r:.2e} of f"),
+            None => format!("not measured ({})", m.noise_f.failure().unwrap_or("")),
+        };
+        println!(
+            "  noise at the first start: {level}; allowance {:.2e} ({} function calls)",
+            m.allowance(),
+            m.evaluations
+        );
+    }
+    Ok((m.allowance(), Some(m)))
 }
 
 /// `[multistart] violation_checks`: the pure descent on the violation from

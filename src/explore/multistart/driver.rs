@@ -79,6 +79,10 @@ pub struct Report {
     /// The iteration records of [`Settings::history_start`], with their
     /// wall times, when that start ran in this invocation.
     pub history: Option<TimedHistory>,
+    /// The noise allowance the runs' ends were settled with (set by the
+    /// multistart command; `None` where a report is read back, as by
+    /// `merge`).
+    pub noise: Option<f64>,
 }
 
 impl Report {
@@ -354,6 +358,7 @@ pub fn run(
     Ok(Report {
         new_runs,
         history,
+        noise: Some(settings.end.noise),
         ..report
     })
 }
@@ -401,6 +406,7 @@ pub fn finish(
         wall_seconds,
         new_runs: 0,
         history: None,
+        noise: None,
     })
 }
 
@@ -497,6 +503,7 @@ mod tests {
             tolerances: Default::default(),
             polish: true,
             rescue: true,
+            noise: 1e-6,
         };
         let row = one_run(&p, fails, &end, 3, &[0.0, 1.0], &mut NoObserver);
         assert!(row.result.is_none() && row.exit.contains("singular"));

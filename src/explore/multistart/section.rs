@@ -10,6 +10,7 @@
 use super::cluster::Tolerances;
 use super::sampling::{self, Sampler};
 use crate::error::{Error, Result};
+use crate::explore::local::settle::DEFAULT_NOISE;
 use crate::explore::local::solvers::{LocalMethod, MmfdPreset, MmfdSettings};
 use crate::optimize::Problem;
 use crate::study::Study;
@@ -89,6 +90,37 @@ pub struct MultistartSection {
     /// MMFD convergence settings (`[multistart.mmfd]`; over the preset).
     #[serde(default)]
     pub mmfd: MmfdSettings,
+    /// The rise of f, relative to `max(|f|, 1)`, that the polish tolerates
+    /// among designs within the evaluation's noise: a number, or
+    /// `"measured"` (ECNoise at the first start before the runs, 8
+    /// function calls or more: 3σ of f; `crate::optimize::noise`).
+    /// Default [`DEFAULT_NOISE`].
+    #[serde(default)]
+    pub noise: NoiseAllowance,
+}
+
+/// `[multistart] noise`: given, or measured before the runs.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum NoiseAllowance {
+    /// A relative allowance.
+    Given(f64),
+    /// Measured by ECNoise at the first start.
+    Measured(Measure),
+}
+
+/// The word `measured`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub enum Measure {
+    /// `"measured"`.
+    #[serde(rename = "measured")]
+    Measured,
+}
+
+impl Default for NoiseAllowance {
+    fn default() -> Self {
+        NoiseAllowance::Given(DEFAULT_NOISE)
+    }
 }
 
 impl MultistartSection {
@@ -101,12 +133,14 @@ impl MultistartSection {
         }
     }
 
-    /// What happens at every run's end.
-    pub fn end_policy(&self) -> crate::explore::local::settle::EndPolicy {
+    /// What happens at every run's end, with the noise allowance `noise`
+    /// (given, or measured by the command).
+    pub fn end_policy(&self, noise: f64) -> crate::explore::local::settle::EndPolicy {
         crate::explore::local::settle::EndPolicy {
             tolerances: self.kkt_tolerances(),
             polish: self.polish,
             rescue: self.rescue,
+            noise,
         }
     }
 }
@@ -163,6 +197,15 @@ pub fn multistart_section(study: &Study) -> Result<MultistartSection> {
             s.feasibility_tolerance,
             "a finite value >= 0",
         )));
+    }
+    if let NoiseAllowance::Given(v) = s.noise {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(loc(Error::input(
+                "noise",
+                v,
+                "a finite relative allowance >= 0, or \"measured\"",
+            )));
+        }
     }
     if let Some(w) = s.max_wall_seconds {
         crate::error::require_positive("max_wall_seconds", w).map_err(&loc)?;

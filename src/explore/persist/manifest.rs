@@ -63,6 +63,51 @@ pub struct MultistartCounts {
     /// many of those descents reached the feasible set.
     #[serde(default)]
     pub violation_checks: (usize, usize),
+    /// The integration tolerance of a scene problem's evaluations (absent
+    /// for a closed-form problem).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtol: Option<f64>,
+    /// The noise measured at the first start (`[multistart] noise =
+    /// "measured"`; absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<NoiseRecord>,
+}
+
+/// The noise of the evaluation measured at one design (ECNoise,
+/// [`crate::optimize::noise`]); a failed estimate is its reason, with σ
+/// absent.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NoiseRecord {
+    /// The design.
+    pub x: Vec<f64>,
+    /// σ of f (absent when the estimate failed).
+    pub sigma_f: Option<f64>,
+    /// σ of f relative to |f|.
+    pub relative_f: Option<f64>,
+    /// `level`, `h_too_small` or `h_too_large`.
+    pub status_f: String,
+    /// σ of each constraint (absent where its estimate failed).
+    pub sigma_g: Vec<Option<f64>>,
+    /// The allowance the runs' ends were settled with (relative to
+    /// `max(|f|, 1)`).
+    pub allowance: f64,
+    /// Function calls spent on the measurement.
+    pub evaluations: usize,
+}
+
+impl NoiseRecord {
+    /// The record of `m`.
+    pub fn of(m: &crate::optimize::noise::Measured) -> NoiseRecord {
+        NoiseRecord {
+            x: m.x.clone(),
+            sigma_f: m.noise_f.sigma(),
+            relative_f: m.relative_f(),
+            status_f: m.noise_f.failure().unwrap_or("level").into(),
+            sigma_g: m.noise_g.iter().map(|n| n.sigma()).collect(),
+            allowance: m.allowance(),
+            evaluations: m.evaluations,
+        }
+    }
 }
 
 /// `evolve`: the budget and TolFun, and the schedules.
@@ -238,6 +283,16 @@ mod tests {
                     },
                     feasibility_tolerance: 1e-6,
                     violation_checks: (8, 1),
+                    rtol: Some(1e-7),
+                    noise: Some(NoiseRecord {
+                        x: vec![55.0, -55.0],
+                        sigma_f: None,
+                        relative_f: None,
+                        status_f: "h_too_large".into(),
+                        sigma_g: vec![Some(2e-8)],
+                        allowance: 3e-8,
+                        evaluations: 24,
+                    }),
                 }),
             },
         };

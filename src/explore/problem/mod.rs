@@ -17,6 +17,7 @@
 //!   with [`build::problem`] and `plyscape run` checks it with
 //!   [`build::check_problem`] before any section runs.
 
+pub mod accuracy;
 pub mod build;
 pub mod problems;
 pub mod scene_bounds;

@@ -68,6 +68,7 @@
 //! written as given, and `x` and `x + 180°` give the same laminate up to
 //! the rounding of the rotation's sines and cosines.
 
+use super::accuracy::{self, Choice, RtolSetting};
 use super::scene_bounds::{self, Bound};
 pub use super::scene_vars::VariableSpec;
 use super::scene_vars::{problem_error, Ties};
@@ -103,6 +104,11 @@ pub struct SceneProblemSpec {
     /// `false`: one lane per body and design variable, summed afterwards.
     #[serde(default = "yes")]
     pub tied_lanes: bool,
+    /// The integration tolerance of the evaluations: a number (over
+    /// `[scene.integrator] rtol`, atol following at the scene's ratio) or
+    /// `"auto"`, the loosest whose measured noise sits a decade below the
+    /// feasibility tolerance ([`super::accuracy`]). Default: the scene's.
+    pub rtol: Option<RtolSetting>,
 }
 
 fn yes() -> bool {
@@ -138,6 +144,11 @@ pub struct SceneProblem {
     start: Vec<f64>,
     /// The study's name, for reports.
     study: String,
+    /// The study's own (rtol, atol): [`Problem::set_tolerance`] keeps
+    /// their ratio.
+    study_tolerances: (f64, f64),
+    /// What `rtol = "auto"` measured and chose.
+    choice: Option<Choice>,
 }
 
 /// Raw response values (and their gradients per degree of each variable).
@@ -198,8 +209,32 @@ impl SceneProblem {
             units: Vec::new(),
             start: spec.start.clone(),
             study: study.name(),
+            study_tolerances: (0.0, 0.0),
+            choice: None,
         };
+        problem.study_tolerances = problem.tolerances();
         problem.set_references(study, &spec)?;
+        match spec.rtol {
+            None => {}
+            Some(RtolSetting::Given(r)) => {
+                problem.set_tolerance(r);
+            }
+            Some(RtolSetting::Auto(_)) => {
+                // τ of the study: [multistart]'s, read raw (the problem
+                // sits below the drivers), else the drivers' default.
+                let feasibility = study
+                    .table
+                    .get("multistart")
+                    .and_then(|m| m.get("feasibility_tolerance"))
+                    .and_then(|v| v.as_float())
+                    .unwrap_or(1e-6);
+                let start = problem.start.clone();
+                let choice = accuracy::choose(&mut problem, &start, feasibility, study.meta.seed)
+                    .map_err(study.locate("scene_problem.rtol"))?;
+                eprintln!("note: {}", choice.summary());
+                problem.choice = Some(choice);
+            }
+        }
         Ok(problem)
     }
 
@@ -216,6 +251,15 @@ impl SceneProblem {
             "the scene problem (variables, start, objective)",
         )?;
         let plan = ScenePlan::new(study)?;
+        if let Some(RtolSetting::Given(r)) = spec.rtol {
+            if !(r.is_finite() && r > 0.0 && r <= 1e-2) {
+                return Err(study.error(
+                    "scene_problem.rtol",
+                    r,
+                    "a tolerance with 0 < rtol <= 1e-2, or \"auto\"",
+                ));
+            }
+        }
         let ties = Ties::resolve(study, &spec.variables, spec.tied_lanes, &plan)?;
         check_objective_and_constraints(study, &spec, &plan, &ties.vars)?;
         Ok((spec, plan, ties))
@@ -263,6 +307,25 @@ impl SceneProblem {
     /// Integrate with `method` from now on (overrides the scene's).
     pub fn set_method(&mut self, method: crate::integrate::Method) {
         self.plan.set_method(method);
+    }
+
+    /// Integrate with the tolerances `rtol` and `atol` from now on
+    /// (overrides `[scene.integrator]`; the constraint bounds and the
+    /// objective's divisor stay those of the study's own tolerances: the
+    /// problem is the same, evaluated more or less accurately).
+    pub fn set_tolerances(&mut self, rtol: f64, atol: f64) {
+        self.plan.set_tolerances(rtol, atol);
+    }
+
+    /// What `rtol = "auto"` measured and chose (`None` without it).
+    pub fn accuracy_choice(&self) -> Option<&Choice> {
+        self.choice.as_ref()
+    }
+
+    /// The relative and absolute tolerances the evaluations use.
+    pub fn tolerances(&self) -> (f64, f64) {
+        let i = &self.plan.spec().integrator;
+        (i.rtol, i.atol)
     }
 
     /// The integration method the evaluations use.
@@ -592,6 +655,18 @@ impl Problem for SceneProblem {
     }
     fn name(&self) -> &str {
         &self.study
+    }
+    fn tolerance(&self) -> Option<f64> {
+        Some(self.tolerances().0)
+    }
+    /// rtol as given, atol at the study's own ratio atol/rtol (a fixed
+    /// atol floors the accuracy: on the SAR scene atol 1e-8 keeps the
+    /// noise of f near 4e-7 of f at any rtol, `[noise]`).
+    fn set_tolerance(&mut self, rtol: f64) -> bool {
+        let (r0, a0) = self.study_tolerances;
+        let atol = if rtol == r0 { a0 } else { a0 * (rtol / r0) };
+        self.set_tolerances(rtol, atol);
+        true
     }
     /// Ply angles in degrees (`theta1_deg` is `θ1 [deg]`), ply
     /// thicknesses in millimetres, scene parameters in SI units
