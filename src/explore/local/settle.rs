@@ -34,6 +34,13 @@
 //!    with the rescue every run reaches the feasible set wherever the pure
 //!    descent from its start does. The descent's calls count with the run.
 //!
+//! 4. [`return_to_best`]: when the run visited a feasible design lower
+//!    than its settled end by more than the noise allowance
+//!    ([`EndPolicy::noise`]), or its end is infeasible while it visited a
+//!    feasible design, it returns to the lowest feasible design it
+//!    visited ([`BestFeasible`] keeps it from the run's records), certified
+//!    there.
+//!
 //! Every evaluation goes through the caller's problem, so a counting
 //! wrapper counts the certificate and the polish with the run.
 //!
@@ -88,18 +95,113 @@ pub struct Settled {
     /// What the rescue did (step 3 of the module doc); `None` when it did
     /// not run.
     pub rescue: Option<Rescue>,
+    /// Step 4: the run went back to the lowest feasible design it visited;
+    /// the f (and feasibility) of the end it left.
+    pub returned: Option<Left>,
+}
+
+/// The end a run left for the lowest feasible design it visited (step 4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Left {
+    /// f at the end left.
+    pub f: f64,
+    /// `max_j g_j` at the end left.
+    pub max_g: f64,
 }
 
 impl Settled {
     /// The `polish` column of `runs.csv`: the polish's text, then the
-    /// rescue's after `; ` (empty when neither ran).
+    /// rescue's and step 4's after `; ` (empty when none ran).
     pub fn note(&self) -> String {
-        let polish = self.polish.text();
-        match &self.rescue {
-            None => polish,
-            Some(r) if polish.is_empty() => r.text(),
-            Some(r) => format!("{polish}; {}", r.text()),
+        let mut parts = vec![self.polish.text()];
+        parts.extend(self.rescue.as_ref().map(Rescue::text));
+        parts.extend(self.returned.map(|l| {
+            format!(
+                "returned to the lowest feasible design visited (the end left: f = {}, max g = {:.3e})",
+                l.f, l.max_g
+            )
+        }));
+        parts.retain(|p| !p.is_empty());
+        parts.join("; ")
+    }
+}
+
+/// Passes every record on and keeps the lowest feasible one
+/// (`max g <= tol`, finite f): what step 4 returns to.
+pub struct BestFeasible<'a> {
+    inner: &'a mut dyn Observer,
+    tol: f64,
+    /// The lowest feasible record so far.
+    pub best: Option<IterRecord>,
+}
+
+impl<'a> BestFeasible<'a> {
+    /// Watch the records passed to `inner` for feasibility within `tol`.
+    pub fn new(inner: &'a mut dyn Observer, tol: f64) -> Self {
+        BestFeasible {
+            inner,
+            tol,
+            best: None,
         }
+    }
+}
+
+impl Observer for BestFeasible<'_> {
+    fn observe(&mut self, r: &IterRecord) {
+        let lower = self.best.as_ref().is_none_or(|b| r.f < b.f);
+        if r.max_g <= self.tol && r.f.is_finite() && lower {
+            self.best = Some(r.clone());
+        }
+        self.inner.observe(r);
+    }
+}
+
+/// Step 4 of the module doc: a run never ends above a feasible design it
+/// visited by more than the noise. When `best` (the lowest feasible record
+/// of the run) lies lower than the settled end by more than
+/// `policy.noise · max(|f|, 1)`, or the end is infeasible, the run returns
+/// to `best`: certified there (one evaluation with gradients, recorded to
+/// `observer` as the run's final check), and taken unless that
+/// certificate fails.
+pub fn return_to_best(
+    problem: &dyn Problem,
+    settled: Settled,
+    best: Option<&IterRecord>,
+    policy: &EndPolicy,
+    observer: &mut dyn Observer,
+) -> Settled {
+    let Some(b) = best else {
+        return settled;
+    };
+    let tol = policy.tolerances.feasibility;
+    let o = &settled.outcome;
+    let max_g = o.g.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let feasible_end = max_g <= tol && o.f.is_finite();
+    if feasible_end && o.f <= b.f + policy.noise * b.f.abs().max(1.0) {
+        return settled;
+    }
+    let counted = Counted::new(problem);
+    let there = LocalOutcome {
+        x: b.x.clone(),
+        f: b.f,
+        g: b.g.clone(),
+        ..o.clone()
+    };
+    let at = (o.function_calls, o.gradient_calls);
+    let Ok((c, calls)) = certify_recorded(&counted, &there, at, &policy.tolerances, observer)
+    else {
+        return settled;
+    };
+    let left = Left { f: o.f, max_g };
+    Settled {
+        outcome: LocalOutcome {
+            function_calls: calls.0,
+            gradient_calls: calls.1,
+            ..there
+        },
+        certificate: Some(c),
+        returned: Some(left),
+        ..settled
     }
 }
 
@@ -360,6 +462,7 @@ fn settle_end(
                 certificate: None,
                 polish: PolishEnd::CertificateFailed(e.to_string()),
                 rescue: None,
+                returned: None,
             }
         }
     };
@@ -381,6 +484,7 @@ fn settle_end(
             certificate: Some(first),
             polish: PolishEnd::NotRun,
             rescue: None,
+            returned: None,
         };
     }
     let before = (counted.function_calls(), counted.gradient_calls());
@@ -414,6 +518,7 @@ fn settle_end(
             return Settled {
                 polish: PolishEnd::Replaced(t),
                 rescue: None,
+                returned: None,
                 outcome: LocalOutcome {
                     function_calls: after.0,
                     gradient_calls: after.1,
@@ -449,6 +554,7 @@ fn settle_end(
         certificate: Some(first),
         polish,
         rescue: None,
+        returned: None,
     }
 }
 
@@ -625,5 +731,73 @@ mod tests {
         assert!(strictly_feasible(&p, &[0.0], &policy(true))
             .unwrap()
             .is_none());
+    }
+
+    /// A record of the run at `x` (feasible where `|x| >= X_STAR`).
+    fn record(p: &dyn Problem, x: f64) -> IterRecord {
+        let e = p.evaluate(&[x], false).unwrap();
+        IterRecord {
+            iteration: 2,
+            x: vec![x],
+            f: e.f,
+            max_g: e.max_g(),
+            g: e.g,
+            ct: None,
+            step: 0.0,
+            function_calls: 5,
+            gradient_calls: 2,
+        }
+    }
+
+    /// Step 4: min x on the islands problem. A run that visited the
+    /// feasible x = −3 (f = −3, the bound optimum) and ended at the
+    /// feasible x = 2.5 returns to −3, certified there (one gradient
+    /// call); an end within the noise allowance of the best is kept; the
+    /// observer keeps the lowest feasible record only.
+    #[test]
+    fn a_run_returns_to_the_lowest_feasible_design_it_visited() {
+        let p = islands();
+        let settled = |x: f64| settle(&p, None, end(&p, x), &policy(false), &mut NoObserver);
+        let best = record(&p, -3.0);
+        let s = return_to_best(
+            &p,
+            settled(2.5),
+            Some(&best),
+            &policy(false),
+            &mut NoObserver,
+        );
+        assert_eq!(s.outcome.x, vec![-3.0]);
+        assert_eq!(s.outcome.f, -3.0);
+        assert_eq!(
+            s.certificate.as_ref().map(|c| c.class),
+            Some(EndClass::Converged)
+        );
+        assert_eq!(s.returned.map(|l| l.f), Some(2.5));
+        assert!(
+            s.note().contains("returned to the lowest feasible design"),
+            "{}",
+            s.note()
+        );
+        assert_eq!(
+            s.outcome.gradient_calls,
+            settled(2.5).outcome.gradient_calls + 1
+        );
+        // Within the noise: x = −3 + 1e-7 against a best 1e-6 · 3 lower.
+        let near = -3.0 + 1e-7;
+        let kept = return_to_best(
+            &p,
+            settled(near),
+            Some(&best),
+            &policy(false),
+            &mut NoObserver,
+        );
+        assert_eq!(kept.outcome.x, vec![near]);
+        assert!(kept.returned.is_none());
+        let mut none = NoObserver;
+        let mut watch = BestFeasible::new(&mut none, 0.0);
+        for x in [2.5, 0.0, -3.0, 2.2] {
+            watch.observe(&record(&p, x));
+        }
+        assert_eq!(watch.best.map(|b| b.x), Some(vec![-3.0]));
     }
 }

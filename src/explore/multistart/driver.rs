@@ -21,7 +21,7 @@
 use super::cluster::{cluster, Optimum, Tolerances};
 use crate::error::{Error, Result};
 pub use crate::explore::context::Shard;
-use crate::explore::local::settle::{settle, EndPolicy};
+use crate::explore::local::settle::{return_to_best, settle, BestFeasible, EndPolicy};
 use crate::explore::local::solvers::LocalSolver;
 use crate::explore::persist::tables::{
     num, read_runs, write_atomic, ClassCounts, RunRecord, RunResult, RunsAppender,
@@ -120,9 +120,12 @@ pub fn one_run(
     // A panic inside one run (a solver bug) becomes that run's error
     // instead of ending a long campaign.
     let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        solver
-            .minimize(&counted, x0, observer)
-            .map(|o| settle(&counted, Some(x0), o, end, observer))
+        let mut watch = BestFeasible::new(observer, end.tolerances.feasibility);
+        let settled = solver
+            .minimize(&counted, x0, &mut watch)
+            .map(|o| settle(&counted, Some(x0), o, end, &mut watch));
+        let best = watch.best.take();
+        settled.map(|s| return_to_best(&counted, s, best.as_ref(), end, observer))
     }))
     .unwrap_or_else(|p| {
         let msg = p
