@@ -2,7 +2,7 @@
 //!
 //! [`probe`] lists every key of a section as dotted paths
 //! (`scene.bodies.flexible.kind`) by running the section's `Deserialize`
-//! implementation against a recording deserializer ([`Rec`]) instead of a
+//! implementation against a recording deserializer (`Rec`) instead of a
 //! TOML document: a struct reports its field names (`deserialize_struct`'s
 //! `FIELDS`) and the recorder then feeds every field a value of whatever
 //! shape the field asks for, so nested tables and arrays of tables are
