@@ -200,21 +200,15 @@ pub fn table(
     Ok(columns)
 }
 
-/// The noise of f and of every constraint of `problem` at `x` from one
-/// table ([`table`]): the estimate for f first, then one per constraint.
-pub fn measure(
-    problem: &dyn Problem,
-    x: &[f64],
-    direction: &[f64],
-    h: f64,
-    points: usize,
-) -> Result<Vec<Noise>> {
-    let columns = table(problem, x, direction, h, points)?;
-    Ok(columns
-        .iter()
-        .enumerate()
-        .map(|(k, c)| ecnoise_scaled(c, if k == 0 { 0.0 } else { 1.0 }))
-        .collect())
+/// The scale of the "h too large" spread test for column `k` of a
+/// [`table`]: 0 for f (Moré and Wild's test relative to |f|), 1 for a
+/// constraint ([`ecnoise_scaled`]).
+fn spread_scale(k: usize) -> f64 {
+    if k == 0 {
+        0.0
+    } else {
+        1.0
+    }
 }
 
 /// How [`estimate`] measures: the table's size, its first step and how
@@ -325,7 +319,7 @@ pub fn estimate(
             first_order_f = first_order(&columns[0]);
         }
         for (k, c) in columns.iter().enumerate() {
-            last[k] = ecnoise_scaled(c, if k == 0 { 0.0 } else { 1.0 });
+            last[k] = ecnoise_scaled(c, spread_scale(k));
             if found[k].is_none() && last[k].sigma().is_some() {
                 found[k] = Some(last[k]);
             }

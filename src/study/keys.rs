@@ -13,7 +13,7 @@
 //! accept: the tag (`missing_field`), the variants (`unknown_variant`) and
 //! each variant's fields (`unknown_field`, since the enum denies unknown
 //! fields). A value that fails (a custom `Deserialize` refusing the
-//! recorder's placeholder) is left out on the next pass; the passes repeat
+//! recorder's stand-in value) is left out on the next pass; the passes repeat
 //! until nothing new is learnt.
 //!
 //! The section registry (`sections::registry::SECTIONS`) gives each
