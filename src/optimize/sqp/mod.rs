@@ -32,7 +32,16 @@
 //!    `B ← B − B s sᵀB / sᵀBs + r rᵀ / sᵀr`. The start model `σ I` has
 //!    `σ = |∇f| / first_step` (the first unconstrained step moves
 //!    `first_step` of the ranges); before the first update it is rescaled
-//!    to `yᵀy / sᵀy` (Shanno–Phua).
+//!    to `yᵀy / sᵀy` (Shanno–Phua). Before each update the model is
+//!    self-scaled (Oren–Luenberger): when `0 < sᵀy < sᵀBs`, `B ← τ B`
+//!    with `τ = sᵀy / sᵀBs`, so the damping acts only where `sᵀy <= 0`.
+//!    Without it a model that learned a steep curvature early (HS 100's
+//!    `10 x₅⁶` from a start at `x₅ = −6`) stays steep in every other
+//!    direction, each update can flatten it by at most 5× along its step,
+//!    and the run creeps with steps growing 1.5–2× an iteration: on HS 100
+//!    from 16 Latin-hypercube starts (`studies/hs100_multistart.toml`)
+//!    1433 function calls without the scaling, 482 with it (scipy's
+//!    SLSQP: 719 from the same starts).
 //!
 //! A line search that finds no decrease restarts the model; a second one
 //! in a row ends the run (`line_search_failed`). Counting follows
@@ -40,7 +49,8 @@
 //! before is a gradient call only.
 //!
 //! References: Powell, *A fast algorithm for nonlinearly constrained
-//! optimization calculations* (1978); Nocedal & Wright, *Numerical
+//! optimization calculations* (1978); Oren & Luenberger, *Self-scaling
+//! variable metric (SSVM) algorithms* (Management Science 20, 1974); Nocedal & Wright, *Numerical
 //! Optimization* (2006), §18.3 (damped BFGS, Procedure 18.2) and §18.5
 //! (ℓ1 merit function, eq. 18.29); Kraft, *A software package for
 //! sequential quadratic programming* (DFVLR-FB 88-28, 1988), the SLSQP
@@ -441,10 +451,18 @@ impl Sqp {
         }
         self.b_fresh = false;
         let sv = nalgebra::DVector::from_column_slice(&s);
-        let bs = &self.b * &sv;
-        let sbs = sv.dot(&bs);
+        let mut bs = &self.b * &sv;
+        let mut sbs = sv.dot(&bs);
         if sbs.is_nan() || sbs <= 0.0 || !sy.is_finite() {
             return;
+        }
+        // Self-scaling (Oren–Luenberger): a model steeper along s than the
+        // measured curvature is shrunk as a whole first.
+        if sy > 0.0 && sy < sbs {
+            let tau = sy / sbs;
+            self.b *= tau;
+            bs *= tau;
+            sbs = sy;
         }
         let theta = if sy >= 0.2 * sbs {
             1.0
