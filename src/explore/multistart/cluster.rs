@@ -54,6 +54,9 @@ pub struct Optimum {
     pub mean_function_calls: f64,
     /// Mean gradient calls of the runs that reached it.
     pub mean_gradient_calls: f64,
+    /// The noise of f and g measured at `x` (`[multistart] noise =
+    /// "measured"`; `None` otherwise).
+    pub noise: Option<crate::optimize::noise::Measured>,
 }
 
 /// Largest periodic-aware coordinate distance between `a` and `b`, each
@@ -128,6 +131,7 @@ pub fn cluster(vars: &[Variable], runs: &mut [RunRecord], tol: Tolerances) -> Ve
                     .map(|&i| runs[i].gradient_calls as f64)
                     .sum::<f64>()
                     / n,
+                noise: None,
             }
         })
         .collect();

@@ -63,13 +63,16 @@ pub fn multistart_with(
         history_start: report_plan.as_ref().map(|_| optimum_report::REPORTED_START),
         end: section.end_policy(noise.0),
     };
-    let report = driver::run(
+    let mut report = driver::run(
         problem,
         solver.as_ref(),
         &plan.starts.points,
         &settings,
         &dir,
     )?;
+    if noise.1.is_some() {
+        noise_at_optima(ctx, problem, &mut report, &dir)?;
+    }
     let checks = violation_checks(ctx, problem, &report, section.violation_checks, &dir)?;
     let mine = (0..plan.starts.points.len())
         .filter(|&k| ctx.flags.shard.owns(k))
@@ -127,6 +130,45 @@ fn noise_allowance(
         );
     }
     Ok((m.allowance(), Some(m)))
+}
+
+/// With `[multistart] noise = "measured"`: ECNoise at every certified
+/// optimum (the same options and seed as at the first start), written to
+/// `optima.csv`'s noise columns ([`driver::NOISE_COLUMNS`]) and printed.
+fn noise_at_optima(
+    ctx: &Context,
+    problem: &dyn Problem,
+    report: &mut driver::Report,
+    dir: &Path,
+) -> Result<()> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(ctx.threads)
+        .build()
+        .map_err(|e| Error::input("threads", ctx.threads, format!("a usable count ({e})")))?;
+    let seed = ctx.study.meta.seed;
+    let measured: Vec<Measured> = pool.install(|| {
+        use rayon::prelude::*;
+        report
+            .optima
+            .par_iter()
+            .map(|o| estimate(problem, &o.x, seed, &NoiseOptions::default()))
+            .collect::<Result<_>>()
+    })?;
+    for (o, m) in report.optima.iter_mut().zip(measured) {
+        if !ctx.quiet {
+            let level = match m.relative_f() {
+                Some(r) => format!("{r:.2e} of f"),
+                None => format!("not measured ({})", m.noise_f.failure().unwrap_or("")),
+            };
+            println!("  noise at optimum {}: {level}", o.id);
+        }
+        o.noise = Some(m);
+    }
+    let (vars, m) = (problem.variables(), problem.n_constraints());
+    crate::explore::persist::tables::write_atomic(
+        &dir.join("optima.csv"),
+        &driver::optima_table(vars, m, &report.optima),
+    )
 }
 
 /// `[multistart] violation_checks`: the pure descent on the violation from

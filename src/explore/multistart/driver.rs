@@ -124,8 +124,8 @@ pub fn one_run(
         let settled = solver
             .minimize(&counted, x0, &mut watch)
             .map(|o| settle(&counted, Some(x0), o, end, &mut watch));
-        let best = watch.best.take();
-        settled.map(|s| return_to_best(&counted, s, best.as_ref(), end, observer))
+        let visited = std::mem::take(&mut watch.visited);
+        settled.map(|s| return_to_best(&counted, s, &visited, end, observer))
     }))
     .unwrap_or_else(|p| {
         let msg = p
@@ -447,7 +447,51 @@ pub fn optima_table(vars: &[Variable], m: usize, optima: &[Optimum]) -> Vec<Vec<
         r.push(num(o.mean_gradient_calls));
         rows.push(r);
     }
+    if optima.iter().any(|o| o.noise.is_some()) {
+        rows[0].extend(NOISE_COLUMNS.map(String::from));
+        for (row, o) in rows[1..].iter_mut().zip(optima) {
+            row.extend(noise_fields(o.noise.as_ref()));
+        }
+    }
     rows
+}
+
+/// The columns `optima.csv` has when the noise was measured at each
+/// optimum (`[multistart] noise = "measured"`): σ of f, σ_f / max(|f|, 1),
+/// the largest σ of the constraints (absolute: they are normalized), what
+/// failed (`""` when every estimate succeeded; else `f: h_too_small`,
+/// `g2: h_too_large`, …) and the function calls spent.
+pub const NOISE_COLUMNS: [&str; 5] = [
+    "noise_f",
+    "noise_f_relative",
+    "noise_max_g",
+    "noise_failed",
+    "noise_evaluations",
+];
+
+/// The [`NOISE_COLUMNS`] fields of one optimum (empty without a
+/// measurement; a failed estimate is its reason, never a number).
+fn noise_fields(m: Option<&crate::optimize::noise::Measured>) -> Vec<String> {
+    let Some(m) = m else {
+        return vec![String::new(); NOISE_COLUMNS.len()];
+    };
+    let opt = |v: Option<f64>| v.map(num).unwrap_or_default();
+    let failed: Vec<String> = std::iter::once(("f".to_string(), m.noise_f))
+        .chain(
+            m.noise_g
+                .iter()
+                .enumerate()
+                .map(|(j, n)| (format!("g{}", j + 1), *n)),
+        )
+        .filter_map(|(name, n)| n.failure().map(|w| format!("{name}: {w}")))
+        .collect();
+    vec![
+        opt(m.noise_f.sigma()),
+        opt(m.noise_f.sigma().map(|s| s / m.f.abs().max(1.0))),
+        opt(m.max_g()),
+        failed.join("; "),
+        m.evaluations.to_string(),
+    ]
 }
 
 /// `run_classes.csv`: one row per class (`converged`, `stopped`,

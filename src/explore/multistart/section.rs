@@ -93,8 +93,9 @@ pub struct MultistartSection {
     /// The rise of f, relative to `max(|f|, 1)`, that the polish tolerates
     /// among designs within the evaluation's noise: a number, or
     /// `"measured"` (ECNoise at the first start before the runs, 8
-    /// function calls or more: 3σ of f; `crate::optimize::noise`).
-    /// Default [`DEFAULT_NOISE`].
+    /// function calls or more: 3σ of f; `crate::optimize::noise`), which
+    /// also measures it at every certified optimum (`optima.csv`'s
+    /// `noise_*` columns). Default [`DEFAULT_NOISE`].
     #[serde(default)]
     pub noise: NoiseAllowance,
 }

@@ -26,6 +26,11 @@
 //! On the SAR problem (`studies/sar_accuracy.toml`, feasibility 1e-6) the
 //! scene's rtol 1e-6 gives σ_f = 4.2e-7 of f and is refused; rtol 1e-7
 //! gives 1.9e-8 and 1.8e-8 for g and is taken.
+//!
+//! The measurement is deterministic (a seeded direction, deterministic
+//! evaluations), so a process that builds the same study's problem again
+//! (`plyscape run`: the multistart, the optimum report, the map) reuses
+//! the first choice ([`remembered`]) instead of measuring it again.
 
 use crate::error::Result;
 use crate::optimize::noise::{estimate, Measured, Noise, NoiseOptions};
@@ -98,6 +103,24 @@ impl Choice {
             self.target,
             self.evaluations()
         )
+    }
+}
+
+/// The choices made in this process, by the full text of their study.
+static CHOICES: std::sync::Mutex<Vec<(String, Choice)>> = std::sync::Mutex::new(Vec::new());
+
+/// The choice made earlier in this process for the study whose full text
+/// (every table, as TOML) is `key`.
+pub fn remembered(key: &str) -> Option<Choice> {
+    let memo = CHOICES.lock().unwrap_or_else(|p| p.into_inner());
+    memo.iter().find(|(k, _)| k == key).map(|(_, c)| c.clone())
+}
+
+/// Keep `choice` for later builds of the study with text `key`.
+pub fn remember(key: String, choice: &Choice) {
+    let mut memo = CHOICES.lock().unwrap_or_else(|p| p.into_inner());
+    if !memo.iter().any(|(k, _)| *k == key) {
+        memo.push((key, choice.clone()));
     }
 }
 

@@ -228,10 +228,22 @@ impl SceneProblem {
                     .and_then(|m| m.get("feasibility_tolerance"))
                     .and_then(|v| v.as_float())
                     .unwrap_or(1e-6);
-                let start = problem.start.clone();
-                let choice = accuracy::choose(&mut problem, &start, feasibility, study.meta.seed)
-                    .map_err(study.locate("scene_problem.rtol"))?;
-                eprintln!("note: {}", choice.summary());
+                let key = toml::to_string(&study.table).unwrap_or_default();
+                let choice = match accuracy::remembered(&key) {
+                    Some(c) => {
+                        problem.set_tolerance(c.rtol);
+                        c
+                    }
+                    None => {
+                        let start = problem.start.clone();
+                        let c =
+                            accuracy::choose(&mut problem, &start, feasibility, study.meta.seed)
+                                .map_err(study.locate("scene_problem.rtol"))?;
+                        eprintln!("note: {}", c.summary());
+                        accuracy::remember(key, &c);
+                        c
+                    }
+                };
                 problem.choice = Some(choice);
             }
         }
