@@ -206,23 +206,9 @@ impl BasisBuilder {
         self.analysis.set_thickness_groups(&groups)
     }
 
-    /// The distinct mesh nodes at the joint points, in the order first met.
+    /// The distinct mesh nodes at the joint points ([`mesh_joint_nodes`]).
     fn joint_nodes(&self) -> Vec<usize> {
-        let nodes = &self.analysis.panel.mesh.nodes;
-        let at = |k: usize| Vector3::new(nodes[k][0], nodes[k][1], 0.0);
-        let size = (0..nodes.len()).fold(1e-3f64, |m, k| m.max(at(k).norm()));
-        let mut out = Vec::new();
-        for p in &self.points {
-            let near = (0..nodes.len())
-                .map(|k| (k, (at(k) - p).norm()))
-                .min_by(|a, b| a.1.total_cmp(&b.1));
-            if let Some((k, d)) = near {
-                if d <= 1e-6 * size && !out.contains(&k) {
-                    out.push(k);
-                }
-            }
-        }
-        out
+        mesh_joint_nodes(&self.analysis.panel.mesh, &self.points)
     }
 
     /// The basis of the panel with lay-up `laminate` (same ply count as the
@@ -376,6 +362,28 @@ impl BasisBuilder {
         }
         Ok(NodeMasses { mass, inertia })
     }
+}
+
+/// The distinct nodes of `mesh` at the panel-frame points `points`, in
+/// the order first met: each point's nearest node, if it lies within
+/// `1e-6` of the panel's size (the largest node distance from the
+/// centre, at least 1 mm); farther points are skipped.
+pub(crate) fn mesh_joint_nodes(mesh: &crate::fe::Mesh, points: &[Vector3<f64>]) -> Vec<usize> {
+    let nodes = &mesh.nodes;
+    let at = |k: usize| Vector3::new(nodes[k][0], nodes[k][1], 0.0);
+    let size = (0..nodes.len()).fold(1e-3f64, |m, k| m.max(at(k).norm()));
+    let mut out = Vec::new();
+    for p in points {
+        let near = (0..nodes.len())
+            .map(|k| (k, (at(k) - p).norm()))
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((k, d)) = near {
+            if d <= 1e-6 * size && !out.contains(&k) {
+                out.push(k);
+            }
+        }
+    }
+    out
 }
 
 /// The 0-based plies of a thickness variable's name `thickness_<plies>`

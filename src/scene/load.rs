@@ -12,34 +12,42 @@
 //! [`crate::laminate::Laminate::with_design`]), never as text. Builders
 //! are pooled, so one plan serves parallel evaluations: each evaluation
 //! takes a builder from the pool (or makes one when all are busy) and
-//! gives it back.
+//! gives it back. Within one build, bodies whose bases have the same
+//! content (mesh, support, lay-up at the design, modes, derivatives, ...)
+//! share one computation ([`crate::panels::shared`]).
 
 use super::build::Scene;
 use super::parts::Stiffening;
-use super::spec::{FlexKind, OutputSpec, SceneSpec};
+use super::spec::{Effect, FlexKind, OutputSpec, SceneSpec};
 use crate::error::{Error, Result};
 use crate::fe::Panel;
 use crate::integrate::SensitivityForm;
 use crate::laminate::Laminate;
 use crate::mbs::ModalBasis;
 use crate::modal::ModeUpdate;
+use crate::panels::shared::{BasisKey, SharedBases};
 use crate::panels::BasisBuilder;
 use crate::study::Study;
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::sync::Mutex;
 use std::time::Instant;
 
 /// What one [`ScenePlan::build_profiled`] computed: panel bases (and how
-/// many with mode derivatives), and the wall time spent in them and in the
-/// whole build.
+/// many with mode derivatives), the bases shared instead of computed, and
+/// the wall time spent in them and in the whole build.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct BuildProfile {
     /// Panel modal bases computed.
     pub bases: usize,
     /// Of those, bases with mode derivatives (dΛ/dθ, dX/dθ).
     pub derivative_bases: usize,
+    /// Panel bodies that got a copy of a basis computed for another body
+    /// of the same build with the same content
+    /// ([`crate::panels::shared`]), not counted in `bases`.
+    pub shared_bases: usize,
     /// Wall time in the panel bases \[s\] (assembly, factorization,
-    /// Lanczos, derivatives, basis conversion).
+    /// Lanczos, derivatives, basis conversion, and the copies and
+    /// content comparisons of shared bases).
     pub bases_seconds: f64,
     /// Wall time of the whole build \[s\] (bases included).
     pub total_seconds: f64,
@@ -202,14 +210,37 @@ impl ScenePlan {
         }
         spec.prune_derivatives();
         let profile = Cell::new(BuildProfile::default());
+        let uses = self.panel_uses(&spec);
+        let shared = RefCell::new(SharedBases::new(&self.panels, laminates, &uses));
         let bases =
             |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: Stiffening| {
                 let t = Instant::now();
                 let thickness = spec.thickness_variables(name);
-                let basis = self.basis(name, modes, (update, geometric), (laminates, &thickness));
+                let key = (self.panels.iter())
+                    .position(|p| p.name == name)
+                    .filter(|&i| shared.borrow().shareable(i))
+                    .map(|i| {
+                        let input = (&self.panels[i], &laminates[i]);
+                        BasisKey::new(input, modes, update, geometric, &thickness)
+                    });
+                let found = key.as_ref().and_then(|k| shared.borrow().find(k).cloned());
                 let mut p = profile.get();
-                p.bases += 1;
-                p.derivative_bases += usize::from(update.is_some());
+                let basis = match found {
+                    Some(b) => {
+                        p.shared_bases += 1;
+                        Ok(b)
+                    }
+                    None => {
+                        let basis =
+                            self.basis(name, modes, (update, geometric), (laminates, &thickness));
+                        p.bases += 1;
+                        p.derivative_bases += usize::from(update.is_some());
+                        if let (Some(k), Ok(b)) = (key, &basis) {
+                            shared.borrow_mut().keep(k, b);
+                        }
+                        basis
+                    }
+                };
                 p.bases_seconds += t.elapsed().as_secs_f64();
                 profile.set(p);
                 basis
@@ -220,6 +251,26 @@ impl ScenePlan {
         let mut p = profile.get();
         p.total_seconds = t0.elapsed().as_secs_f64();
         Ok((scene, p))
+    }
+
+    /// How many flexible bodies of `spec` take their basis from each
+    /// `[[panels]]` entry (none when the scene runs without
+    /// `flexibility`).
+    fn panel_uses(&self, spec: &SceneSpec) -> Vec<usize> {
+        let mut uses = vec![0; self.panels.len()];
+        if !spec.has(Effect::Flexibility) {
+            return uses;
+        }
+        let panel_names = spec.bodies.iter().filter_map(|b| {
+            let f = b.flexible.as_ref()?;
+            (f.kind == FlexKind::Panel).then_some(f.panel.as_deref()?)
+        });
+        for name in panel_names {
+            if let Some(i) = self.panels.iter().position(|p| p.name == name) {
+                uses[i] += 1;
+            }
+        }
+        uses
     }
 
     /// The basis of panel `name` with lay-up `laminates[i]`, from a pooled

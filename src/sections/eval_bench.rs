@@ -15,14 +15,16 @@
 //! fast spells paired out, which the ratio of the two medians is not on a
 //! machine whose speed drifts. Reported per case, medians
 //! over the repeats, one thread: the panel bases computed (and how many
-//! with mode derivatives) and their time, the rest of the scene build, the
-//! integration (states and, for `f+g`, the sensitivity lanes), the output
-//! and response evaluation, the total (with the smallest and largest
-//! total of the repeats: the spread a single timing carries on that
-//! machine), the integrator's steps,
-//! right-hand-side calls and Jacobian-vector products (for fused
-//! sensitivities: multi-lane dual evaluations) and the integration time
-//! per right-hand-side call. Wall times are what a user waits; `cpu [ms]`
+//! with mode derivatives), the bodies that got a copy of another body's
+//! basis of the same content instead (`shared_bases`,
+//! [`crate::panels::shared`]) and the time of both, the rest of the
+//! scene build, the integration (states and, for `f+g`, the sensitivity
+//! lanes), the output and response evaluation, the total (with the
+//! smallest and largest total of the repeats: the spread a single timing
+//! carries on that machine), the integrator's steps, right-hand-side
+//! calls and Jacobian-vector products (for fused sensitivities:
+//! multi-lane dual evaluations) and the integration time per
+//! right-hand-side call. Wall times are what a user waits; `cpu [ms]`
 //! is the evaluating thread's own CPU time (Linux; empty elsewhere), which
 //! stays close to the wall time on an idle machine and keeps measuring
 //! the work when other processes share the cores (`load_1min`, read at
@@ -68,7 +70,7 @@ pub struct EvalBenchSpec {
 }
 
 /// Column headers of `eval_bench.csv`.
-pub const HEADERS: [&str; 23] = [
+pub const HEADERS: [&str; 24] = [
     "problem",
     "method",
     "design [deg]",
@@ -77,6 +79,7 @@ pub const HEADERS: [&str; 23] = [
     "lanes",
     "bases",
     "derivative_bases",
+    "shared_bases",
     "bases [ms]",
     "build_other [ms]",
     "integrate [ms]",
@@ -130,6 +133,7 @@ fn row(
         p.lanes.to_string(),
         p.build.bases.to_string(),
         p.build.derivative_bases.to_string(),
+        p.build.shared_bases.to_string(),
         ms(&|r| r.build.bases_seconds),
         ms(&|r| r.build.total_seconds - r.build.bases_seconds),
         ms(&|r| r.integrate_seconds),

@@ -1,4 +1,6 @@
 //! Tests of `plyscape::scene`: study text read into a scene, the input
-//! errors it names (file, key, value, expectation) and the drive laws.
+//! errors it names (file, key, value, expectation), the drive laws and
+//! the panel bases shared by bodies of the same content.
 mod drives;
 mod input;
+mod shared_bases;
