@@ -174,7 +174,7 @@ pub fn table(
         if outside {
             return Err(Error::input(
                 "noise.step",
-                h,
+                format!("{h:?}"),
                 format!(
                     "a step whose {points} points stay inside the bounds (point {i} leaves them)"
                 ),
@@ -183,7 +183,7 @@ pub fn table(
         if y.iter().zip(x).all(|(a, b)| a == b) && i > 0 {
             return Err(Error::input(
                 "noise.step",
-                h,
+                format!("{h:?}"),
                 "a step that moves the design (it underflows against x)",
             ));
         }

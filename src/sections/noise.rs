@@ -127,11 +127,12 @@ pub fn check(study: &Study) -> Result<NoiseSpec> {
     if !(4..=20).contains(&spec.points) {
         return Err(study.error("noise.points", spec.points, "4 <= points <= 20"));
     }
-    if !(spec.step.is_finite() && spec.step > 0.0 && spec.step <= 0.01) {
+    if !(spec.step.is_finite() && (1e-12..=0.01).contains(&spec.step)) {
         return Err(study.error(
             "noise.step",
-            spec.step,
-            "a scaled step with 0 < step <= 0.01 (1 spans a variable's range)",
+            format!("{:?}", spec.step),
+            "a scaled step with 1e-12 <= step <= 0.01 (1 spans a variable's range; \
+             below 1e-12 the points differ by rounding only)",
         ));
     }
     if spec.retries > 4 {
@@ -268,7 +269,8 @@ fn measure_at(
         .iter()
         .enumerate()
         .map(|(i, d)| estimate(problem, d, study.meta.seed.wrapping_add(i as u64), options))
-        .collect::<Result<Vec<_>>>()?;
+        .collect::<Result<Vec<_>>>()
+        .map_err(study.locate(""))?;
     let f_cpu = time(problem, &designs[0], false, spec.timing_repeats)?;
     let fg_cpu = time(problem, &designs[0], true, spec.timing_repeats)?;
     let run = if spec.solve {
@@ -584,6 +586,7 @@ mod tests {
         for (extra, key) in [
             ("points = 3\n", "noise.points"),
             ("step = 0.5\n", "noise.step"),
+            ("step = 1e-300\n", "`noise.step` = 1e-300"),
             ("retries = 9\n", "noise.retries"),
             ("rtol = [1e-6]\n", "noise.rtol"),
             (

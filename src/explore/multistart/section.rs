@@ -102,7 +102,7 @@ pub struct MultistartSection {
 
 /// `[multistart] noise`: given, or measured before the runs.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "a number, or \"measured\"")]
 pub enum NoiseAllowance {
     /// A relative allowance.
     Given(f64),

@@ -39,7 +39,7 @@ use serde::Deserialize;
 
 /// `[scene_problem] rtol`: a tolerance, or `"auto"`.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "a number, or \"auto\"")]
 pub enum RtolSetting {
     /// This relative tolerance (atol at the scene's ratio).
     Given(f64),

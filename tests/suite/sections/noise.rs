@@ -100,3 +100,33 @@ fn auto_tolerance_is_the_loosest_that_meets_the_noise_target() {
     let atol = p.tolerances().1;
     assert!((atol - 1e-8 * choice.rtol).abs() <= 1e-12 * atol, "{atol}");
 }
+
+/// The two words of the accuracy keys: anything else is refused with the
+/// key the user wrote and what it takes (not serde's "untagged enum").
+#[test]
+fn unknown_accuracy_words_name_their_key_and_the_choices() {
+    let tmp = temp_dir("noise-words");
+    let dir = tmp.path().to_path_buf();
+    let text = "[study]\nname = \"hw\"\n[problem]\nname = \"himmelblau\"\n\
+                [multistart]\nstarts = 2\nnoise = \"estimated\"\n";
+    let s = study("hw", text);
+    let e = match explore::run_multistart(&ctx(&s, &dir, 1, DriveFlags::default())) {
+        Ok(_) => panic!("noise = \"estimated\" was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains("multistart.noise") && e.contains("a number, or \"measured\""),
+        "{e}"
+    );
+    let text = STUDY.replace("rtol = \"auto\"", "rtol = \"fast\"");
+    let e = match Study::parse("sar_optimize.toml", &text)
+        .and_then(|s| plyscape::explore::problem::build::problem(&s).map(|_| ()))
+    {
+        Ok(()) => panic!("rtol = \"fast\" was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains("scene_problem.rtol") && e.contains("a number, or \"auto\""),
+        "{e}"
+    );
+}
