@@ -35,11 +35,11 @@ pub(super) fn build_responses(
                 "a unique, non-empty name",
             ));
         }
-        if !r.scale.is_finite() {
+        if !(r.scale.is_finite() && r.scale != 0.0) {
             return Err(Error::input(
                 format!("{key}.scale"),
                 r.scale,
-                "a finite factor",
+                "a finite, nonzero factor (0 makes the response identically 0)",
             ));
         }
         if r.of.is_empty() {

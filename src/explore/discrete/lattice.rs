@@ -42,6 +42,10 @@ fn default_exhaustive_limit() -> usize {
     4096
 }
 
+/// The most values one discrete variable may have (a `step` that would
+/// give more is refused before anything runs).
+pub const MAX_SET_SIZE: usize = 100_000;
+
 /// One discrete variable: exactly one of `values` and `step`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -137,6 +141,28 @@ impl Lattice {
                             key("step"),
                             step,
                             format!("a step in (0, {range}]"),
+                        ));
+                    }
+                    let count = range / step;
+                    if count > MAX_SET_SIZE as f64 {
+                        return Err(Error::input(
+                            key("step"),
+                            format!("{step:?}"),
+                            format!(
+                                "a step giving at most {MAX_SET_SIZE} values ({count:.3e} on \
+                                 a range of {range})"
+                            ),
+                        ));
+                    }
+                    if v.period.is_some() && (count - count.round()).abs() > 1e-9 * count {
+                        return Err(Error::input(
+                            key("step"),
+                            step,
+                            format!(
+                                "a step that divides the period {range} (it fits {count:.4} \
+                                 times: the values would leave a gap of {:.4} at the wrap)",
+                                range - count.floor() * step
+                            ),
                         ));
                     }
                     let slack = 1e-9 * range;
@@ -451,6 +477,10 @@ mod tests {
             (var("x", Some(vec![0.5, 1.5]), None), "values"),
             (var("x", None, Some(2.0)), "step"),
             (var("y", None, Some(0.5)), "name"),
+            // 180/7 is no whole number: a 5° gap at the wrap.
+            (var("t1", None, Some(7.0)), "step"),
+            // 1.8e11 values.
+            (var("t1", None, Some(1e-9)), "step"),
         ];
         for (v, key) in cases {
             let e = Lattice::new(&angles(), &section(vec![v]))

@@ -188,6 +188,18 @@ pub fn check(study: &Study) -> Result<FrontSection> {
             }
         }
     }
+    if let Some(r) = s
+        .reference_relative
+        .as_ref()
+        .filter(|r| r.iter().any(|&v| v <= 0.0))
+    {
+        return Err(study.error(
+            "front.reference_relative",
+            format!("{r:?}"),
+            "positive factors of the start's objectives (a factor <= 0 moves the reference \
+             point to the other side of 0, where it bounds no front: hypervolume 0)",
+        ));
+    }
     if s.reference.is_some() && s.reference_relative.is_some() {
         return Err(study.error(
             "front.reference_relative",

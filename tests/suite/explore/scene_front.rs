@@ -165,4 +165,14 @@ fn scene_front_input_errors_name_the_key() {
         1,
     ));
     assert!(e.contains("front.reference_relative"), "{e}");
+    let e = err(&replace(
+        &text,
+        "reference_relative = [1.2, 1.2]",
+        "reference_relative = [-1.0, 1.2]",
+        1,
+    ));
+    assert!(
+        e.contains("front.reference_relative") && e.contains("positive factors"),
+        "{e}"
+    );
 }

@@ -266,6 +266,12 @@ fn response_keys_are_checked() {
             "responses[5].of",
             "one flexible body",
         ),
+        (
+            "time = 0.237",
+            "time = 0.237\nscale = 0.0",
+            "responses[1].scale",
+            "nonzero",
+        ),
     ] {
         assert!(base.contains(from), "{from}");
         let text = base.replacen(from, to, 1);
