@@ -34,14 +34,22 @@ pub struct DiscreteRow {
 /// Check `[discrete]`: its values, and that a `[multistart]` provides the
 /// continuous optima it rounds.
 pub fn check(study: &Study) -> Result<()> {
-    if discrete::lattice::section(study)?.is_some() && !study.has("multistart") {
+    let Some(section) = discrete::lattice::section(study)? else {
+        return Ok(());
+    };
+    if !study.has("multistart") {
         return Err(study.error(
             "discrete",
             "(table)",
             "a [multistart] too: the gradient route rounds its certified optima",
         ));
     }
-    Ok(())
+    // The sets against the variables (names, bounds, steps), before any
+    // section runs.
+    let vars = crate::explore::problem::build::variables(study)?;
+    Lattice::new(&vars, &section)
+        .map(|_| ())
+        .map_err(study.locate(""))
 }
 
 /// The certified continuous optima of `optima.csv` in `dir`: (id, x).

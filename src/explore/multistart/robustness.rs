@@ -106,6 +106,14 @@ pub fn section(study: &Study) -> Result<Option<RobustnessSection>> {
     if s.samples == 0 {
         return Err(study.error("robustness.samples", 0, "a sample size >= 1"));
     }
+    let n = crate::explore::problem::build::variables(study)?.len();
+    if s.tolerance.len() != n {
+        return Err(study.error(
+            "robustness.tolerance",
+            format!("(array of {})", s.tolerance.len()),
+            format!("{n} tolerances, one per variable"),
+        ));
+    }
     Ok(Some(s))
 }
 

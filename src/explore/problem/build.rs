@@ -5,7 +5,7 @@
 use super::problems;
 use super::scene_problem;
 use crate::error::Result;
-use crate::optimize::Problem;
+use crate::optimize::{Problem, Variable};
 use crate::study::Study;
 
 /// Build the study's `[problem]`.
@@ -36,5 +36,19 @@ pub fn check_problem(study: &Study) -> Result<()> {
         scene_problem::SceneProblem::check(study)
     } else {
         problem(study).map(|_| ())
+    }
+}
+
+/// The study's variables without evaluating anything: a test problem is
+/// built (cheap), a scene problem's `[scene_problem]` only read and
+/// checked. For the checks of sections that depend on the variables
+/// (`[discrete]`, `[robustness]`) before any section runs.
+pub fn variables(study: &Study) -> Result<Vec<Variable>> {
+    let spec: problems::ProblemSpec =
+        study.require_section("problem", "the problem to explore (name = ...)")?;
+    if spec.name == "scene" {
+        scene_problem::SceneProblem::variables_of(study)
+    } else {
+        Ok(problem(study)?.variables().to_vec())
     }
 }

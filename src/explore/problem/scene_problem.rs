@@ -256,6 +256,12 @@ impl SceneProblem {
         Self::checked(study).map(|_| ())
     }
 
+    /// The problem's variables, checked as [`SceneProblem::check`] does,
+    /// without evaluating any design.
+    pub fn variables_of(study: &Study) -> Result<Vec<Variable>> {
+        Self::checked(study).map(|(_, _, ties)| ties.vars)
+    }
+
     /// The parsed and checked spec, the scene plan and the ties.
     fn checked(study: &Study) -> Result<(SceneProblemSpec, ScenePlan, Ties)> {
         let spec: SceneProblemSpec = study.require_section(

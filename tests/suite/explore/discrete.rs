@@ -107,3 +107,49 @@ fn constrained_discrete_designs_are_feasible_and_on_the_set() {
         .to_string();
     assert!(e.contains("[multistart]"), "{e}");
 }
+
+/// Every `[discrete]` set and the `[robustness]` length are checked with
+/// the study, before any section runs (before, only after the whole
+/// multistart): a periodic step that does not divide the period, a step
+/// giving 1.8e11 values, an unknown variable, and a tolerance list of
+/// the wrong length.
+#[test]
+fn discrete_sets_and_robustness_are_checked_before_anything_runs() {
+    let base = "[study]\nname = \"p2\"\n[problem]\nname = \"periodic2\"\n\
+                [multistart]\nstarts = 4\n";
+    let var = |name: &str, step: &str| {
+        format!("[[discrete.variables]]\nname = \"{name}\"\nstep = {step}\n")
+    };
+    for (extra, key, detail) in [
+        (
+            var("theta1_deg", "7.0"),
+            "discrete.variables[0].step",
+            "divides the period",
+        ),
+        (
+            var("theta1_deg", "1e-9"),
+            "discrete.variables[0].step",
+            "at most 100000 values",
+        ),
+        (
+            var("z", "15.0"),
+            "discrete.variables[0].name",
+            "a variable of the problem",
+        ),
+        (
+            "[robustness]\ntolerance = [1.0]\n".to_string(),
+            "robustness.tolerance",
+            "2 tolerances",
+        ),
+    ] {
+        let s = study("p2", &format!("{base}{extra}"));
+        let e = match plyscape::sections::registry::check_study(&s) {
+            Ok(()) => panic!("{extra}: accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(e.contains(key) && e.contains(detail), "{extra}: {e}");
+    }
+    // 15° steps divide the 180° period: accepted.
+    let s = study("p2", &format!("{base}{}", var("theta1_deg", "15.0")));
+    plyscape::sections::registry::check_study(&s).unwrap();
+}
