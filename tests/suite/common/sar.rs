@@ -125,3 +125,42 @@ impl CoarseSar<'_> {
         load_scene(&Study::parse(self.file, &self.text()).unwrap()).unwrap()
     }
 }
+
+/// The two-angle SAR problem's gradients at `x` (`e`, an evaluation with
+/// gradients there) against central differences of `p`'s own `evaluate`
+/// with a step of 0.01°: every component of ∂f and ∂g₁ within 1e-5 of
+/// the largest component of its gradient (dg/dθ1 is far smaller than
+/// dg/dθ2, and the differences carry the integrator's error over h).
+pub fn assert_gradients_match_central_differences(
+    p: &dyn plyscape::optimize::Problem,
+    x: [f64; 2],
+    e: &plyscape::optimize::Evaluation,
+) {
+    let (gf, gg) = (e.grad_f.as_ref().unwrap(), e.grad_g.as_ref().unwrap());
+    let h = 0.01; // degrees
+    let mut fd = [[0.0; 2]; 2];
+    for i in 0..2 {
+        let (mut xp, mut xm) = (x, x);
+        xp[i] += h;
+        xm[i] -= h;
+        let (ep, em) = (
+            p.evaluate(&xp, false).unwrap(),
+            p.evaluate(&xm, false).unwrap(),
+        );
+        fd[0][i] = (ep.f - em.f) / (2.0 * h);
+        fd[1][i] = (ep.g[0] - em.g[0]) / (2.0 * h);
+    }
+    for (k, (an, fd)) in [gf, &gg[0]].into_iter().zip(&fd).enumerate() {
+        let scale = fd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for i in 0..2 {
+            let rel = (an[i] - fd[i]).abs() / scale;
+            println!(
+                "{} d/dx{i}: analytic {:e}, FD {:e}, error {rel:.1e} of the largest component",
+                ["f", "g"][k],
+                an[i],
+                fd[i]
+            );
+            assert!(rel < 1e-5, "{} d/dx{i}: {rel:e}", ["f", "g"][k]);
+        }
+    }
+}

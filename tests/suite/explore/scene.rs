@@ -5,7 +5,7 @@
 //! gradients against central finite differences of its own `evaluate`,
 //! its 180° periodicity, and input errors that name the key.
 
-use crate::common::sar::{coarse_sar, replace};
+use crate::common::sar::{assert_gradients_match_central_differences, coarse_sar, replace};
 use crate::common::temp_dir;
 use plyscape::explore;
 use plyscape::optimize::Problem;
@@ -46,37 +46,7 @@ fn gradients_match_central_differences_of_evaluate() {
         "evaluation with gradients: {:.3} s",
         t.elapsed().as_secs_f64()
     );
-    let (gf, gg) = (e.grad_f.unwrap(), e.grad_g.unwrap());
-    // Relative to the largest component of each gradient: dg/dθ1 is
-    // 70 times smaller than dg/dθ2 here, and central differences carry the
-    // integrator's error (rtol 1e-10 on g ≈ 0.3) divided by h, about 2e-9
-    // per degree, which is 1e-5 of dg/dθ1 itself.
-    let h = 0.01; // degrees
-    let mut fd = [[0.0; 2]; 2];
-    for i in 0..2 {
-        let (mut xp, mut xm) = (x, x);
-        xp[i] += h;
-        xm[i] -= h;
-        let (ep, em) = (
-            p.evaluate(&xp, false).unwrap(),
-            p.evaluate(&xm, false).unwrap(),
-        );
-        fd[0][i] = (ep.f - em.f) / (2.0 * h);
-        fd[1][i] = (ep.g[0] - em.g[0]) / (2.0 * h);
-    }
-    for (k, (an, fd)) in [&gf, &gg[0]].into_iter().zip(&fd).enumerate() {
-        let scale = fd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for i in 0..2 {
-            let rel = (an[i] - fd[i]).abs() / scale;
-            println!(
-                "{} d/dx{i}: analytic {:e}, FD {:e}, error {rel:.1e} of the largest component",
-                ["f", "g"][k],
-                an[i],
-                fd[i]
-            );
-            assert!(rel < 1e-5, "{} d/dx{i}: {rel:e}", ["f", "g"][k]);
-        }
-    }
+    assert_gradients_match_central_differences(p.as_ref(), x, &e);
 }
 
 /// The study text at design `x` [deg] by the old road: the ply angles

@@ -6,10 +6,9 @@
 //! makes their meshes, and at a design with the same angles their bases,
 //! the same.
 
-use crate::common::sar::{coarse_sar, replace};
+use crate::common::sar::{assert_gradients_match_central_differences, coarse_sar, replace};
 use plyscape::explore::problem::scene_problem::SceneProblem;
 use plyscape::laminate::Laminate;
-use plyscape::optimize::Problem;
 use plyscape::panels::basis::RIGID_CONTENT_LIMIT;
 use plyscape::scene::{BuildProfile, Scene, ScenePlan};
 use plyscape::study::Study;
@@ -147,34 +146,5 @@ fn gradients_with_a_shared_basis_match_central_differences() {
     let x = [40.0, -25.0];
     let (e, profile) = p.evaluate_profiled(&x, true).unwrap();
     assert_eq!(counts(&profile.build), [1, 1, 1]);
-    let (gf, gg) = (e.grad_f.unwrap(), e.grad_g.unwrap());
-    // Relative to the largest component of each gradient (dg/dθ1 is
-    // far smaller than dg/dθ2; central differences carry the
-    // integrator's error over h).
-    let h = 0.01; // degrees
-    let mut fd = [[0.0; 2]; 2];
-    for i in 0..2 {
-        let (mut xp, mut xm) = (x, x);
-        xp[i] += h;
-        xm[i] -= h;
-        let (ep, em) = (
-            p.evaluate(&xp, false).unwrap(),
-            p.evaluate(&xm, false).unwrap(),
-        );
-        fd[0][i] = (ep.f - em.f) / (2.0 * h);
-        fd[1][i] = (ep.g[0] - em.g[0]) / (2.0 * h);
-    }
-    for (k, (an, fd)) in [&gf, &gg[0]].into_iter().zip(&fd).enumerate() {
-        let scale = fd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for i in 0..2 {
-            let rel = (an[i] - fd[i]).abs() / scale;
-            println!(
-                "{} d/dx{i}: analytic {:e}, FD {:e}, error {rel:.1e}",
-                ["f", "g"][k],
-                an[i],
-                fd[i]
-            );
-            assert!(rel < 1e-5, "{} d/dx{i}: {rel:e}", ["f", "g"][k]);
-        }
-    }
+    assert_gradients_match_central_differences(&p, x, &e);
 }
