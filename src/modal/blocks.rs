@@ -59,8 +59,8 @@ pub(crate) struct Blocks {
 
 impl Blocks {
     /// The blocks of `pencil` with the design derivatives `dk` (module
-    /// doc). `cache`: the blocks of the previous design, kept (values
-    /// refreshed) when the partition is the same. `None` when the pencil
+    /// doc). `cache`: the blocks of the previous design, kept (values of
+    /// `K` and `M` refreshed) when the partition is the same. `None` when the pencil
     /// does not split. Matrices of another size than the pencil are left to
     /// the caller's checks.
     pub(crate) fn refresh(

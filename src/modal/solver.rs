@@ -17,6 +17,8 @@ use faer::Mat;
 /// Sparse modal analysis of one stiffness pattern: holds `K` ∪ diagonal, the
 /// mass, and the symbolic Cholesky structure (AMD ordering), computed once
 /// and reused by every numeric factorization (shift-invert and Nelson).
+/// A new design gives its `K` ([`ModalSolver::set_stiffness`]) and, when
+/// its ply thicknesses moved the mass, its `M` ([`ModalSolver::set_mass`]).
 pub struct ModalSolver {
     pencil: Pencil,
     /// The independent blocks of the last design with derivatives
@@ -48,6 +50,20 @@ impl ModalSolver {
             self.blocks = None;
         }
         Ok(())
+    }
+
+    /// Replace the lumped mass (length `n`, every entry finite and > 0):
+    /// a new design whose ply thicknesses moved it. `M` is diagonal, so
+    /// the pattern and the symbolic factorization are kept; the blocks of
+    /// the derivatives take it at their next refresh. Errors: as
+    /// [`ModalSolver::new`]'s `mass`; on error the solver is unchanged.
+    pub fn set_mass(&mut self, mass: &[f64]) -> Result<()> {
+        self.pencil.set_mass(mass)
+    }
+
+    /// The lumped mass the modes are computed with (length `n`).
+    pub fn mass(&self) -> &[f64] {
+        self.pencil.mass()
     }
 
     /// The `opts.n_modes` lowest modes. Errors: `n_modes` = 0 or > n →

@@ -176,3 +176,56 @@ fn a_new_pattern_rebuilds_the_blocks() {
         }
     }
 }
+
+/// A new lumped mass on a reused solver ([`ModalSolver::set_mass`], a
+/// design whose ply thicknesses moved M) reaches the modes and, through
+/// the kept blocks, the updated-mode derivatives: the same bits as a
+/// solver made with that mass. A bad mass is refused and leaves the
+/// solver as it was.
+#[test]
+fn a_new_mass_reaches_the_modes_and_the_blocks() {
+    let m = 20;
+    let k = chains(m, 0.0, stiffness);
+    let dk = chains(m, 0.0, alpha);
+    let mass = |scale: f64| -> Vec<f64> {
+        (0..2 * m)
+            .map(|i| scale * (1.0 + 0.3 * ((i as f64) * 0.7).sin()))
+            .collect()
+    };
+    let (m0, m1) = (mass(1.0), mass(1.7));
+    let dm = mass(0.4);
+    let var = [DesignDerivative {
+        dk: &dk,
+        d2k: None,
+        mass: Some(crate::modal::MassDerivative { dm: &dm, d2m: None }),
+    }];
+    let o = DerivativeOptions::default();
+    let opts = ModalOptions::new(6);
+    let mut reused = ModalSolver::new(&k, &m0).unwrap();
+    let modes0 = reused.solve(&opts).unwrap();
+    // Two uncoupled chains: the derivatives make (and keep) two blocks.
+    reused.derivatives(&modes0, &var, &o).unwrap();
+    reused.set_mass(&m1).unwrap();
+    let got = reused.solve(&opts).unwrap();
+    let got_d = reused.derivatives(&got, &var, &o).unwrap();
+    let mut fresh = ModalSolver::new(&k, &m1).unwrap();
+    let want = fresh.solve(&opts).unwrap();
+    let want_d = fresh.derivatives(&want, &var, &o).unwrap();
+    assert_eq!(got.lambda, want.lambda);
+    assert_eq!(got.modes, want.modes);
+    assert_eq!(got_d[0].dlambda, want_d[0].dlambda);
+    assert_eq!(got_d[0].dmodes, want_d[0].dmodes);
+    // λ of M1 = 1.7 M0: λ0 / 1.7, to the solver's tolerance.
+    for (l1, l0) in got.lambda.iter().zip(&modes0.lambda) {
+        assert!((l1 * 1.7 / l0 - 1.0).abs() < 1e-9, "{l1} vs {l0}");
+    }
+    let mut bad = m1.clone();
+    bad[3] = 0.0;
+    assert!(reused
+        .set_mass(&bad)
+        .unwrap_err()
+        .to_string()
+        .contains("mass[3]"));
+    assert!(reused.set_mass(&m1[1..]).is_err());
+    assert_eq!(reused.solve(&opts).unwrap().lambda, want.lambda);
+}

@@ -65,8 +65,10 @@ pub fn layup_label(panel: &Panel) -> String {
 /// A panel prepared for repeated modal analyses: mesh, sparsity pattern,
 /// assembly buffers, symbolic factorization and mirror maps are built once
 /// ([`PanelAnalysis::new`]); each [`PanelAnalysis::run`] for a lay-up then
-/// costs one assembly, one numeric factorization, the Lanczos iteration and
-/// (if asked) the derivatives. This is the shape an optimization loop uses.
+/// costs one assembly (`K` and the lumped `M`, both of that lay-up's ply
+/// angles and thicknesses), one numeric factorization, the Lanczos
+/// iteration and (if asked) the derivatives. This is the shape an
+/// optimization loop uses.
 pub struct PanelAnalysis {
     pub(super) panel: Panel,
     pub(super) model: crate::fe::PanelModel,
@@ -166,7 +168,8 @@ impl PanelAnalysis {
     }
 
     /// Modes (and derivatives) for `laminate` (same ply count as the
-    /// panel's; ply angles may differ). `n_modes` outside 1..=[`Self::max_modes`]
+    /// panel's; ply angles and thicknesses may differ: `K` and `M` are
+    /// both assembled for it). `n_modes` outside 1..=[`Self::max_modes`]
     /// is an input error on `n_modes` that names the largest allowed.
     pub fn run(
         &mut self,
@@ -178,6 +181,11 @@ impl PanelAnalysis {
         self.model
             .assemble_into(laminate, &self.panel.design, &mut self.sys)?;
         self.solver.set_stiffness(&self.sys.k)?;
+        // The lumped M of this laminate: its ply thicknesses (design
+        // variables `thickness_<plies>`) move μ = Σ ρ_k t_k and
+        // I = Σ ρ_k ∫z² dz, so the mass given in `new` (the panel's own
+        // lay-up) is stale for another thickness.
+        self.solver.set_mass(&self.sys.m_diag)?;
         let t1 = Instant::now();
         let free = self.panel.support == crate::fe::Support::FreeFree;
         let mut opts = ModalOptions::new(if free { n_modes + 6 } else { n_modes });

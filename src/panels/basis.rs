@@ -33,9 +33,12 @@
 //! [`BasisBuilder`] keeps the analysis (sparsity pattern, symbolic
 //! factorization) across designs, so an optimization loop pays one assembly,
 //! one numeric factorization and the Lanczos iteration per design;
-//! [`panel_basis`] is the one-shot form. The lumped masses are recomputed
-//! per call from the element geometry (O(elements)) and checked against
-//! the assembled diagonal of M, entry by entry.
+//! [`panel_basis`] is the one-shot form. A design's ply thicknesses move
+//! `K` and `M` alike: both are assembled anew for every design's laminate
+//! and given to the eigen-solver (the symbolic factorization is kept, `M`
+//! being diagonal). The lumped masses are recomputed per call from the
+//! element geometry (O(elements)) and checked against the diagonal of M
+//! the eigen-solver used, entry by entry.
 //!
 //! Measured (`benches/panel_basis_bench.rs`; SAR panel 3, 32 divisions,
 //! 4152 DOF, 14 modes; 2-core x86_64 VM shared with other jobs, fastest of
@@ -337,25 +340,25 @@ impl BasisBuilder {
     }
 
     /// HRZ lumped masses of every node (from the analysis's
-    /// [`RigidFrame`]); each free DOF's value is checked against the
-    /// assembled diagonal of M (the basis must be M-orthonormal with
-    /// exactly these masses).
+    /// [`RigidFrame`], i.e. from the laminate of this design); each free
+    /// DOF's value is checked against the diagonal of M the eigen-solver
+    /// used (the basis must be M-orthonormal with exactly these masses).
     fn node_masses(&self, frame: &RigidFrame) -> Result<NodeMasses> {
         let (mass, inertia) = (frame.mass().to_vec(), frame.inertia().to_vec());
-        let sys = &self.analysis.sys;
-        for (f, &(node, comp)) in sys.dof_map.iter().enumerate() {
+        let solver_mass = self.analysis.solver.mass();
+        for (f, &(node, comp)) in self.analysis.sys.dof_map.iter().enumerate() {
             let ours = if comp < 3 {
                 mass[node]
             } else {
                 inertia[node][comp - 3]
             };
-            let m = sys.m_diag[f];
+            let m = solver_mass[f];
             if (ours - m).abs() > 1e-12 * m.abs() {
                 return Err(Error::numerical(
                     "panels::basis::node_masses",
                     format!(
                         "lumped mass of node {node}, component {comp}: {ours:e} differs from \
-                         the assembled M entry {m:e}"
+                         the eigen-solver's M entry {m:e}"
                     ),
                 ));
             }

@@ -14,8 +14,10 @@
 //! - the design map (which plies each derivative variable sets, and so
 //!   the derivative names, e.g. `theta_1_4`);
 //! - the laminate at this design (material, thickness and angle of each
-//!   ply) and the `[[panels]]` entry's own laminate (its lumped mass is
-//!   the eigen-solver's mass, set once per builder);
+//!   ply) and the `[[panels]]` entry's own laminate (the builder's set-up
+//!   assembles it once; since `K` and `M` are both taken from the design's
+//!   laminate, the basis reads only its ply count, so comparing all of it
+//!   is conservative);
 //! - the number of modes, the derivative approach (none, `fixed`,
 //!   `updated`) and the ply-thickness variables (names, in order);
 //! - with geometric stiffening, the mesh nodes at the body's joint points

@@ -58,22 +58,7 @@ impl Pencil {
                 "at least one DOF",
             ));
         }
-        if mass.len() != n {
-            return Err(Error::input(
-                "mass",
-                format!("{} entries", mass.len()),
-                format!("{n} entries (one per DOF of the stiffness matrix)"),
-            ));
-        }
-        for (i, &m) in mass.iter().enumerate() {
-            if !(m.is_finite() && m > 0.0) {
-                return Err(Error::input(
-                    format!("mass[{i}]"),
-                    m,
-                    "a finite lumped mass > 0",
-                ));
-            }
-        }
+        check_mass(mass, n)?;
         let pat = Pattern::build(k)?;
         let Pattern {
             col_ptr,
@@ -171,6 +156,17 @@ impl Pencil {
         true
     }
 
+    /// Replace the lumped mass by `mass` (a new design whose ply
+    /// thicknesses moved it: `M` is diagonal, so the pattern, ordering and
+    /// symbolic factorization are unchanged; every later factorization of
+    /// `K − σM` reads it). Errors: as [`Pencil::new`]'s `mass` (length `n`,
+    /// every entry finite and > 0); on error the pencil is unchanged.
+    pub(crate) fn set_mass(&mut self, mass: &[f64]) -> Result<()> {
+        check_mass(mass, self.n)?;
+        self.mass.copy_from_slice(mass);
+        Ok(())
+    }
+
     /// `k_lower` from `k_val` (after new values of `K`).
     fn gather_lower(&mut self) {
         let (src, val) = (&self.ordered.src, &self.k_val);
@@ -218,8 +214,12 @@ impl Pencil {
     }
 
     /// Take the values of `K` from `full` through `map` (from
-    /// [`Self::block`]): the block of a new design's stiffness.
+    /// [`Self::block`]) and the mass of the block's DOFs: the block of a
+    /// new design's pencil (its mass moves with the ply thicknesses).
     pub(crate) fn gather_values(&mut self, full: &Pencil, map: &[usize]) {
+        for (m, &d) in self.mass.iter_mut().zip(&self.global) {
+            *m = full.mass[d];
+        }
         self.k_val.clear();
         self.k_val.extend(map.iter().map(|&p| full.k_val[p]));
         self.k_max = self.k_val.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -253,4 +253,26 @@ impl Pencil {
         let d = self.ordered.fwd.get(index).copied().unwrap_or(index);
         self.global.get(d).copied().unwrap_or(d)
     }
+}
+
+/// A lumped diagonal mass for `n` DOFs: `n` entries, each finite and > 0
+/// (kg or kg·m²); else an input error on key `mass` or `mass[i]`.
+fn check_mass(mass: &[f64], n: usize) -> Result<()> {
+    if mass.len() != n {
+        return Err(Error::input(
+            "mass",
+            format!("{} entries", mass.len()),
+            format!("{n} entries (one per DOF of the stiffness matrix)"),
+        ));
+    }
+    for (i, &m) in mass.iter().enumerate() {
+        if !(m.is_finite() && m > 0.0) {
+            return Err(Error::input(
+                format!("mass[{i}]"),
+                m,
+                "a finite lumped mass > 0",
+            ));
+        }
+    }
+    Ok(())
 }
