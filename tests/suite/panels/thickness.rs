@@ -25,13 +25,7 @@ fn panel(support: Support, t1: f64) -> Panel {
         ])
         .unwrap(),
         design: DesignMap::per_ply(4),
-        mesh: Mesh::structured(&MeshParams {
-            length: 1.0,
-            width: 0.6,
-            divisions: 6,
-            points: vec![],
-        })
-        .unwrap(),
+        mesh: mesh_1m_by_0_6m(),
         support,
     }
 }
@@ -115,15 +109,20 @@ fn cross_ply_panel(t: [f64; 4]) -> Panel {
         name: "p".into(),
         laminate: cross_ply(t),
         design: DesignMap::symmetric(4),
-        mesh: Mesh::structured(&MeshParams {
-            length: 1.0,
-            width: 0.6,
-            divisions: 6,
-            points: vec![],
-        })
-        .unwrap(),
+        mesh: mesh_1m_by_0_6m(),
         support: Support::SimplySupported,
     }
+}
+
+/// The 1.0 m × 0.6 m structured mesh of 6 divisions both panels use.
+fn mesh_1m_by_0_6m() -> Mesh {
+    Mesh::structured(&MeshParams {
+        length: 1.0,
+        width: 0.6,
+        divisions: 6,
+        points: vec![],
+    })
+    .unwrap()
 }
 
 /// Largest |a − b| over the largest |b|.
