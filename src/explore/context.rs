@@ -1,5 +1,6 @@
 //! What a driver command gets from the command line ([`Context`],
-//! [`DriveFlags`], [`Shard`]), the directory it writes into and its manifest entry.
+//! [`DriveFlags`], [`Shard`]), the directory it writes into, its manifest
+//! entry and its worker pool ([`thread_pool`]).
 
 use crate::error::{Error, Result};
 use crate::explore::persist::fingerprint::Fingerprint;
@@ -110,4 +111,13 @@ impl Context<'_> {
             Some(shard),
         )
     }
+}
+
+/// A pool of `threads` workers for a driver's parallel work; a count the
+/// system refuses is an input error on `threads`.
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::input("threads", threads, format!("a usable count ({e})")))
 }

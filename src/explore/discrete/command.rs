@@ -99,10 +99,7 @@ pub fn run_discrete(ctx: &Context) -> Result<Vec<DiscreteRow>> {
     let dir = ctx.dir()?;
     let optima = read_optima(&dir, vars)?;
     let cache = Cache::default();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(ctx.threads)
-        .build()
-        .map_err(|e| Error::input("threads", ctx.threads, format!("a usable count ({e})")))?;
+    let pool = crate::explore::context::thread_pool(ctx.threads)?;
     let row = |method: &str, from: Option<usize>, found: &Found| DiscreteRow {
         method: method.into(),
         from_optimum: from,

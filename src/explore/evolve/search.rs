@@ -174,10 +174,7 @@ pub fn run(
     quiet: bool,
 ) -> Result<Report> {
     let t0 = Instant::now();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::input("threads", threads, format!("a usable count ({e})")))?;
+    let pool = crate::explore::context::thread_pool(threads)?;
     let recorder = Recorder {
         inner: problem,
         values: Mutex::new(Vec::new()),

@@ -341,10 +341,7 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
         feasibility_tolerance: tol,
         ..Nsga2Options::default()
     };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::input("threads", threads, format!("a usable count ({e})")))?;
+    let pool = crate::explore::context::thread_pool(threads)?;
     let t = Instant::now();
     let sims = problem.simulations();
     let evo = pool

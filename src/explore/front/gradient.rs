@@ -210,10 +210,7 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
         ));
     }
     let x0 = problem.start();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(s.threads)
-        .build()
-        .map_err(|e| Error::input("threads", s.threads, format!("a usable count ({e})")))?;
+    let pool = crate::explore::context::thread_pool(s.threads)?;
     let names = problem.objective_names();
     // 1. Anchors from every start, the best of each objective, and its
     // lexicographic refinement.

@@ -108,10 +108,7 @@ pub fn evaluate_grid(
         }
         x
     };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::input("threads", threads, format!("a usable count ({e})")))?;
+    let pool = crate::explore::context::thread_pool(threads)?;
     let progress = Progress::new("grid", count as u64, quiet);
     let points: Vec<GridPoint> = pool.install(|| {
         (0..count)

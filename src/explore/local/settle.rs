@@ -176,13 +176,10 @@ pub fn lowest_comparable(visited: &[IterRecord], end_max_g: f64, tol: f64) -> Op
     } else {
         tol
     };
-    visited.iter().filter(|r| r.max_g <= bound).fold(
-        None,
-        |best: Option<&IterRecord>, r| match best {
-            Some(b) if b.f <= r.f => Some(b),
-            _ => Some(r),
-        },
-    )
+    visited
+        .iter()
+        .filter(|r| r.max_g <= bound)
+        .min_by(|a, b| a.f.total_cmp(&b.f))
 }
 
 /// Step 4 of the module doc: a run never ends above a feasible design it

@@ -208,10 +208,7 @@ pub fn run(
     let vars = problem.variables();
     let n = vars.len();
     let m = problem.n_constraints();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads)
-        .build()
-        .map_err(|e| Error::input("threads", opts.threads, format!("a usable count ({e})")))?;
+    let pool = crate::explore::context::thread_pool(opts.threads)?;
     let res = req.resolution;
     let progress = Progress::new("map", (req.pairs.len() * res * res) as u64, opts.quiet);
     let mut out = Vec::new();

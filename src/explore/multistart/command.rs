@@ -119,17 +119,23 @@ fn noise_allowance(
     };
     let m = estimate(problem, x0, ctx.study.meta.seed, &NoiseOptions::default())?;
     if !ctx.quiet {
-        let level = match m.relative_f() {
-            Some(r) => format!("{r:.2e} of f"),
-            None => format!("not measured ({})", m.noise_f.failure().unwrap_or("")),
-        };
         println!(
-            "  noise at the first start: {level}; allowance {:.2e} ({} function calls)",
+            "  noise at the first start: {}; allowance {:.2e} ({} function calls)",
+            level(&m),
             m.allowance(),
             m.evaluations
         );
     }
     Ok((m.allowance(), Some(m)))
+}
+
+/// The noise of f for the terminal: relative to |f|, or why it was not
+/// measured.
+fn level(m: &Measured) -> String {
+    match m.relative_f() {
+        Some(r) => format!("{r:.2e} of f"),
+        None => format!("not measured ({})", m.noise_f.failure().unwrap_or("")),
+    }
 }
 
 /// With `[multistart] noise = "measured"`: ECNoise at every certified
@@ -141,10 +147,7 @@ fn noise_at_optima(
     report: &mut driver::Report,
     dir: &Path,
 ) -> Result<()> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(ctx.threads)
-        .build()
-        .map_err(|e| Error::input("threads", ctx.threads, format!("a usable count ({e})")))?;
+    let pool = crate::explore::context::thread_pool(ctx.threads)?;
     let seed = ctx.study.meta.seed;
     let measured: Vec<Measured> = pool.install(|| {
         use rayon::prelude::*;
@@ -156,11 +159,7 @@ fn noise_at_optima(
     })?;
     for (o, m) in report.optima.iter_mut().zip(measured) {
         if !ctx.quiet {
-            let level = match m.relative_f() {
-                Some(r) => format!("{r:.2e} of f"),
-                None => format!("not measured ({})", m.noise_f.failure().unwrap_or("")),
-            };
-            println!("  noise at optimum {}: {level}", o.id);
+            println!("  noise at optimum {}: {}", o.id, level(&m));
         }
         o.noise = Some(m);
     }

@@ -271,10 +271,7 @@ pub fn run(
         .collect();
     let mut appender = RunsAppender::open(&path, vars, m)?;
 
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(settings.threads)
-        .build()
-        .map_err(|e| Error::input("threads", settings.threads, format!("a usable count ({e})")))?;
+    let pool = crate::explore::context::thread_pool(settings.threads)?;
     let finished_evals: Mutex<BTreeMap<usize, usize>> =
         Mutex::new(done.iter().map(|(&k, r)| (k, r.function_calls)).collect());
     let next = AtomicUsize::new(0);

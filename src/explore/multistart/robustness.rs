@@ -265,18 +265,9 @@ pub fn apply(
     let Some(s) = section(ctx.study)? else {
         return Ok(None);
     };
+    // `section` checked the tolerances' count against the variables.
     let vars = problem.variables();
-    if s.tolerance.len() != vars.len() {
-        return Err(ctx.study.error(
-            "robustness.tolerance",
-            format!("(array of {})", s.tolerance.len()),
-            format!("{} tolerances, one per variable", vars.len()),
-        ));
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(ctx.threads)
-        .build()
-        .map_err(|e| Error::input("threads", ctx.threads, format!("a usable count ({e})")))?;
+    let pool = crate::explore::context::thread_pool(ctx.threads)?;
     let seed = ctx.study.meta.seed;
     let robust: Vec<Robustness> = pool.install(|| {
         optima

@@ -228,8 +228,10 @@ impl SceneProblem {
                     .and_then(|m| m.get("feasibility_tolerance"))
                     .and_then(|v| v.as_float())
                     .unwrap_or(1e-6);
-                let key = toml::to_string(&study.table).unwrap_or_default();
-                let choice = match accuracy::remembered(&key) {
+                // Keyed by the study's full text; a study that does not
+                // serialize is measured every time.
+                let key = toml::to_string(&study.table).ok();
+                let choice = match key.as_deref().and_then(accuracy::remembered) {
                     Some(c) => {
                         problem.set_tolerance(c.rtol);
                         c
@@ -240,7 +242,9 @@ impl SceneProblem {
                             accuracy::choose(&mut problem, &start, feasibility, study.meta.seed)
                                 .map_err(study.locate("scene_problem.rtol"))?;
                         eprintln!("note: {}", c.summary());
-                        accuracy::remember(key, &c);
+                        if let Some(key) = key {
+                            accuracy::remember(key, &c);
+                        }
                         c
                     }
                 };

@@ -50,8 +50,8 @@
 //!
 //! References: Powell, *A fast algorithm for nonlinearly constrained
 //! optimization calculations* (1978); Oren & Luenberger, *Self-scaling
-//! variable metric (SSVM) algorithms* (Management Science 20, 1974); Nocedal & Wright, *Numerical
-//! Optimization* (2006), §18.3 (damped BFGS, Procedure 18.2) and §18.5
+//! variable metric (SSVM) algorithms* (Management Science 20, 1974);
+//! Nocedal & Wright, *Numerical Optimization* (2006), §18.3 (damped BFGS, Procedure 18.2) and §18.5
 //! (ℓ1 merit function, eq. 18.29); Kraft, *A software package for
 //! sequential quadratic programming* (DFVLR-FB 88-28, 1988), the SLSQP
 //! stop test and penalty update.
