@@ -29,6 +29,7 @@ use super::block_lu::{with_blocks, BlockLu};
 use super::legs::{lift_failure_cap, Integrand, Legs};
 use super::ode::OdeModel;
 use super::options::{Options, Stats};
+use super::step::StepWatch;
 use crate::error::{Error, Result};
 use diffsol::{
     FaerContext, FaerMat, FaerVec, OdeBuilder, OdeEquations, OdeEquationsImplicit, OdeSolverProblem,
@@ -43,6 +44,7 @@ pub(super) fn integrate_fused<M: OdeModel>(
     opts: &Options,
     (params, p0): (&[M::Param], &[f64]),
     observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+    within: &mut StepWatch<'_>,
 ) -> Result<Stats> {
     let n = y0.len();
     let np = params.len();
@@ -117,7 +119,7 @@ pub(super) fn integrate_fused<M: OdeModel>(
         columns: &columns,
     };
     let legs = Legs::new(opts, model, (&ev, &work), (params, p0), &lanes);
-    legs.run(&mut lanes, (&rhs_calls, &jvps), observe)
+    legs.run(&mut lanes, (&rhs_calls, &jvps), observe, within)
 }
 
 /// The states with the lanes in the state, `z = [y; s_1; ..; s_np]`, on

@@ -12,6 +12,7 @@
 
 use super::ode::OdeModel;
 use super::options::{Options, Scheme, Stats};
+use super::step::{DenseState, Step, StepWatch};
 use crate::error::{Error, Result};
 use diffsol::error::DiffsolError;
 use diffsol::{
@@ -163,7 +164,8 @@ impl<'c, M: OdeModel> Legs<'c, M> {
     }
 
     /// Integrate leg after leg until the end time, calling `observe(t, y,
-    /// s)` at every output time, and return the statistics; `calls` count
+    /// s)` at every output time and `within` with every accepted step
+    /// ([`Step`]), and return the statistics; `calls` count
     /// the right-hand sides and the directional derivatives. Every method
     /// and every form goes through here: the solver of the method's
     /// family comes from `integrand`, and a new leg starts from each event
@@ -173,6 +175,7 @@ impl<'c, M: OdeModel> Legs<'c, M> {
         integrand: &mut I,
         calls: (&Cell<u64>, &Cell<u64>),
         mut observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+        within: &mut StepWatch<'_>,
     ) -> Result<Stats> {
         let start = Instant::now();
         let observer_time = Cell::new(0.0f64);
@@ -182,20 +185,32 @@ impl<'c, M: OdeModel> Legs<'c, M> {
             observer_time.set(observer_time.get() + t0.elapsed().as_secs_f64());
             r
         };
+        let mut within = |step: &Step<'_>| {
+            let t0 = Instant::now();
+            let r = within(step);
+            observer_time.set(observer_time.get() + t0.elapsed().as_secs_f64());
+            r
+        };
+        let within: &mut StepWatch<'_> = &mut within;
         let setup = |e: DiffsolError| {
             Error::numerical(format!("{}: solver set-up", I::PLACE), e.to_string())
         };
         let mut stats = Stats::default();
         loop {
             let leg = match self.opts.method.scheme() {
-                Scheme::Bdf => integrand
-                    .implicit(|| self.drive(integrand.bdf().map_err(setup)?, &mut observe))?,
-                Scheme::Sdirk(tableau) => integrand.implicit(|| {
-                    self.drive(integrand.sdirk(tableau).map_err(setup)?, &mut observe)
+                Scheme::Bdf => integrand.implicit(|| {
+                    self.drive(integrand.bdf().map_err(setup)?, (&mut observe, within))
                 })?,
-                Scheme::ExplicitRk(tableau) => {
-                    self.drive(integrand.explicit_rk(tableau).map_err(setup)?, &mut observe)?
-                }
+                Scheme::Sdirk(tableau) => integrand.implicit(|| {
+                    self.drive(
+                        integrand.sdirk(tableau).map_err(setup)?,
+                        (&mut observe, within),
+                    )
+                })?,
+                Scheme::ExplicitRk(tableau) => self.drive(
+                    integrand.explicit_rk(tableau).map_err(setup)?,
+                    (&mut observe, within),
+                )?,
             };
             let Some(e) = self.end_leg(&mut stats, leg, &mut observe)? else {
                 break;
@@ -220,13 +235,17 @@ impl<'c, M: OdeModel> Legs<'c, M> {
     /// Step a solver through the output times until the end or an
     /// accepted segment change; with `nsens > 0` the sensitivities
     /// (`nsens` lanes of the state length, lane-major) are interpolated
-    /// too and handed to `observe` after the state. Outputs after an
-    /// event are not served by this leg (its law is extended past the
-    /// breakpoint there).
+    /// too and handed to `observe` after the state; every accepted step
+    /// goes to `within` with its dense output, ending at the event when
+    /// it located one. Outputs after an event are not served by this leg
+    /// (its law is extended past the breakpoint there).
     fn drive<'a, Eqn, S>(
         &mut self,
         mut solver: S,
-        observe: &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+        (observe, within): (
+            &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+            &mut StepWatch<'_>,
+        ),
     ) -> Result<(Stats, Option<Event<M::Crossing>>)>
     where
         Eqn: diffsol::OdeEquations<T = f64, V = diffsol::FaerVec<f64>> + 'a,
@@ -295,6 +314,13 @@ impl<'c, M: OdeModel> Legs<'c, M> {
                     });
                 }
             }
+            if t > t_before {
+                let dense = |tq: f64| self.dense(&solver, tq);
+                within(&Step {
+                    span: (t_before, t),
+                    dense: &dense,
+                })?;
+            }
             while self.next < times.len() && times[self.next] <= t {
                 let tq = times[self.next];
                 if let Some(e) = event.as_ref().filter(|e| e.t == tq) {
@@ -302,24 +328,7 @@ impl<'c, M: OdeModel> Legs<'c, M> {
                     self.next += 1;
                     continue;
                 }
-                let y = if tq == solver.state().t {
-                    solver.state().y.clone()
-                } else {
-                    solver.interpolate(tq).map_err(|e| {
-                        Error::numerical_at("integrate: dense output", tq, e.to_string())
-                    })?
-                };
-                let (y, s_fused) = self.split(y.clone_as_vec());
-                let sens = if nsens > 0 {
-                    solver
-                        .interpolate_sens(tq)
-                        .map_err(|e| {
-                            Error::numerical_at("integrate: sensitivity output", tq, e.to_string())
-                        })?
-                        .clone_as_vec()
-                } else {
-                    s_fused
-                };
+                let (y, sens) = self.dense(&solver, tq)?;
                 emit(tq, &y, &sens, observe)?;
                 self.next += 1;
             }
@@ -340,6 +349,31 @@ impl<'c, M: OdeModel> Legs<'c, M> {
             ..Stats::default()
         };
         Ok((stats, event))
+    }
+
+    /// The state and the sensitivities (lane-major) at `tq` in the last
+    /// accepted step of `solver`, from its dense output (its state at the
+    /// step's end).
+    fn dense<'a, Eqn, S>(&self, solver: &S, tq: f64) -> Result<DenseState>
+    where
+        Eqn: diffsol::OdeEquations<T = f64, V = diffsol::FaerVec<f64>> + 'a,
+        S: OdeSolverMethod<'a, Eqn>,
+    {
+        let y = if tq == solver.state().t {
+            solver.state().y.clone()
+        } else {
+            solver
+                .interpolate(tq)
+                .map_err(|e| Error::numerical_at("integrate: dense output", tq, e.to_string()))?
+        };
+        let (y, s_fused) = self.split(y.clone_as_vec());
+        if self.nsens == 0 {
+            return Ok((y, s_fused));
+        }
+        let sens = solver
+            .interpolate_sens(tq)
+            .map_err(|e| Error::numerical_at("integrate: sensitivity output", tq, e.to_string()))?;
+        Ok((y, sens.clone_as_vec()))
     }
 
     /// The end of a leg: count it; at an event, end the integration with

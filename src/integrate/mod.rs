@@ -42,10 +42,12 @@ mod ode;
 mod options;
 mod plain;
 mod sens;
+mod step;
 #[cfg(test)]
 mod tests;
 
 pub use ode::OdeModel;
 pub use options::{Method, Options, SensitivityForm, Stats};
-pub use plain::integrate;
-pub use sens::integrate_sens;
+pub use plain::{integrate, integrate_stepped};
+pub use sens::{integrate_sens, integrate_sens_stepped};
+pub use step::{DenseState, Step, StepWatch};

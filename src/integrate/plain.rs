@@ -3,6 +3,7 @@
 use super::legs::{lift_failure_cap, Integrand, Legs};
 use super::ode::OdeModel;
 use super::options::{Options, Stats};
+use super::step::StepWatch;
 use crate::error::{Error, Result};
 use diffsol::{
     FaerContext, FaerLU, FaerMat, FaerVec, OdeBuilder, OdeEquations, OdeEquationsImplicit,
@@ -16,7 +17,19 @@ pub fn integrate<M: OdeModel>(
     model: &M,
     y0: &[f64],
     opts: &Options,
+    observe: impl FnMut(f64, &[f64]) -> Result<()>,
+) -> Result<Stats> {
+    integrate_stepped(model, y0, opts, observe, &mut |_| Ok(()))
+}
+
+/// [`integrate`], calling `within` with every accepted step and its dense
+/// output besides ([`super::Step`]; its sensitivities are empty).
+pub fn integrate_stepped<M: OdeModel>(
+    model: &M,
+    y0: &[f64],
+    opts: &Options,
     mut observe: impl FnMut(f64, &[f64]) -> Result<()>,
+    within: &mut StepWatch<'_>,
 ) -> Result<Stats> {
     opts.validate()?;
     let n = y0.len();
@@ -64,7 +77,12 @@ pub fn integrate<M: OdeModel>(
         start_y: &start_y,
     };
     let legs = Legs::new(opts, model, (&ev, &work), none, &states);
-    legs.run(&mut states, (&rhs_calls, &jvps), |t, y, _s| observe(t, y))
+    legs.run(
+        &mut states,
+        (&rhs_calls, &jvps),
+        |t, y, _s| observe(t, y),
+        within,
+    )
 }
 
 /// The states alone, on diffsol's plain solvers with its dense LU; a leg

@@ -3,6 +3,7 @@
 use super::legs::{lift_failure_cap, Integrand, Legs};
 use super::ode::OdeModel;
 use super::options::{Options, SensitivityForm, Stats};
+use super::step::StepWatch;
 use crate::error::{Error, Result};
 use diffsol::error::DiffsolError;
 use diffsol::{
@@ -30,6 +31,19 @@ pub fn integrate_sens<M: OdeModel>(
     params: &[M::Param],
     observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
 ) -> Result<Stats> {
+    integrate_sens_stepped(model, y0, opts, params, observe, &mut |_| Ok(()))
+}
+
+/// [`integrate_sens`], calling `within` with every accepted step and its
+/// dense output (state and sensitivities, [`super::Step`]) besides.
+pub fn integrate_sens_stepped<M: OdeModel>(
+    model: &M,
+    y0: &[f64],
+    opts: &Options,
+    params: &[M::Param],
+    observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+    within: &mut StepWatch<'_>,
+) -> Result<Stats> {
     opts.validate()?;
     let n = y0.len();
     let np = params.len();
@@ -45,7 +59,7 @@ pub fn integrate_sens<M: OdeModel>(
         p0.push(v);
     }
     if opts.sensitivity == SensitivityForm::Fused && np > 0 {
-        return super::fused::integrate_fused(model, y0, opts, (params, &p0), observe);
+        return super::fused::integrate_fused(model, y0, opts, (params, &p0), observe, within);
     }
     let ev = RefCell::new(model.events(opts.events, y0));
     let nroots = model.nroots(&ev.borrow());
@@ -113,7 +127,7 @@ pub fn integrate_sens<M: OdeModel>(
         start: (&start_y, &start_s),
     };
     let legs = Legs::new(opts, model, (&ev, &work), (params, &p0), &states);
-    legs.run(&mut states, (&rhs_calls, &jvps), observe)
+    legs.run(&mut states, (&rhs_calls, &jvps), observe, within)
 }
 
 /// The states and `np` lanes of forward sensitivities in diffsol's

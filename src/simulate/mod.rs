@@ -11,7 +11,7 @@
 //! is written at the output times.
 
 use crate::error::{Error, Result};
-use crate::integrate::{integrate, integrate_sens, Stats};
+use crate::integrate::{integrate_sens_stepped, integrate_stepped, Stats, Step, StepWatch};
 use crate::mbs::post::energy::EnergyMonitor;
 use crate::mbs::responses::ResponseValue;
 use crate::mbs::Projection;
@@ -23,6 +23,7 @@ use crate::scene::{Quantity, Scene};
 use num_dual::Dual64;
 use std::path::{Path, PathBuf};
 
+mod continuous;
 mod responses;
 pub mod sampled;
 pub mod spin;
@@ -127,19 +128,13 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
     // The final sensitivities (for integral responses).
     let mut s_end = vec![0.0; n * scene.params.len()];
     let mut sampler = sampled::Sampler::new(&scene.responses);
+    let mut continuous = continuous::Continuous::new(&scene.responses);
     let mut spin = spin::SpinWatch::new(&sys);
+    let mut within =
+        |step: &Step<'_>| continuous.step((&sys, &scene.responses), (&scene.params, n), step);
     let mut observe = |t: f64, y: &[f64], s: &[f64]| {
         spin.observe(&sys, t, y);
-        let lanes: Vec<(&[f64], Param)> = if s.is_empty() {
-            Vec::new()
-        } else {
-            scene
-                .params
-                .iter()
-                .enumerate()
-                .map(|(i, (_, p))| (&s[i * n..(i + 1) * n], *p))
-                .collect()
-        };
+        let lanes = sampled::lanes_of(&scene.params, s, n);
         sampler.observe(&sys, &scene.responses, (t, y), &lanes);
         if !s.is_empty() {
             s_end.copy_from_slice(s);
@@ -179,11 +174,12 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
         y_end.copy_from_slice(y);
         Ok(())
     };
-    let run = run_scene(&sys, scene, &y0, &mut observe);
+    let run = run_scene(&sys, scene, &y0, (&mut observe, &mut within));
     let (stats, failure) = failure_of(&sys, run)?;
     let responses = if failure.is_none() {
         let end = responses::RunEnd {
             sampler: &sampler,
+            continuous: &continuous,
             y_end: &y_end,
             s_end: &s_end,
         };
@@ -217,14 +213,18 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
 }
 
 /// Integrate the scene from `y0`, with its sensitivities when it has
-/// parameters, calling `observe(t, y, s)` at every output time. A scene
-/// in which nothing moves is not integrated: its constant state is
-/// observed at the output times.
+/// parameters, calling `observe(t, y, s)` at every output time and
+/// `within` with every accepted step. A scene in which nothing moves is
+/// not integrated: its constant state is observed at the output times and
+/// makes one step over the run.
 fn run_scene(
     sys: &System,
     scene: &Scene,
     y0: &[f64],
-    mut observe: impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+    (mut observe, within): (
+        impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
+        &mut StepWatch<'_>,
+    ),
 ) -> Result<Stats> {
     if sys.nb() == 0 {
         // Nothing moves: the state (integrals of zero energies included)
@@ -234,13 +234,19 @@ fn run_scene(
             for &t in &scene.options.times {
                 observe(t, y0, &s0)?;
             }
+            let times = &scene.options.times;
+            let (t0, t1) = (scene.options.t0, times.last().copied().unwrap_or(0.0));
+            if t1 > t0 {
+                let dense = |_t: f64| Ok((y0.to_vec(), s0.clone()));
+                within(&Step::constant((t0, t1), &dense))?;
+            }
             Ok(Stats::default())
         })
     } else if scene.params.is_empty() {
-        integrate(sys, y0, &scene.options, |t, y| observe(t, y, &[]))
+        integrate_stepped(sys, y0, &scene.options, |t, y| observe(t, y, &[]), within)
     } else {
         let params: Vec<Param> = scene.params.iter().map(|(_, p)| *p).collect();
-        integrate_sens(sys, y0, &scene.options, &params, &mut observe)
+        integrate_sens_stepped(sys, y0, &scene.options, &params, &mut observe, within)
     }
 }
 

@@ -3,30 +3,32 @@
 //!
 //! A sum of energies in the energy form ([`ResponseKind::energy_form`])
 //! is an integrated state (`integral`: its value at the end, its gradient
-//! the state's sensitivities at the end), the sum at the end state
+//! the state's sensitivities at the end) or the sum at the end state
 //! (`final`: [`energy_lanes`] with the sensitivities at the end, lane-major
-//! `s_end`) or its largest value at the critical time points of its
-//! sampled series (`peak`: [`critical_points`], the largest first). A
-//! response in the sampled form reduces the series of its outputs
-//! ([`crate::mbs::series`]: the trapezoidal integral, the extreme of the
-//! interpolated series with every critical point in its sense, the last
-//! sample, the value at a time, the first crossing of a level). A
-//! frequency reads the modal basis ([`super::sampled::frequency`]).
+//! `s_end`). A peak (either form), a crossing time and an integral of
+//! outputs are read on the continuous solution
+//! ([`super::continuous`]: every local extreme in the peak's sense, the
+//! extreme first; the first crossing of a level; the quadrature of the
+//! steps). A value at a time and a final value of outputs are read from
+//! their output samples ([`crate::mbs::series`]). A frequency reads the
+//! modal basis ([`super::sampled::frequency`]).
 
+use super::continuous::Continuous;
 use super::sampled::{frequency, Sampler};
 use crate::error::{Error, Result};
-use crate::mbs::responses::{
-    critical_extremes, critical_points, energy_lanes, Direction, ResponseKind, ResponseValue,
-};
-use crate::mbs::series::{crossing, extreme, trapezoid, value_at, NoCrossing, Sample};
+use crate::mbs::responses::{energy_lanes, Direction, ResponseKind, ResponseValue};
+use crate::mbs::series::{value_at, NoCrossing};
 use crate::mbs::{Param, System};
 use crate::scene::{Response, Scene};
 
-/// What a run leaves for the responses: the sampled series, the state and
-/// the sensitivities (lane-major) at the end.
+/// What a run leaves for the responses: the sampled series, the readings
+/// on the continuous solution, the state and the sensitivities
+/// (lane-major) at the end.
 pub(super) struct RunEnd<'a> {
-    /// The series of the sampled responses and of the energy peaks.
+    /// The series of the responses read from the output samples.
     pub(super) sampler: &'a Sampler,
+    /// The peaks, crossings and integrals of outputs.
+    pub(super) continuous: &'a Continuous,
     /// The state at the end time.
     pub(super) y_end: &'a [f64],
     /// The sensitivities at the end time, lane-major.
@@ -59,7 +61,7 @@ fn evaluate(
     let fail = |detail: String| {
         Error::numerical("simulate: responses", format!("response {name}: {detail}"))
     };
-    let none = || fail("no samples (no output times)".into());
+    let none = || fail("no samples (no output times or no step)".into());
     let (time, value, gradient, critical) = match r.kind {
         ResponseKind::Frequency { body, mode } => return frequency(sys, r, (body, mode), params),
         ResponseKind::Integral if energies => {
@@ -67,19 +69,13 @@ fn evaluate(
             (None, value, gradient, Vec::new())
         }
         ResponseKind::Integral => {
-            let (v, g) = trapezoid(series).ok_or_else(none)?;
+            let (v, g) = end.continuous.integral(k).ok_or_else(none)?;
             (None, v, g, Vec::new())
         }
-        ResponseKind::Peak { .. } if energies => {
-            let critical = critical_points(series);
-            let (t, value, gradient) = critical.first().cloned().ok_or_else(|| {
-                Error::numerical("simulate: responses", format!("no samples for {name}"))
-            })?;
+        ResponseKind::Peak { .. } => {
+            let critical = end.continuous.extremes(k);
+            let (t, value, gradient) = critical.first().cloned().ok_or_else(none)?;
             (Some(t), value, gradient, critical)
-        }
-        ResponseKind::Peak { sense } => {
-            let (t, v, g) = extreme(series, sense).ok_or_else(none)?;
-            (Some(t), v, g, critical_extremes(series, sense))
         }
         ResponseKind::Final if energies => {
             let (value, gradient) = end_value(sys, r, end, params);
@@ -106,8 +102,10 @@ fn evaluate(
             (Some(time), v, g, Vec::new())
         }
         ResponseKind::Crossing { level, direction } => {
-            let (t, g) = crossing(series, level, direction)
-                .map_err(|e| fail(no_crossing(r, series, e, (level, direction))))?;
+            let (t, g) =
+                end.continuous.crossing(k).ok_or_else(none)?.map_err(|e| {
+                    fail(no_crossing(r, &scene.options.times, e, (level, direction)))
+                })?;
             (Some(t), t, g, Vec::new())
         }
     };
@@ -155,11 +153,12 @@ fn end_value(sys: &System, r: &Response, end: &RunEnd<'_>, params: &[Param]) -> 
     energy_lanes(sys, (&r.terms, r.scale), end.y_end, &lanes)
 }
 
-/// Why a series has no crossing time: it never crosses the level (with
-/// its range over the run), or touches it with zero slope.
+/// Why a response has no crossing time: it never crosses the level (with
+/// its range over the run between the output times `times`), or touches
+/// it with zero slope.
 fn no_crossing(
     r: &Response,
-    series: &[Sample],
+    times: &[f64],
     e: NoCrossing,
     (level, dir): (f64, Direction),
 ) -> String {
@@ -167,8 +166,8 @@ fn no_crossing(
         NoCrossing::Never(lo, hi) => format!(
             "does not cross level {level} ({dir:?}) between t = {} s and {} s: \
              its range over the run is [{lo:e}, {hi:e}] {}",
-            series.first().map_or(0.0, |s| s.0),
-            series.last().map_or(0.0, |s| s.0),
+            times.first().map_or(0.0, |t| *t),
+            times.last().map_or(0.0, |t| *t),
             r.outputs
                 .first()
                 .map_or("", |o| o.quantity.kind.info().unit)

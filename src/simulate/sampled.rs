@@ -1,15 +1,18 @@
-//! Responses in the sampled form and frequency responses.
+//! A response at one state, the responses read from the output samples,
+//! and frequency responses.
 //!
-//! A sampled response `scale · Σ y_i` over scalar outputs
-//! ([`crate::scene::ScalarOutput`]) is evaluated at every output time
-//! with its derivative along each sensitivity lane `(∂y/∂p, p)`: one
-//! dual-number evaluation of each output at `y + ε ∂y/∂p` with the design
-//! seed of `p` (so `dX/dθ` and `dΛ/dθ` enter explicitly), as the columns
-//! of `sensitivities.csv`. Joint angles are unwrapped over the series as
-//! in `history.csv`. The series is then reduced by its kind
-//! (`super::responses`, through [`crate::mbs::series`]). A peak of
-//! energies (the energy form) is sampled here too, as the sum of its
-//! energies with their lanes ([`crate::mbs::responses::energy_lanes`]).
+//! A response in the sampled form `scale · Σ y_i` over scalar outputs
+//! ([`crate::scene::ScalarOutput`]) is evaluated at a state with its
+//! derivative along each sensitivity lane `(∂y/∂p, p)`: one dual-number
+//! evaluation of each output at `y + ε ∂y/∂p` with the design seed of `p`
+//! (so `dX/dθ` and `dΛ/dθ` enter explicitly), as the columns of
+//! `sensitivities.csv`; one in the energy form is the sum of its energies
+//! with their lanes ([`crate::mbs::responses::energy_lanes`])
+//! ([`response_lanes`]). Joint angles are unwrapped as in `history.csv`.
+//! A value at a time and a final value of outputs are read from their
+//! series at the output times (`super::responses`, through
+//! [`crate::mbs::series`]); peaks, crossings and integrals of outputs are
+//! read on the continuous solution (`super::continuous`).
 //!
 //! A frequency response is `f_k = scale · √λ_k / (2π)` of a flexible
 //! body's basis, with `df_k/dp = scale · (dλ_k/dp) / (4π √λ_k)` for a
@@ -84,19 +87,67 @@ fn output_lanes(
     (value, grad)
 }
 
-/// Whether a response in the energy form has a series: a peak of
-/// energies is located among its samples; an integral of energies is an
-/// integrated state and a final value is read at the end state.
-fn samples_energies(r: &Response) -> bool {
-    matches!(r.kind, ResponseKind::Peak { .. })
+/// Whether a response is read from its output samples: a value at a time
+/// and a final value of outputs. Peaks, crossings and integrals of
+/// outputs are read on the continuous solution (`super::continuous`); an
+/// integral or final value of energies is read at the end state.
+fn is_sampled(r: &Response) -> bool {
+    !r.outputs.is_empty() && matches!(r.kind, ResponseKind::ValueAt { .. } | ResponseKind::Final)
 }
 
-/// The series of the scene's sampled responses and of its peaks of
-/// energies, filled at the output times.
+/// The sensitivity lanes `(∂y/∂p_i, p_i)` of the lane-major `s` (state
+/// length `n`); none when `s` is empty.
+pub fn lanes_of<'a>(params: &[(String, Param)], s: &'a [f64], n: usize) -> Vec<(&'a [f64], Param)> {
+    if s.is_empty() {
+        return Vec::new();
+    }
+    params
+        .iter()
+        .enumerate()
+        .map(|(i, (_, p))| (&s[i * n..(i + 1) * n], *p))
+        .collect()
+}
+
+/// Response `r` at state `y` with its derivative along each lane: the
+/// sum of its energies (the energy form, [`energy_lanes`]) or `scale ·
+/// Σ y_i` of its outputs, each joint angle unwrapped against its last
+/// value in `unwrap` (which it updates).
+pub fn response_lanes(
+    sys: &System,
+    r: &Response,
+    y: &[f64],
+    lanes: &[(&[f64], Param)],
+    unwrap: &mut [Option<f64>],
+) -> (f64, Vec<f64>) {
+    if r.outputs.is_empty() {
+        return energy_lanes(sys, (&r.terms, r.scale), y, lanes);
+    }
+    let turn = 2.0 * std::f64::consts::PI;
+    let mut value = 0.0;
+    let mut grad = vec![0.0; lanes.len()];
+    for (out, prev) in r.outputs.iter().zip(unwrap.iter_mut()) {
+        let (mut v, g) = output_lanes(sys, out, y, lanes);
+        if out.quantity.kind == QuantityKind::Angle {
+            if let Some(p) = *prev {
+                v += turn * ((p - v) / turn).round();
+            }
+        }
+        *prev = Some(v);
+        value += v;
+        for (a, b) in grad.iter_mut().zip(&g) {
+            *a += b;
+        }
+    }
+    let s = r.scale;
+    (s * value, grad.iter().map(|g| s * g).collect())
+}
+
+/// The series of the scene's responses read from the output samples
+/// (`is_sampled`), filled at the output times.
 #[derive(Debug, Default)]
 pub struct Sampler {
-    /// Per response of the scene: its samples (empty for integrals and
-    /// final values of energies and for frequencies).
+    /// Per response of the scene: its samples (empty for a response not
+    /// read from samples).
     series: Vec<Vec<Sample>>,
     /// Per response and output: the previous value (angle unwrapping).
     prev: Vec<Vec<Option<f64>>>,
@@ -114,8 +165,8 @@ impl Sampler {
         }
     }
 
-    /// Sample every sampled response, and every peak of energies, at
-    /// `(t, y)` with its lanes.
+    /// Sample every response read from samples at `(t, y)` with its
+    /// lanes.
     pub fn observe(
         &mut self,
         sys: &System,
@@ -123,37 +174,14 @@ impl Sampler {
         (t, y): (f64, &[f64]),
         lanes: &[(&[f64], Param)],
     ) {
-        let turn = 2.0 * std::f64::consts::PI;
-        for (k, r) in responses.iter().enumerate() {
-            if r.outputs.is_empty() {
-                if samples_energies(r) {
-                    let (v, g) = energy_lanes(sys, (&r.terms, r.scale), y, lanes);
-                    self.series[k].push((t, v, g));
-                }
-                continue;
-            }
-            let mut value = 0.0;
-            let mut grad = vec![0.0; lanes.len()];
-            for (out, prev) in r.outputs.iter().zip(self.prev[k].iter_mut()) {
-                let (mut v, g) = output_lanes(sys, out, y, lanes);
-                if out.quantity.kind == QuantityKind::Angle {
-                    if let Some(p) = *prev {
-                        v += turn * ((p - v) / turn).round();
-                    }
-                }
-                *prev = Some(v);
-                value += v;
-                for (a, b) in grad.iter_mut().zip(&g) {
-                    *a += b;
-                }
-            }
-            let s = r.scale;
-            self.series[k].push((t, s * value, grad.iter().map(|g| s * g).collect()));
+        for (k, r) in responses.iter().enumerate().filter(|(_, r)| is_sampled(r)) {
+            let (v, g) = response_lanes(sys, r, y, lanes, &mut self.prev[k]);
+            self.series[k].push((t, v, g));
         }
     }
 
-    /// The series of response `k` (empty for the energy form without a
-    /// series and for frequencies).
+    /// The series of response `k` (empty for a response not read from
+    /// samples).
     pub fn series(&self, k: usize) -> &[Sample] {
         &self.series[k]
     }

@@ -222,11 +222,12 @@ pub fn return_to_best(
     let at = (o.function_calls, o.gradient_calls);
     let Ok((c, calls)) = certify_recorded(&counted, &there, at, &policy.tolerances, observer)
     else {
-        return settled;
+        let spent = (counted.function_calls(), counted.gradient_calls());
+        return stay(settled, (at.0 + spent.0, at.1 + spent.1), observer);
     };
     let converged = |c: Option<&Certificate>| c.is_some_and(|c| c.class == EndClass::Converged);
     if converged(settled.certificate.as_ref()) && !converged(Some(&c)) {
-        return settled;
+        return stay(settled, calls, observer);
     }
     let left = Left { f: o.f, max_g };
     Settled {
@@ -237,6 +238,33 @@ pub fn return_to_best(
         },
         certificate: Some(c),
         returned: Some(left),
+        ..settled
+    }
+}
+
+/// The settled end stays the run's result after a look at a visited
+/// design that spent `calls` in all: its counts become those, and it is
+/// recorded once more, so that the history ends at the result with the
+/// run's calls.
+fn stay(settled: Settled, calls: (usize, usize), observer: &mut dyn Observer) -> Settled {
+    let o = LocalOutcome {
+        function_calls: calls.0,
+        gradient_calls: calls.1,
+        ..settled.outcome
+    };
+    observer.observe(&IterRecord {
+        iteration: o.iterations,
+        x: o.x.clone(),
+        f: o.f,
+        g: o.g.clone(),
+        max_g: o.g.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        ct: None,
+        step: 0.0,
+        function_calls: o.function_calls,
+        gradient_calls: o.gradient_calls,
+    });
+    Settled {
+        outcome: o,
         ..settled
     }
 }
@@ -568,30 +596,21 @@ fn settle_end(
     };
     // The solver's end stays the result: recorded once more after the
     // polish's iterations, so that the history ends at the result.
-    let end = LocalOutcome {
-        iterations: c,
-        function_calls: calls.0 + counted.function_calls() - before.0,
-        gradient_calls: calls.1 + counted.gradient_calls() - before.1,
-        ..outcome
-    };
-    observer.observe(&IterRecord {
-        iteration: end.iterations,
-        x: end.x.clone(),
-        f: end.f,
-        g: end.g.clone(),
-        max_g: end.g.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        ct: None,
-        step: 0.0,
-        function_calls: end.function_calls,
-        gradient_calls: end.gradient_calls,
-    });
-    Settled {
-        outcome: end,
+    let kept = Settled {
+        outcome: LocalOutcome {
+            iterations: c,
+            ..outcome
+        },
         certificate: Some(first),
         polish,
         rescue: None,
         returned: None,
-    }
+    };
+    let spent = (
+        calls.0 + counted.function_calls() - before.0,
+        calls.1 + counted.gradient_calls() - before.1,
+    );
+    stay(kept, spent, observer)
 }
 
 /// A design with `max g <= 0`, reached from `x` by the polish (when `x` is
@@ -836,6 +855,50 @@ mod tests {
         }
         let lowest = lowest_comparable(&watch.visited, 0.0, 0.0);
         assert_eq!(lowest.map(|b| b.x.clone()), Some(vec![-3.0]));
+    }
+
+    /// The islands problem, failing when gradients are asked below
+    /// x = −2.9 (a design-dependent failure, as a modal basis whose
+    /// retained modes split a cluster).
+    struct FailsLow(crate::optimize::testproblems::Analytic);
+
+    impl Problem for FailsLow {
+        fn variables(&self) -> &[crate::optimize::Variable] {
+            self.0.variables()
+        }
+        fn n_constraints(&self) -> usize {
+            self.0.n_constraints()
+        }
+        fn evaluate(
+            &self,
+            x: &[f64],
+            gradients: bool,
+        ) -> crate::error::Result<crate::optimize::Evaluation> {
+            if gradients && x[0] < -2.9 {
+                return Err(crate::error::Error::numerical("test", "no gradient here"));
+            }
+            self.0.evaluate(x, gradients)
+        }
+    }
+
+    /// Step 4 that cannot certify the visited design (its evaluation
+    /// fails) keeps the end, counts the failed call, and records the end
+    /// once more with the run's calls, so that the history ends at the
+    /// result with the counts of `runs.csv`.
+    #[test]
+    fn a_failed_look_back_keeps_the_end_and_counts_its_call() {
+        let p = FailsLow(islands());
+        let s = settle(&p, None, end(&p, 2.5), &policy(false), &mut NoObserver);
+        let before = (s.outcome.function_calls, s.outcome.gradient_calls);
+        let mut history = crate::optimize::History::default();
+        let kept = return_to_best(&p, s, &[record(&p, -3.0)], &policy(false), &mut history);
+        assert_eq!(kept.outcome.x, vec![2.5]);
+        assert!(kept.returned.is_none());
+        let calls = (kept.outcome.function_calls, kept.outcome.gradient_calls);
+        assert_eq!(calls, (before.0 + 1, before.1 + 1));
+        let last = history.0.last().unwrap();
+        assert_eq!(last.x, vec![2.5]);
+        assert_eq!((last.function_calls, last.gradient_calls), calls);
     }
 
     /// Step 4 compares a feasible end only with designs no less feasible

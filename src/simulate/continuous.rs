@@ -1,0 +1,532 @@
+//! Responses read on the continuous solution: a peak, a crossing time
+//! and an integral of outputs are located on the integrator's dense
+//! output, step by step ([`crate::integrate::Step`]), not on the output
+//! samples, so they do not depend on `dt_out`.
+//!
+//! - **Peak** (largest or smallest value, both forms): the response is
+//!   evaluated at `NODES + 1` equally spaced points of every accepted step
+//!   (the step's ends included). Each local extreme of that node sequence
+//!   is refined by Brent's method on the step's interpolant over the two
+//!   node intervals beside it, then by one Newton step on `U̇ = 0` with
+//!   central differences of the interpolant (`polish`); a node at a
+//!   step's end is refined on both sides, the earlier side while its step
+//!   is still at hand. The run's
+//!   ends count when the response falls away from them. The value and its
+//!   gradient are taken at the refined time `t*` from the interpolated
+//!   state and sensitivities: `dU*/dp = ∂U/∂y · s(t*) + ∂U/∂p`, the
+//!   envelope theorem (`U̇(t*) = 0`, or `t*` an end of the run). All local
+//!   extremes are kept, the extreme first ([`ResponseValue::critical`]).
+//!   Between nodes a local extreme narrower than a quarter of a step can
+//!   be missed; the steps resolve the motion to the integrator's
+//!   tolerance, so such a feature is below that tolerance.
+//! - **Crossing** of a level: the first node interval over which the
+//!   response crosses the level in the asked direction brackets the root
+//!   of the interpolant, found by bisection to the rounding of `t`;
+//!   `dt*/dp = −(∂y/∂p)(t*) / ẏ(t*)` (implicit function theorem), with the
+//!   slope `ẏ(t*)` a central difference of the interpolant over
+//!   `10⁻⁶` of the step (error `O(10⁻¹² h²)` relative).
+//! - **Integral** of outputs: three-point Gauss–Legendre quadrature of
+//!   every step on its interpolant, with the gradient the same quadrature
+//!   of the lanes; its error is that of the interpolant (the method's
+//!   dense-output order), not the `O(Δt²)` of a trapezoidal rule on the
+//!   output samples. (An integral of energies is an integrated state.)
+//!
+//! [`ResponseValue::critical`]: crate::mbs::responses::ResponseValue::critical
+
+use super::sampled::{lanes_of, response_lanes};
+use crate::error::Result;
+use crate::integrate::Step;
+use crate::mbs::responses::{Direction, ResponseKind, Sense};
+use crate::mbs::series::{NoCrossing, Sample};
+use crate::mbs::{Param, System};
+use crate::scene::Response;
+
+/// Node intervals per accepted step at which a peak or a crossing is
+/// sought.
+const NODES: usize = 4;
+
+/// What a run leaves of each response read on the continuous solution.
+#[derive(Debug, Default)]
+pub struct Continuous {
+    /// Per response of the scene: its tracker (None: not read here).
+    tracks: Vec<Option<Track>>,
+}
+
+/// The reading of one response.
+#[derive(Debug)]
+enum Track {
+    Peak(PeakTrack),
+    Crossing(CrossTrack),
+    Integral(Quadrature),
+}
+
+/// The result of a crossing: its time and gradient, or why there is none.
+pub type CrossingResult = std::result::Result<(f64, Vec<f64>), NoCrossing>;
+
+/// The response at one point: the scene, the system, the sensitivity
+/// parameters and the state's length.
+struct At<'a> {
+    sys: &'a System,
+    r: &'a Response,
+    params: &'a [(String, Param)],
+    n: usize,
+}
+
+impl At<'_> {
+    /// The value of the response (no lanes) at `t` of `step`.
+    fn value(&self, step: &Step<'_>, t: f64, unwrap: &mut [Option<f64>]) -> Result<f64> {
+        let (y, _) = step.at(t)?;
+        Ok(response_lanes(self.sys, self.r, &y, &[], unwrap).0)
+    }
+
+    /// The value and gradient (one per parameter) at `t` of `step`.
+    fn sample(&self, step: &Step<'_>, t: f64, unwrap: &mut [Option<f64>]) -> Result<Sample> {
+        let (y, s) = step.at(t)?;
+        let lanes = lanes_of(self.params, &s, self.n);
+        let (v, g) = response_lanes(self.sys, self.r, &y, &lanes, unwrap);
+        Ok((t, v, g))
+    }
+
+    /// The response's values at the nodes of `step` (signed by `sign`).
+    fn nodes(
+        &self,
+        step: &Step<'_>,
+        sign: f64,
+        unwrap: &mut [Option<f64>],
+    ) -> Result<([f64; NODES + 1], [f64; NODES + 1])> {
+        let (a, b) = step.span;
+        let mut ts = [0.0; NODES + 1];
+        let mut ws = [0.0; NODES + 1];
+        for j in 0..=NODES {
+            ts[j] = if j == NODES {
+                b
+            } else {
+                a + (b - a) * j as f64 / NODES as f64
+            };
+            ws[j] = sign * self.value(step, ts[j], unwrap)?;
+        }
+        Ok((ts, ws))
+    }
+}
+
+impl Continuous {
+    /// Trackers for the responses of `responses` read here (peaks,
+    /// crossings and integrals of outputs).
+    pub fn new(responses: &[Response]) -> Continuous {
+        let tracks = responses
+            .iter()
+            .map(|r| {
+                let unwrap = vec![None; r.outputs.len()];
+                match r.kind {
+                    ResponseKind::Peak { sense } => {
+                        Some(Track::Peak(PeakTrack::new(sense, unwrap)))
+                    }
+                    ResponseKind::Crossing { level, direction } if !r.outputs.is_empty() => {
+                        Some(Track::Crossing(CrossTrack::new(level, direction, unwrap)))
+                    }
+                    ResponseKind::Integral if !r.outputs.is_empty() => {
+                        Some(Track::Integral(Quadrature::new(unwrap)))
+                    }
+                    _ => None,
+                }
+            })
+            .collect();
+        Continuous { tracks }
+    }
+
+    /// Advance every tracker over one accepted step; `params` are the
+    /// scene's sensitivity parameters (the lanes of the step's
+    /// sensitivities), `n` the state's length.
+    pub fn step(
+        &mut self,
+        (sys, responses): (&System, &[Response]),
+        (params, n): (&[(String, Param)], usize),
+        step: &Step<'_>,
+    ) -> Result<()> {
+        for (track, r) in self.tracks.iter_mut().zip(responses) {
+            let at = At { sys, r, params, n };
+            match track {
+                Some(Track::Peak(p)) => p.step(&at, step)?,
+                Some(Track::Crossing(c)) => c.step(&at, step)?,
+                Some(Track::Integral(q)) => q.step(&at, step)?,
+                None => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// The local extremes of peak response `k`, the extreme first (empty
+    /// when no step was taken).
+    pub fn extremes(&self, k: usize) -> Vec<Sample> {
+        match &self.tracks[k] {
+            Some(Track::Peak(p)) => p.extremes(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The first crossing of crossing response `k`.
+    pub fn crossing(&self, k: usize) -> Option<CrossingResult> {
+        match &self.tracks[k] {
+            Some(Track::Crossing(c)) => Some(c.result()),
+            _ => None,
+        }
+    }
+
+    /// The integral of integral response `k` with its gradient.
+    pub fn integral(&self, k: usize) -> Option<(f64, Vec<f64>)> {
+        match &self.tracks[k] {
+            Some(Track::Integral(q)) => q.total.clone(),
+            _ => None,
+        }
+    }
+}
+
+/// A peak's tracker: the local extremes of `sign · U(t)` found so far.
+#[derive(Debug)]
+struct PeakTrack {
+    /// +1 for the largest value, −1 for the smallest.
+    sign: f64,
+    /// The signed value at the node before the last step's end.
+    left: Option<f64>,
+    /// The extreme over the last node interval of the previous step, when
+    /// the response rose (signed) to that step's end.
+    pending: Option<Sample>,
+    /// The refined local extremes (signed).
+    found: Vec<Sample>,
+    /// The response at the start of the run (a response constant over the
+    /// run has no strict local extreme).
+    start: Option<Sample>,
+    /// The outputs' last values (angle unwrapping).
+    unwrap: Vec<Option<f64>>,
+}
+
+impl PeakTrack {
+    fn new(sense: Sense, unwrap: Vec<Option<f64>>) -> PeakTrack {
+        let sign = match sense {
+            Sense::Max => 1.0,
+            Sense::Min => -1.0,
+        };
+        PeakTrack {
+            sign,
+            left: None,
+            pending: None,
+            found: Vec::new(),
+            start: None,
+            unwrap,
+        }
+    }
+
+    fn step(&mut self, at: &At<'_>, step: &Step<'_>) -> Result<()> {
+        if self.start.is_none() {
+            let s = at.sample(step, step.span.0, &mut self.unwrap.clone())?;
+            self.start = Some(self.signed(s));
+        }
+        let (ts, ws) = at.nodes(step, self.sign, &mut self.unwrap)?;
+        let pending = self.pending.take();
+        for j in 0..NODES {
+            let left = if j == 0 { self.left } else { Some(ws[j - 1]) };
+            if left.is_some_and(|l| l > ws[j]) || ws[j] <= ws[j + 1] {
+                continue;
+            }
+            let lo = ts[j.saturating_sub(1)];
+            let mut best = self.refine(at, step, (lo, ts[j + 1]))?;
+            if let Some(p) = pending.as_ref().filter(|_| j == 0) {
+                if p.1 > best.1 {
+                    best = p.clone();
+                }
+            }
+            self.found.push(best);
+        }
+        self.pending = if ws[NODES] > ws[NODES - 1] {
+            Some(self.refine(at, step, (ts[NODES - 1], ts[NODES]))?)
+        } else {
+            None
+        };
+        self.left = Some(ws[NODES - 1]);
+        Ok(())
+    }
+
+    /// The signed extreme of the response over `[lo, hi]` in `step`
+    /// (Brent's method on the interpolant), with its gradient.
+    fn refine(&self, at: &At<'_>, step: &Step<'_>, (lo, hi): (f64, f64)) -> Result<Sample> {
+        let mut unwrap = self.unwrap.clone();
+        let mut err = None;
+        let sign = self.sign;
+        let t = brent_max(
+            |t| match at.value(step, t, &mut unwrap) {
+                Ok(v) => sign * v,
+                Err(e) => {
+                    err.get_or_insert(e);
+                    f64::NEG_INFINITY
+                }
+            },
+            (lo, hi),
+        );
+        if let Some(e) = err {
+            return Err(e);
+        }
+        let t = polish(|t| at.value(step, t, &mut self.unwrap.clone()), t, (lo, hi))?;
+        let s = at.sample(step, t, &mut self.unwrap.clone())?;
+        Ok(self.signed(s))
+    }
+
+    fn signed(&self, (t, v, g): Sample) -> Sample {
+        (t, self.sign * v, g.iter().map(|x| self.sign * x).collect())
+    }
+
+    /// The local extremes in the response's own sign, the extreme first,
+    /// then by decreasing (signed) value.
+    fn extremes(&self) -> Vec<Sample> {
+        let mut all = self.found.clone();
+        if let Some(p) = &self.pending {
+            all.push(p.clone());
+        }
+        if all.is_empty() {
+            all.extend(self.start.clone());
+        }
+        all.sort_by(|a, b| b.1.total_cmp(&a.1));
+        all.into_iter().map(|s| self.signed(s)).collect()
+    }
+}
+
+/// A crossing's tracker: the first crossing of a level, once found.
+#[derive(Debug)]
+struct CrossTrack {
+    level: f64,
+    dir: Direction,
+    /// The first crossing, once found.
+    found: Option<CrossingResult>,
+    /// The range of the response over the nodes so far.
+    range: (f64, f64),
+    unwrap: Vec<Option<f64>>,
+}
+
+impl CrossTrack {
+    fn new(level: f64, dir: Direction, unwrap: Vec<Option<f64>>) -> CrossTrack {
+        CrossTrack {
+            level,
+            dir,
+            found: None,
+            range: (f64::INFINITY, f64::NEG_INFINITY),
+            unwrap,
+        }
+    }
+
+    fn crosses(&self, a: f64, b: f64) -> bool {
+        let up = a < self.level && b >= self.level;
+        let down = a > self.level && b <= self.level;
+        match self.dir {
+            Direction::Up => up,
+            Direction::Down => down,
+            Direction::Either => up || down,
+        }
+    }
+
+    fn step(&mut self, at: &At<'_>, step: &Step<'_>) -> Result<()> {
+        if self.found.is_some() {
+            return Ok(());
+        }
+        let (ts, vs) = at.nodes(step, 1.0, &mut self.unwrap)?;
+        for v in vs {
+            self.range = (self.range.0.min(v), self.range.1.max(v));
+        }
+        let Some(j) = (1..=NODES).find(|&j| self.crosses(vs[j - 1], vs[j])) else {
+            return Ok(());
+        };
+        // Bisection on the interpolant between the bracketing nodes.
+        let mut unwrap = self.unwrap.clone();
+        let (mut a, mut b) = (ts[j - 1], ts[j]);
+        let below = vs[j - 1] < self.level;
+        if vs[j] == self.level {
+            a = b;
+        }
+        while b - a > 4.0 * f64::EPSILON * b.abs().max(a.abs()).max(1e-300) {
+            let m = 0.5 * (a + b);
+            if m <= a || m >= b {
+                break;
+            }
+            if (at.value(step, m, &mut unwrap)? < self.level) == below {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        let t = if a == b { a } else { 0.5 * (a + b) };
+        let (_, _, grad) = at.sample(step, t, &mut self.unwrap.clone())?;
+        let (t0, t1) = step.span;
+        let d = 1e-6 * (t1 - t0);
+        let (lo, hi) = ((t - d).max(t0), (t + d).min(t1));
+        let slope =
+            (at.value(step, hi, &mut unwrap)? - at.value(step, lo, &mut unwrap)?) / (hi - lo);
+        self.found = Some(if slope == 0.0 || !slope.is_finite() {
+            Err(NoCrossing::Flat(t))
+        } else {
+            Ok((t, grad.iter().map(|g| -g / slope).collect()))
+        });
+        Ok(())
+    }
+
+    fn result(&self) -> CrossingResult {
+        self.found
+            .clone()
+            .unwrap_or(Err(NoCrossing::Never(self.range.0, self.range.1)))
+    }
+}
+
+/// An integral's tracker: three-point Gauss–Legendre quadrature of every
+/// step.
+#[derive(Debug)]
+struct Quadrature {
+    total: Option<(f64, Vec<f64>)>,
+    unwrap: Vec<Option<f64>>,
+}
+
+impl Quadrature {
+    fn new(unwrap: Vec<Option<f64>>) -> Quadrature {
+        Quadrature {
+            total: None,
+            unwrap,
+        }
+    }
+
+    fn step(&mut self, at: &At<'_>, step: &Step<'_>) -> Result<()> {
+        // Nodes ±√(3/5) and 0 on [−1, 1], weights 5/9, 8/9, 5/9.
+        let x = (0.6f64).sqrt();
+        let (a, b) = step.span;
+        let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+        for (xi, wi) in [(-x, 5.0 / 9.0), (0.0, 8.0 / 9.0), (x, 5.0 / 9.0)] {
+            let (_, v, g) = at.sample(step, mid + half * xi, &mut self.unwrap)?;
+            let (value, grad) = self.total.get_or_insert_with(|| (0.0, vec![0.0; g.len()]));
+            *value += half * wi * v;
+            for (acc, gi) in grad.iter_mut().zip(&g) {
+                *acc += half * wi * gi;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One Newton step on `U̇(t) = 0` from Brent's `t` inside `(lo, hi)`,
+/// with central differences of the interpolant over `d = 10⁻⁴ (hi − lo)`.
+/// Brent's method compares values, so it locates a smooth extreme only
+/// to `√(ε |U| / |Ü|)`, where `U` is flat; the gradient read there
+/// (envelope theorem) is off by `∂U̇/∂p · δt`. The slope's rounding is
+/// `ε |U| / d` instead, which puts `t*` about `10⁻⁴ (hi − lo)`-times
+/// closer. An end of the interval, a step out of it or a slope that does
+/// not turn keeps `t`.
+fn polish(mut u: impl FnMut(f64) -> Result<f64>, t: f64, (lo, hi): (f64, f64)) -> Result<f64> {
+    let d = 1e-4 * (hi - lo);
+    if t - d <= lo || t + d >= hi {
+        return Ok(t);
+    }
+    let (um, u0, up) = (u(t - d)?, u(t)?, u(t + d)?);
+    let (slope, curvature) = ((up - um) / (2.0 * d), (up - 2.0 * u0 + um) / (d * d));
+    if curvature == 0.0 || !curvature.is_finite() {
+        return Ok(t);
+    }
+    let next = t - slope / curvature;
+    Ok(if (next - t).abs() <= d && next > lo && next < hi {
+        next
+    } else {
+        t
+    })
+}
+
+/// The maximizer of `f` over `[a, b]` by Brent's method (golden-section
+/// steps, parabolic steps where they are safe), to a time tolerance of
+/// `10⁻⁹ (b − a)` plus the rounding of `t`; an end of the interval when
+/// `f` is monotone over it (to that tolerance).
+fn brent_max(mut f: impl FnMut(f64) -> f64, (a, b): (f64, f64)) -> f64 {
+    let golden = 0.5 * (3.0 - 5f64.sqrt());
+    let (mut lo, mut hi) = (a, b);
+    let mut x = lo + golden * (hi - lo);
+    let (mut w, mut v) = (x, x);
+    let mut fx = -f(x);
+    let (mut fw, mut fv) = (fx, fx);
+    let (mut d, mut e) = (0.0f64, 0.0f64);
+    for _ in 0..100 {
+        let m = 0.5 * (lo + hi);
+        let tol = 1e-9 * (b - a) + 4.0 * f64::EPSILON * x.abs();
+        if (x - m).abs() <= 2.0 * tol - 0.5 * (hi - lo) {
+            break;
+        }
+        let mut golden_step = true;
+        if e.abs() > tol {
+            // A parabola through x, w, v.
+            let r = (x - w) * (fx - fv);
+            let q0 = (x - v) * (fx - fw);
+            let mut p = (x - v) * q0 - (x - w) * r;
+            let mut q = 2.0 * (q0 - r);
+            if q > 0.0 {
+                p = -p;
+            }
+            q = q.abs();
+            if p.abs() < (0.5 * q * e).abs() && p > q * (lo - x) && p < q * (hi - x) {
+                e = d;
+                d = p / q;
+                let u = x + d;
+                if u - lo < 2.0 * tol || hi - u < 2.0 * tol {
+                    d = if x < m { tol } else { -tol };
+                }
+                golden_step = false;
+            }
+        }
+        if golden_step {
+            e = if x < m { hi - x } else { lo - x };
+            d = golden * e;
+        }
+        let u = if d.abs() >= tol {
+            x + d
+        } else {
+            x + tol.copysign(d)
+        };
+        let fu = -f(u);
+        if fu <= fx {
+            if u < x {
+                hi = x;
+            } else {
+                lo = x;
+            }
+            (v, fv, w, fw, x, fx) = (w, fw, x, fx, u, fu);
+        } else {
+            if u < x {
+                lo = u;
+            } else {
+                hi = u;
+            }
+            if fu <= fw || w == x {
+                (v, fv, w, fw) = (w, fw, u, fu);
+            } else if fu <= fv || v == x || v == w {
+                (v, fv) = (u, fu);
+            }
+        }
+    }
+    // A monotone f: the better end.
+    let (fa, fb) = (-f(a), -f(b));
+    if fa < fx && fa <= fb {
+        a
+    } else if fb < fx {
+        b
+    } else {
+        x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::brent_max;
+
+    #[test]
+    fn brent_finds_an_interior_maximum_and_a_monotone_end() {
+        // −(t − 0.3)² + 1 peaks at 0.3 (closed form).
+        let t = brent_max(|t| 1.0 - (t - 0.3) * (t - 0.3), (0.0, 1.0));
+        assert!((t - 0.3).abs() < 1e-8, "{t}");
+        // sin t on [0, π/2 − 0.1] rises: its maximum is the right end.
+        let b = std::f64::consts::FRAC_PI_2 - 0.1;
+        assert_eq!(brent_max(f64::sin, (0.0, b)), b);
+        assert_eq!(brent_max(|t| -t, (2.0, 3.0)), 2.0);
+        // cos on [2, 5] is smallest at π: its negation peaks there.
+        let t = brent_max(|t| -t.cos(), (2.0, 5.0));
+        assert!((t - std::f64::consts::PI).abs() < 1e-8, "{t}");
+    }
+}
