@@ -27,7 +27,7 @@
 //! A bound on a `peak` response may name `critical_points = K` (default
 //! 1): its side of the peak (`upper` for `sense = "max"`, `lower` for
 //! `"min"`) then gives `K` constraints, one per critical time point of the
-//! response, largest first (`crate::mbs::responses::critical_points`):
+//! response, largest first (every local maximum, located on the continuous solution):
 //! `g_k = (R(t*_k) − c) / s`. Where the response has fewer than `K`
 //! local maxima the missing ones repeat the peak. The feasible set is the
 //! same as with the peak alone (every critical point is at most the

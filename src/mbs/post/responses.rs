@@ -121,7 +121,7 @@ impl ResponseKind {
 
     /// Whether a sum of energies of this kind keeps the energy form
     /// (integrals as integrated states, the largest value by
-    /// [`critical_points`], the final value from the end state): integrals,
+    /// its critical time points, the final value from the end state): integrals,
     /// final values and peaks of the largest value; every other response
     /// is sampled.
     pub fn energy_form(&self) -> bool {
@@ -202,7 +202,7 @@ pub struct ResponseValue {
     /// `d value / d p` for each sensitivity parameter of the scene.
     pub gradient: Vec<f64>,
     /// A peak's critical time points `(t*, value, gradient)`: every local
-    /// extreme in its sense ([`critical_points`]), this peak first; empty
+    /// extreme in its sense (located on the continuous solution), this peak first; empty
     /// for the other kinds.
     pub critical: Vec<(f64, f64, Vec<f64>)>,
 }
