@@ -54,6 +54,10 @@ pub enum Command {
         /// Output, thread and overwrite options.
         #[command(flatten)]
         common: Common,
+        /// Continue a killed run: the multistart (also `[compare]`'s) and
+        /// the map continue from their tables; the other stages run again.
+        #[arg(long)]
+        resume: bool,
     },
     /// Modes of the study's panels; modes.csv (+ mode_derivatives.csv,
     /// mode_shapes.csv, convergence.csv when the study asks).
@@ -182,6 +186,7 @@ impl RunConfig {
             threads,
             quiet: common.quiet,
             force: common.force,
+            resume: false,
         })
     }
 }
@@ -192,8 +197,15 @@ impl RunConfig {
 pub fn execute(cli: Cli) -> Result<()> {
     crate::report::mark_start();
     match cli.command {
-        Command::Run { study, common } => {
-            let cfg = RunConfig::resolve(study.as_ref(), &common)?;
+        Command::Run {
+            study,
+            common,
+            resume,
+        } => {
+            let cfg = RunConfig {
+                resume,
+                ..RunConfig::resolve(study.as_ref(), &common)?
+            };
             let _lock = lock(&cfg, "run", None)?;
             run_study(&cfg)
         }

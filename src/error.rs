@@ -127,7 +127,10 @@ impl Error {
     /// Attach the study file and a key prefix to an input error: a library
     /// error with key `plies[1].thickness` raised while reading section
     /// `panels[0]` of `study.toml` becomes `study.toml: panels[0].plies[1].thickness`.
-    /// Other variants pass through unchanged.
+    /// An error already placed in a file keeps its file and key (they are
+    /// the ones its writer wrote: a top-level `[[panels]]` entry stays
+    /// `panels[0]` when the scene that uses it adds `scene`). Other
+    /// variants pass through unchanged.
     pub fn in_file(self, file: impl AsRef<Path>, key_prefix: &str) -> Self {
         match self {
             Error::Input {
@@ -135,12 +138,8 @@ impl Error {
                 key,
                 value,
                 expected,
-            } => {
-                let file = if f.is_empty() {
-                    file.as_ref().display().to_string()
-                } else {
-                    f
-                };
+            } if f.is_empty() => {
+                let file = file.as_ref().display().to_string();
                 let key = match (key_prefix.is_empty(), key.is_empty()) {
                     (true, _) => key,
                     (false, true) => key_prefix.to_string(),
@@ -242,6 +241,12 @@ mod tests {
             "studies/x.toml: `panels[0].plies[1].thickness` = -1: expected a finite value > 0"
         );
         assert_eq!(e.exit_code(), 2);
+        // Placed once, placed for good: the scene that builds the panel
+        // does not rename the top-level `[[panels]]` entry.
+        let again = Error::input("plies[1].thickness", -1.0, "a finite value > 0")
+            .in_file("studies/x.toml", "panels[0]")
+            .in_file("studies/x.toml", "scene");
+        assert_eq!(again.to_string(), msg);
     }
 
     #[test]

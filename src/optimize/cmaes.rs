@@ -452,15 +452,20 @@ fn normal(rng: &mut ChaCha8Rng) -> f64 {
     (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
+/// The default population of the first run on `n` variables,
+/// `4 + ⌊3 ln n⌋` (Hansen, Table 1): the fewest evaluations of one
+/// generation.
+pub fn default_population(n: usize) -> usize {
+    4 + (3.0 * (n.max(1) as f64).ln()).floor() as usize
+}
+
 impl Cmaes {
     /// A solver for `problem` (validates the options).
     pub fn new(problem: &dyn Problem, options: CmaesOptions) -> Result<Cmaes> {
         let vars = problem.variables();
         let n = vars.len();
         options.validate(n)?;
-        let lambda0 = options
-            .popsize
-            .unwrap_or(4 + (3.0 * (n as f64).ln()).floor() as usize);
+        let lambda0 = options.popsize.unwrap_or(default_population(n));
         Ok(Cmaes {
             rng: ChaCha8Rng::seed_from_u64(options.seed),
             lower: vars.iter().map(|v| v.lower).collect(),

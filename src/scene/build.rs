@@ -274,11 +274,22 @@ impl SceneSpec {
                 "an output interval > 0 (s)",
             ));
         }
-        if !(it.t_end > 0.0 && it.t_end.is_finite()) || it.t_end / it.dt_out > 1e7 {
+        if !(it.t_end > 0.0 && it.t_end.is_finite()) {
             return Err(Error::input(
                 "integrator.t_end",
                 it.t_end,
-                "an end time > 0 (s) with at most 1e7 output intervals",
+                "an end time > 0 (s)",
+            ));
+        }
+        if it.t_end / it.dt_out > 1e7 {
+            return Err(Error::input(
+                "integrator.dt_out",
+                it.dt_out,
+                format!(
+                    "an output interval of at least t_end / 1e7 = {:e} s (at most 1e7 \
+                     rows of history.csv; responses do not depend on it)",
+                    it.t_end / 1e7
+                ),
             ));
         }
         let nout = (it.t_end / it.dt_out).round().max(1.0) as usize;

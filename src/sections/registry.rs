@@ -26,13 +26,18 @@ pub struct RunConfig {
     /// Discard an earlier `runs.csv` instead of keeping it as
     /// `runs-<UTC time>.csv` (multistart without `--resume`).
     pub force: bool,
+    /// `run --resume`: every stage that keeps its progress in its tables
+    /// (the multistart, `[compare]`'s multistart, the map) continues from
+    /// them; the other stages run again.
+    pub resume: bool,
 }
 
 impl RunConfig {
     /// The exploration drivers' view of this run, with `flags` (`--force`
-    /// taken from the run).
+    /// taken from the run, and `--resume` when the run resumes).
     pub fn explore(&self, mut flags: DriveFlags) -> explore::Context<'_> {
         flags.force = self.force;
+        flags.resume |= self.resume;
         explore::Context {
             study: &self.study,
             out: &self.out,

@@ -25,6 +25,12 @@
 //!   `dt*/dp = −(∂y/∂p)(t*) / ẏ(t*)` (implicit function theorem), with the
 //!   slope `ẏ(t*)` a central difference of the interpolant over
 //!   `10⁻⁶` of the step (error `O(10⁻¹² h²)` relative).
+//! - **Value at a time** of outputs: the interpolant of the step that
+//!   holds the time, with the interpolated sensitivities (exact at any
+//!   time, not only at an output time).
+//! - **Final value** of outputs: the end state; the steps only carry the
+//!   joint angles' unwrapping (a joint turning past ±π between two output
+//!   times keeps its turns).
 //! - **Integral** of outputs: three-point Gauss–Legendre quadrature of
 //!   every step on its interpolant, with the gradient the same quadrature
 //!   of the lanes; its error is that of the interpolant (the method's
@@ -58,6 +64,11 @@ enum Track {
     Peak(PeakTrack),
     Crossing(CrossTrack),
     Integral(Quadrature),
+    /// A value at a time: the time, and the sample once read.
+    At(f64, Option<Sample>, Vec<Option<f64>>),
+    /// A final value of outputs: the angles' unwrapping at the last
+    /// step's end.
+    Final(Vec<Option<f64>>),
 }
 
 /// The result of a crossing: its time and gradient, or why there is none.
@@ -110,8 +121,9 @@ impl At<'_> {
 }
 
 impl Continuous {
-    /// Trackers for the responses of `responses` read here (peaks,
-    /// crossings and integrals of outputs).
+    /// Trackers for the responses of `responses` read here (peaks; the
+    /// crossings, values at a time, final values and integrals of
+    /// outputs).
     pub fn new(responses: &[Response]) -> Continuous {
         let tracks = responses
             .iter()
@@ -127,6 +139,10 @@ impl Continuous {
                     ResponseKind::Integral if !r.outputs.is_empty() => {
                         Some(Track::Integral(Quadrature::new(unwrap)))
                     }
+                    ResponseKind::ValueAt { time } if !r.outputs.is_empty() => {
+                        Some(Track::At(time, None, unwrap))
+                    }
+                    ResponseKind::Final if !r.outputs.is_empty() => Some(Track::Final(unwrap)),
                     _ => None,
                 }
             })
@@ -149,6 +165,16 @@ impl Continuous {
                 Some(Track::Peak(p)) => p.step(&at, step)?,
                 Some(Track::Crossing(c)) => c.step(&at, step)?,
                 Some(Track::Integral(q)) => q.step(&at, step)?,
+                Some(Track::At(time, found, unwrap)) => {
+                    let (t0, t1) = step.span;
+                    if found.is_none() && *time >= t0 && *time <= t1 {
+                        *found = Some(at.sample(step, *time, unwrap)?);
+                    }
+                    at.value(step, t1, unwrap)?;
+                }
+                Some(Track::Final(unwrap)) => {
+                    at.value(step, step.span.1, unwrap)?;
+                }
                 None => {}
             }
         }
@@ -170,6 +196,31 @@ impl Continuous {
             Some(Track::Crossing(c)) => Some(c.result()),
             _ => None,
         }
+    }
+
+    /// The value at a time of response `k` (None: the time is outside the
+    /// run).
+    pub fn value_at(&self, k: usize) -> Option<Sample> {
+        match &self.tracks[k] {
+            Some(Track::At(_, found, _)) => found.clone(),
+            _ => None,
+        }
+    }
+
+    /// The final value of outputs of response `k` at the end state `y`
+    /// with its gradient along `lanes` (the angles unwrapped over the run's
+    /// steps).
+    pub fn final_value(
+        &self,
+        (sys, r, k): (&System, &Response, usize),
+        y: &[f64],
+        lanes: &[(&[f64], Param)],
+    ) -> (f64, Vec<f64>) {
+        let mut unwrap = match &self.tracks[k] {
+            Some(Track::Final(u)) => u.clone(),
+            _ => vec![None; r.outputs.len()],
+        };
+        response_lanes(sys, r, y, lanes, &mut unwrap)
     }
 
     /// The integral of integral response `k` with its gradient.

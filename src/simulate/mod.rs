@@ -127,15 +127,12 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
     let n = y0.len();
     // The final sensitivities (for integral responses).
     let mut s_end = vec![0.0; n * scene.params.len()];
-    let mut sampler = sampled::Sampler::new(&scene.responses);
     let mut continuous = continuous::Continuous::new(&scene.responses);
     let mut spin = spin::SpinWatch::new(&sys);
     let mut within =
         |step: &Step<'_>| continuous.step((&sys, &scene.responses), (&scene.params, n), step);
     let mut observe = |t: f64, y: &[f64], s: &[f64]| {
         spin.observe(&sys, t, y);
-        let lanes = sampled::lanes_of(&scene.params, s, n);
-        sampler.observe(&sys, &scene.responses, (t, y), &lanes);
         if !s.is_empty() {
             s_end.copy_from_slice(s);
         }
@@ -178,7 +175,6 @@ pub fn simulate_partial(scene: &Scene) -> Result<(System, Simulation)> {
     let (stats, failure) = failure_of(&sys, run)?;
     let responses = if failure.is_none() {
         let end = responses::RunEnd {
-            sampler: &sampler,
             continuous: &continuous,
             y_end: &y_end,
             s_end: &s_end,

@@ -9,25 +9,23 @@
 //! outputs are read on the continuous solution
 //! ([`super::continuous`]: every local extreme in the peak's sense, the
 //! extreme first; the first crossing of a level; the quadrature of the
-//! steps). A value at a time and a final value of outputs are read from
-//! their output samples ([`crate::mbs::series`]). A frequency reads the
-//! modal basis ([`super::sampled::frequency`]).
+//! steps, the value at a time on the step that holds it, the final value
+//! at the end state). A frequency reads the modal basis
+//! ([`super::sampled::frequency`]).
 
 use super::continuous::Continuous;
-use super::sampled::{frequency, Sampler};
+use super::sampled::{frequency, lanes_of};
 use crate::error::{Error, Result};
 use crate::mbs::responses::{energy_lanes, Direction, ResponseKind, ResponseValue};
-use crate::mbs::series::{value_at, NoCrossing};
+use crate::mbs::series::NoCrossing;
 use crate::mbs::{Param, System};
 use crate::scene::{Response, Scene};
 
-/// What a run leaves for the responses: the sampled series, the readings
-/// on the continuous solution, the state and the sensitivities
-/// (lane-major) at the end.
+/// What a run leaves for the responses: the readings on the continuous
+/// solution, the state and the sensitivities (lane-major) at the end.
 pub(super) struct RunEnd<'a> {
-    /// The series of the responses read from the output samples.
-    pub(super) sampler: &'a Sampler,
-    /// The peaks, crossings and integrals of outputs.
+    /// The peaks, and the crossings, values at a time, final values and
+    /// integrals of outputs.
     pub(super) continuous: &'a Continuous,
     /// The state at the end time.
     pub(super) y_end: &'a [f64],
@@ -55,7 +53,6 @@ fn evaluate(
     (k, params): (usize, &[Param]),
 ) -> Result<ResponseValue> {
     let r = &scene.responses[k];
-    let series = end.sampler.series(k);
     let energies = r.outputs.is_empty();
     let name = &r.name;
     let fail = |detail: String| {
@@ -87,8 +84,9 @@ fn evaluate(
             )
         }
         ResponseKind::Final => {
-            let (t, v, g) = series.last().cloned().ok_or_else(none)?;
-            (Some(t), v, g, Vec::new())
+            let lanes = lanes_of(&scene.params, end.s_end, end.y_end.len());
+            let (v, g) = end.continuous.final_value((sys, r, k), end.y_end, &lanes);
+            (scene.options.times.last().copied(), v, g, Vec::new())
         }
         ResponseKind::ValueAt { .. } | ResponseKind::Crossing { .. } if energies => {
             return Err(Error::numerical(
@@ -97,8 +95,13 @@ fn evaluate(
             ))
         }
         ResponseKind::ValueAt { time } => {
-            let (v, g) = value_at(series, time)
-                .ok_or_else(|| fail(format!("time {time} s is outside the output times")))?;
+            let (_, v, g) = end.continuous.value_at(k).ok_or_else(|| {
+                let (t0, t1) = (scene.options.t0, scene.options.times.last().copied());
+                fail(format!(
+                    "time {time} s is outside the run (t = {t0} s to {} s)",
+                    t1.unwrap_or(t0)
+                ))
+            })?;
             (Some(time), v, g, Vec::new())
         }
         ResponseKind::Crossing { level, direction } => {

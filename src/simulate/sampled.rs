@@ -1,5 +1,4 @@
-//! A response at one state, the responses read from the output samples,
-//! and frequency responses.
+//! A response at one state, and frequency responses.
 //!
 //! A response in the sampled form `scale · Σ y_i` over scalar outputs
 //! ([`crate::scene::ScalarOutput`]) is evaluated at a state with its
@@ -9,10 +8,8 @@
 //! `sensitivities.csv`; one in the energy form is the sum of its energies
 //! with their lanes ([`crate::mbs::responses::energy_lanes`])
 //! ([`response_lanes`]). Joint angles are unwrapped as in `history.csv`.
-//! A value at a time and a final value of outputs are read from their
-//! series at the output times (`super::responses`, through
-//! [`crate::mbs::series`]); peaks, crossings and integrals of outputs are
-//! read on the continuous solution (`super::continuous`).
+//! The responses over time are read on the continuous solution with it
+//! (`super::continuous`).
 //!
 //! A frequency response is `f_k = scale · √λ_k / (2π)` of a flexible
 //! body's basis, with `df_k/dp = scale · (dλ_k/dp) / (4π √λ_k)` for a
@@ -23,7 +20,6 @@
 
 use crate::error::{Error, Result};
 use crate::mbs::responses::{energy_lanes, ResponseKind, ResponseValue};
-use crate::mbs::series::Sample;
 use crate::mbs::{Energy, Param, System, Workspace};
 use crate::scene::{QuantityKind, Response, ScalarOutput, Scene};
 use num_dual::Dual64;
@@ -87,14 +83,6 @@ fn output_lanes(
     (value, grad)
 }
 
-/// Whether a response is read from its output samples: a value at a time
-/// and a final value of outputs. Peaks, crossings and integrals of
-/// outputs are read on the continuous solution (`super::continuous`); an
-/// integral or final value of energies is read at the end state.
-fn is_sampled(r: &Response) -> bool {
-    !r.outputs.is_empty() && matches!(r.kind, ResponseKind::ValueAt { .. } | ResponseKind::Final)
-}
-
 /// The sensitivity lanes `(∂y/∂p_i, p_i)` of the lane-major `s` (state
 /// length `n`); none when `s` is empty.
 pub fn lanes_of<'a>(params: &[(String, Param)], s: &'a [f64], n: usize) -> Vec<(&'a [f64], Param)> {
@@ -140,51 +128,6 @@ pub fn response_lanes(
     }
     let s = r.scale;
     (s * value, grad.iter().map(|g| s * g).collect())
-}
-
-/// The series of the scene's responses read from the output samples
-/// (`is_sampled`), filled at the output times.
-#[derive(Debug, Default)]
-pub struct Sampler {
-    /// Per response of the scene: its samples (empty for a response not
-    /// read from samples).
-    series: Vec<Vec<Sample>>,
-    /// Per response and output: the previous value (angle unwrapping).
-    prev: Vec<Vec<Option<f64>>>,
-}
-
-impl Sampler {
-    /// An empty sampler for `responses`.
-    pub fn new(responses: &[Response]) -> Sampler {
-        Sampler {
-            series: vec![Vec::new(); responses.len()],
-            prev: responses
-                .iter()
-                .map(|r| vec![None; r.outputs.len()])
-                .collect(),
-        }
-    }
-
-    /// Sample every response read from samples at `(t, y)` with its
-    /// lanes.
-    pub fn observe(
-        &mut self,
-        sys: &System,
-        responses: &[Response],
-        (t, y): (f64, &[f64]),
-        lanes: &[(&[f64], Param)],
-    ) {
-        for (k, r) in responses.iter().enumerate().filter(|(_, r)| is_sampled(r)) {
-            let (v, g) = response_lanes(sys, r, y, lanes, &mut self.prev[k]);
-            self.series[k].push((t, v, g));
-        }
-    }
-
-    /// The series of response `k` (empty for a response not read from
-    /// samples).
-    pub fn series(&self, k: usize) -> &[Sample] {
-        &self.series[k]
-    }
 }
 
 /// A frequency response of the built model (module doc): mode `j`

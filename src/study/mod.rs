@@ -48,11 +48,46 @@ pub struct Study {
     pub meta: StudyMeta,
 }
 
+/// The largest study file read (4 MiB): a study is a few hundred lines;
+/// a larger file is a mistake (a pasted table) that parsing, checking and
+/// copying into `manifest.json` would multiply.
+pub const MAX_STUDY_BYTES: u64 = 4 << 20;
+
 impl Study {
     /// Read and parse a study file.
     pub fn load(path: impl AsRef<Path>) -> Result<Study> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let refuse = |value: String, expected: &str| Error::Input {
+            file: path.display().to_string(),
+            key: String::new(),
+            value,
+            expected: expected.to_string(),
+        };
+        let size = std::fs::metadata(path)
+            .map_err(|e| Error::io(path, e))?
+            .len();
+        if size > MAX_STUDY_BYTES {
+            return Err(refuse(
+                format!("{size} bytes"),
+                &format!("a study file of at most {MAX_STUDY_BYTES} bytes (tables of values belong in CSV files)"),
+            ));
+        }
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            let before = &e.as_bytes()[..at];
+            let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+            let column = at
+                - before
+                    .iter()
+                    .rposition(|&b| b == b'\n')
+                    .map_or(0, |k| k + 1)
+                + 1;
+            refuse(
+                format!("byte {at} (line {line}, column {column})"),
+                "UTF-8 text (TOML files are UTF-8)",
+            )
+        })?;
         Study::parse(path, &text)
     }
 
@@ -165,21 +200,53 @@ impl Study {
     }
 }
 
-/// The dotted key of `path` inside section `key` (`scene.joints[2].axis`)
-/// and the TOML value there, if the document has one (a missing field has
-/// none).
 /// Serde's message turned into what the error's "expected ..." reads:
 /// `unknown variant `x`, expected one of `a`, `b`` becomes
-/// `one of `a`, `b` (unknown variant `x`)`, and `missing field `m`` becomes
-/// `the field `m` (missing)`.
+/// `one of `a`, `b` (unknown variant `x`)`, with `; did you mean `a`?`
+/// when one name is near (at most a third of its letters off, at least
+/// two), and `missing field `m`` becomes `the field `m` (missing)`.
 fn expectation(msg: &str) -> String {
     if let Some((what, wanted)) = msg.rsplit_once(", expected ") {
-        format!("{wanted} ({what})")
+        let typed = what.split('`').nth(1).unwrap_or("");
+        match nearest(typed, wanted.split('`').skip(1).step_by(2)) {
+            Some(near) => format!("{wanted} ({what}; did you mean `{near}`?)"),
+            None => format!("{wanted} ({what})"),
+        }
     } else if let Some(field) = msg.strip_prefix("missing field ") {
         format!("the field {field} (missing)")
     } else {
         msg.to_string()
     }
+}
+
+/// The name of `names` nearest to `typed` by edit distance (Levenshtein:
+/// insertions, deletions, substitutions), when it is within
+/// `max(2, len/3)` edits.
+fn nearest<'a>(typed: &str, names: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    let t: Vec<char> = typed.to_lowercase().chars().collect();
+    let limit = (t.len() / 3).max(2);
+    names
+        .map(|n| (edits(&t, &n.to_lowercase().chars().collect::<Vec<_>>()), n))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, n)| n)
+}
+
+/// The edit distance between `a` and `b` (one row of the table at a time).
+fn edits(a: &[char], b: &[char]) -> usize {
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.iter().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let next = (row[j + 1] + 1)
+                .min(row[j] + 1)
+                .min(diagonal + usize::from(ca != cb));
+            diagonal = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
 }
 
 /// The key and value of the entry of `table` holding the unknown variant
@@ -373,6 +440,15 @@ mod tests {
         let (_, key, _, expected) = input_error(s.section::<Nested>("scene").unwrap_err());
         assert!(key.starts_with("scene.joints[0]"), "{key}");
         assert!(expected.contains("nmae"), "{expected}");
+        assert!(expected.contains("did you mean `name`?"), "{expected}");
+        // Nothing near: no suggestion.
+        let s = Study::parse(
+            "u.toml",
+            &joint("[0.0, 0.0, 1.0]").replace("name", "zzzzzz"),
+        )
+        .unwrap();
+        let (_, _, _, expected) = input_error(s.section::<Nested>("scene").unwrap_err());
+        assert!(!expected.contains("did you mean"), "{expected}");
     }
 
     #[test]
@@ -384,6 +460,27 @@ mod tests {
             e.contains("study.threads") && e.contains("thread count"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn non_utf8_and_oversized_files_are_refused_with_a_place() {
+        let dir = std::env::temp_dir().join(format!("plyscape-study-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bad = dir.join("latin1.toml");
+        std::fs::write(&bad, b"[study]\nname = \"caf\xe9\"\n").unwrap();
+        let e = Study::load(&bad).unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        let msg = e.to_string();
+        assert!(
+            msg.contains("byte 19 (line 2, column 12)") && msg.contains("UTF-8"),
+            "{msg}"
+        );
+        let big = dir.join("big.toml");
+        let line = format!("# {}\n", "x".repeat(1 << 16));
+        std::fs::write(&big, line.repeat(80)).unwrap();
+        let msg = Study::load(&big).unwrap_err().to_string();
+        assert!(msg.contains("at most 4194304 bytes"), "{msg}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

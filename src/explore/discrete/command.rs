@@ -47,6 +47,18 @@ pub fn check(study: &Study) -> Result<()> {
     // The sets against the variables (names, bounds, steps), before any
     // section runs.
     let vars = crate::explore::problem::build::variables(study)?;
+    let generation = crate::optimize::cmaes::default_population(vars.len());
+    if section.cmaes_samples < generation {
+        return Err(study.error(
+            "discrete.cmaes_samples",
+            section.cmaes_samples,
+            format!(
+                "a budget of at least one CMA-ES generation: {generation} designs for {} \
+                 variables",
+                vars.len()
+            ),
+        ));
+    }
     Lattice::new(&vars, &section)
         .map(|_| ())
         .map_err(study.locate(""))

@@ -93,6 +93,7 @@ pub fn multistart_with(
         }),
     };
     ctx.manifest(&dir, "multistart", done)?;
+    every_run_failed(&report)?;
     if !ctx.quiet {
         print_optima(problem, &report);
     }
@@ -102,6 +103,24 @@ pub fn multistart_with(
         p.finish(ctx, &dir, problem, plan, &report)?;
     }
     Ok(report)
+}
+
+/// A multistart none of whose runs gave a result is a numerical failure
+/// (exit 3), with the first run's reason; its tables are written first.
+fn every_run_failed(report: &driver::Report) -> Result<()> {
+    if report.runs.is_empty() || report.runs.iter().any(|r| r.result.is_some()) {
+        return Ok(());
+    }
+    let first = &report.runs[0];
+    Err(Error::numerical(
+        "explore::multistart",
+        format!(
+            "every one of the {} runs failed (runs.csv); start {}: {}",
+            report.runs.len(),
+            first.start,
+            first.exit
+        ),
+    ))
 }
 
 /// `[multistart] noise`: the allowance given, or ECNoise's at the first

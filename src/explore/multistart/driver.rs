@@ -522,14 +522,16 @@ fn check_row(row: &RunRecord, starts: &[Vec<f64>], shard: Shard, path: &Path) ->
     if ok {
         Ok(())
     } else {
-        Err(Error::csv(
-            path,
-            format!(
-                "row for start {} (x0 = {:?}) is not a start of this study/shard; \
-                 the study changed since: rerun without --resume",
-                row.start, row.x0
-            ),
-        ))
+        // The study changed (its seed, sampler, starts or points): bad
+        // input for a resume (exit 2), not a damaged table.
+        Err(Error::Input {
+            file: path.display().to_string(),
+            key: format!("start {}", row.start),
+            value: format!("x0 = {:?}", row.x0),
+            expected: "a start of this study/shard: the study changed since (its seed, \
+                       sampler, starts or points); rerun without --resume"
+                .into(),
+        })
     }
 }
 

@@ -84,12 +84,42 @@ pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<driver::Report
     };
     ctx.manifest(&dir, "merge", entry)?;
     if !quiet {
+        println!(
+            "merged {} shards into {} (runs.csv, optima.csv, manifest.json)",
+            dirs.len(),
+            dir.display()
+        );
         print_optima(problem.as_ref(), &report);
     }
     // `[robustness]`: the merged optima.csv again with the worst-case
     // columns, as an unsharded run writes it.
     super::robustness::apply(&ctx, problem.as_ref(), &report.optima, &dir)?;
     Ok(report)
+}
+
+/// The error for a directory without a manifest: it names the shard
+/// directories below it when there are any (a study's folder or a
+/// results root given instead of its shards).
+fn not_a_shard(d: &Path) -> Error {
+    let mut below: Vec<String> = std::fs::read_dir(d)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.join("manifest.json").is_file())
+        .map(|p| p.display().to_string())
+        .collect();
+    below.sort();
+    let expected = if below.is_empty() {
+        "a shard directory (`results/STUDY/shard-I-of-N`, with its manifest.json)".to_string()
+    } else {
+        format!(
+            "a shard directory, not a folder of them: name the shards, \
+             `plyscape merge {}`",
+            below.join(" ")
+        )
+    };
+    Error::input(d.display().to_string(), "(no manifest.json)", expected)
 }
 
 /// The study text, study file name and shard count shared by the shard
@@ -100,6 +130,9 @@ fn shard_manifests(dirs: &[PathBuf]) -> Result<(String, String, usize, Vec<usize
     let mut first: Option<(String, String, usize)> = None;
     let mut seen = Vec::new();
     for d in dirs {
+        if !d.join("manifest.json").is_file() {
+            return Err(not_a_shard(d));
+        }
         let m = Manifest::read(d)?;
         let t = m.study_text.clone();
         let Some(ShardRecord { index: i, count: n }) = m.shard else {

@@ -103,6 +103,13 @@ pub(crate) struct Ties {
     pub scale: Vec<f64>,
 }
 
+/// The range of a ply-thickness variable's bounds (mm): from 1 µm to
+/// 25 mm, about 200 times either way around the 0.125 mm of a
+/// carbon/epoxy prepreg ply. Outside it the input is a slip of units or
+/// of digits (a thickness in metres, a bound of 1e6), and every
+/// evaluation would fail deep inside the modal analysis.
+pub const PLY_THICKNESS_MM: (f64, f64) = (1e-3, 25.0);
+
 /// Metres per unit of a ply-thickness variable (mm).
 pub(crate) const THICKNESS_UNIT: f64 = 1e-3;
 
@@ -198,12 +205,16 @@ impl Ties {
                         .into(),
                 ));
             }
-            if kind == Kind::Thickness && !(v.bounds[0] > 0.0 && v.bounds[0].is_finite()) {
+            let (lo, hi) = PLY_THICKNESS_MM;
+            if kind == Kind::Thickness && !(v.bounds[0] >= lo && v.bounds[1] <= hi) {
                 return Err(problem_error(
                     study,
                     format!("{key}.bounds"),
-                    format!("{:?}", v.bounds),
-                    "a finite lower bound > 0 mm for a ply thickness".into(),
+                    format!("[{}, {}]", v.bounds[0], v.bounds[1]),
+                    format!(
+                        "bounds within [{lo}, {hi}] mm for a ply thickness (the variable \
+                         is in millimetres: a 0.125 mm ply is 0.125, not 0.000125)"
+                    ),
                 ));
             }
             ties.vars.push(variable(study, &key, v)?);

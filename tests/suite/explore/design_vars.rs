@@ -121,6 +121,25 @@ fn ply_thickness_variables_have_exact_gradients() {
     // Thicker outer plies change Ψ₀ (the variable reaches the laminate).
     let e = p.evaluate(&x, true).unwrap();
     assert!(e.grad_f.unwrap()[2].abs() > 1e-3, "df/dt");
+    // Bounds outside [0.001, 25] mm are refused naming the unit: a
+    // thickness in metres, and a bound of 1e6 mm (every evaluation would
+    // fail in the modal analysis).
+    for bounds in ["[0.0001, 0.002]", "[0.1, 1e6]"] {
+        let bad = replace(
+            &text,
+            "bounds = [0.1, 2.0]",
+            &format!("bounds = {bounds}"),
+            1,
+        );
+        let e = match build(&bad) {
+            Ok(_) => panic!("accepted {bounds}"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.contains("scene_problem.variables[2].bounds") && e.contains("millimetres"),
+            "{e}"
+        );
+    }
 }
 
 #[test]

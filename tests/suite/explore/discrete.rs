@@ -111,8 +111,8 @@ fn constrained_discrete_designs_are_feasible_and_on_the_set() {
 /// Every `[discrete]` set and the `[robustness]` length are checked with
 /// the study, before any section runs (before, only after the whole
 /// multistart): a periodic step that does not divide the period, a step
-/// giving 1.8e11 values, an unknown variable, and a tolerance list of
-/// the wrong length.
+/// giving 1.8e11 values, an unknown variable, a tolerance list of the
+/// wrong length, and a CMA-ES budget below one generation.
 #[test]
 fn discrete_sets_and_robustness_are_checked_before_anything_runs() {
     let base = "[study]\nname = \"p2\"\n[problem]\nname = \"periodic2\"\n\
@@ -140,6 +140,16 @@ fn discrete_sets_and_robustness_are_checked_before_anything_runs() {
             "[robustness]\ntolerance = [1.0]\n".to_string(),
             "robustness.tolerance",
             "2 tolerances",
+        ),
+        // Fewer designs than one CMA-ES generation (6 for 2 variables):
+        // named with the section's own key, not CMA-ES's budget.
+        (
+            format!(
+                "[discrete]\ncmaes_samples = 1\n{}",
+                var("theta1_deg", "15.0")
+            ),
+            "discrete.cmaes_samples",
+            "6 designs for 2 variables",
         ),
     ] {
         let s = study("p2", &format!("{base}{extra}"));

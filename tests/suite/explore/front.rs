@@ -13,6 +13,7 @@ fn run(study: &Study, out: &std::path::Path, threads: usize) {
         threads,
         quiet: true,
         force: false,
+        resume: false,
     };
     run_study(&cfg).unwrap_or_else(|e| panic!("{}: {e}", study.path.display()));
 }

@@ -28,6 +28,90 @@ fn plyscape(args: &[&str]) -> Command {
     c
 }
 
+/// Spawn `cmd`, kill it once `runs` holds 3 rows (or after 120 s), and
+/// return the rows on disk at the kill; the child must still have been
+/// running.
+fn kill_after_rows(mut cmd: Command, runs: &std::path::Path) -> usize {
+    let mut child = cmd.spawn().unwrap();
+    let t0 = Instant::now();
+    // Kill once a few rows (header + 3) are on disk.
+    loop {
+        let lines = std::fs::read_to_string(runs).map_or(0, |t| t.lines().count());
+        if lines >= 4 || t0.elapsed() > Duration::from_secs(120) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let waited = t0.elapsed();
+    child.kill().unwrap();
+    let killed = child.wait().unwrap();
+    // Killed by the signal, not finished: the child was still running.
+    assert!(!killed.success(), "the child finished before the kill");
+    let rows_at_kill = std::fs::read_to_string(runs).unwrap().lines().count() - 1;
+    println!("killed after {waited:?} with {rows_at_kill} runs on disk");
+    rows_at_kill
+}
+
+/// `plyscape run` killed in its multistart continues with `run --resume`:
+/// the multistart from its rows, the CMA-ES stage after it again, and
+/// every table equals an uninterrupted run's.
+#[test]
+fn killed_run_resumes_to_the_same_tables() {
+    let tmp = temp_dir("kill-run");
+    let dir = tmp.path().to_path_buf();
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, format!("{text}[evolve]\nmax_evaluations = 300\n")).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let (study, slow) = (write("k.toml", STUDY), write("slow.toml", SLOW));
+    let (full, part) = (dir.join("full"), dir.join("part"));
+    let (full_s, part_s) = (full.to_str().unwrap(), part.to_str().unwrap());
+    let st = plyscape(&["run", &study, "--out", full_s, "--threads", "2", "-q"])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let rows = kill_after_rows(
+        plyscape(&["run", &slow, "--out", part_s, "--threads", "2", "-q"]),
+        &part.join("k/runs.csv"),
+    );
+    assert!((3..24).contains(&rows), "{rows} rows at kill");
+    let out = plyscape(&[
+        "run",
+        &study,
+        "--out",
+        part_s,
+        "--threads",
+        "1",
+        "--resume",
+        "-q",
+    ])
+    .output()
+    .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in ["runs.csv", "optima.csv", "evolution.csv"] {
+        assert_eq!(
+            table_without(&full.join("k").join(f), &["wall_seconds"]),
+            table_without(&part.join("k").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(part.join("k/manifest.json")).unwrap())
+            .unwrap();
+    assert_eq!(m["commands"]["multistart"]["resume"], true);
+    assert!(
+        m["commands"]["multistart"]["runs_this_invocation"]
+            .as_u64()
+            .unwrap()
+            <= 21
+    );
+}
+
 #[test]
 fn killed_multistart_resumes_to_the_same_tables() {
     let tmp = temp_dir("kill");
@@ -45,26 +129,11 @@ fn killed_multistart_resumes_to_the_same_tables() {
         .unwrap();
     assert!(st.success());
 
-    let mut child = plyscape(&["multistart", slow, "--out", part_s, "--threads", "2", "-q"])
-        .spawn()
-        .unwrap();
     let runs = part.join("k/runs.csv");
-    let t0 = Instant::now();
-    // Kill once a few rows (header + 3) are on disk.
-    loop {
-        let lines = std::fs::read_to_string(&runs).map_or(0, |t| t.lines().count());
-        if lines >= 4 || t0.elapsed() > Duration::from_secs(120) {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    let waited = t0.elapsed();
-    child.kill().unwrap();
-    let killed = child.wait().unwrap();
-    // Killed by the signal, not finished: the child was still running.
-    assert!(!killed.success(), "the child finished before the kill");
-    let rows_at_kill = std::fs::read_to_string(&runs).unwrap().lines().count() - 1;
-    println!("killed after {waited:?} with {rows_at_kill} runs on disk");
+    let rows_at_kill = kill_after_rows(
+        plyscape(&["multistart", slow, "--out", part_s, "--threads", "2", "-q"]),
+        &runs,
+    );
     assert!(
         (3..24).contains(&rows_at_kill),
         "{rows_at_kill} rows at kill"

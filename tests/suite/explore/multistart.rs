@@ -181,7 +181,9 @@ fn resume_after_a_kill_gives_the_uninterrupted_tables() {
     // Resuming with a changed study is refused, not mixed.
     let other = study("h", &himmelblau(20, "").replace("seed = 11", "seed = 12"));
     let e = explore::run_multistart(&ctx(&other, &part, 1, flags)).unwrap_err();
-    assert!(e.to_string().contains("not a start of this study"), "{e}");
+    assert!(e.to_string().contains("a start of this study"), "{e}");
+    // The study changed: bad input (exit 2), not a damaged table (4).
+    assert_eq!(e.exit_code(), 2, "{e}");
 }
 
 #[test]
@@ -390,6 +392,7 @@ fn a_bad_late_section_is_refused_before_any_work() {
             threads: 1,
             quiet: true,
             force: false,
+            resume: false,
         };
         let e = plyscape::cli::run_study(&cfg).unwrap_err().to_string();
         assert!(e.starts_with("late.toml") && e.contains(key), "{e}");

@@ -17,6 +17,7 @@ fn run(study: &Study, out: &std::path::Path) {
         threads: 2,
         quiet: true,
         force: false,
+        resume: false,
     };
     run_study(&cfg).unwrap_or_else(|e| panic!("{}: {e}", study.path.display()));
 }

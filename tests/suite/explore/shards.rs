@@ -113,5 +113,14 @@ fn merge_is_strict_and_read_only() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("unsharded"), "{e}");
+    // The study's folder instead of its shards: refused as bad input,
+    // naming the shards to give.
+    let e = explore::merge(&[dir.join("h")], &dir, true).unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    let e = e.to_string();
+    assert!(
+        e.contains("name the shards") && e.contains("shard-0-of-2"),
+        "{e}"
+    );
     explore::merge(&dirs, &dir, true).unwrap();
 }

@@ -13,6 +13,7 @@ fn run(file: &str, out: &std::path::Path) -> Study {
         threads: 2,
         quiet: true,
         force: false,
+        resume: false,
     };
     run_study(&cfg).unwrap_or_else(|e| panic!("{file}: {e}"));
     study

@@ -54,6 +54,7 @@ fn shipped_scene_studies_run_and_write_history() {
             threads: 1,
             quiet: true,
             force: false,
+            resume: false,
         };
         run_study(&cfg).unwrap_or_else(|e| panic!("{file}: {e}"));
         let dir = out.join(study.name());
