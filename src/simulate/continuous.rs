@@ -4,14 +4,15 @@
 //! samples, so they do not depend on `dt_out`.
 //!
 //! - **Peak** (largest or smallest value, both forms): the response is
-//!   evaluated at `NODES + 1` equally spaced points of every accepted step
-//!   (the step's ends included). Each local extreme of that node sequence
-//!   is refined by Brent's method on the step's interpolant over the two
-//!   node intervals beside it, then by one Newton step on `U̇ = 0` with
-//!   central differences of the interpolant (`polish`); a node at a
-//!   step's end is refined on both sides, the earlier side while its step
-//!   is still at hand. The run's
-//!   ends count when the response falls away from them. The value and its
+//!   evaluated at the ends and the middle of every accepted step. Each
+//!   local extreme of that node sequence is refined by Brent's method on
+//!   the step's interpolant over the node intervals beside it, then by one
+//!   Newton step on `U̇ = 0` with central differences of the interpolant
+//!   (`polish`). A step that ends rising is probed just before its end:
+//!   falling there, the extreme is in its last interval and is refined
+//!   while its interpolant is at hand; rising, it is in the next step or
+//!   at the run's end. The run's ends count when the response falls away
+//!   from them. The value and its
 //!   gradient are taken at the refined time `t*` from the interpolated
 //!   state and sensitivities: `dU*/dp = ∂U/∂y · s(t*) + ∂U/∂p`, the
 //!   envelope theorem (`U̇(t*) = 0`, or `t*` an end of the run). All local
@@ -49,7 +50,7 @@ use crate::scene::Response;
 
 /// Node intervals per accepted step at which a peak or a crossing is
 /// sought.
-const NODES: usize = 4;
+const NODES: usize = 2;
 
 /// What a run leaves of each response read on the continuous solution.
 #[derive(Debug, Default)]
@@ -98,11 +99,13 @@ impl At<'_> {
         Ok((t, v, g))
     }
 
-    /// The response's values at the nodes of `step` (signed by `sign`).
+    /// The response's values at the nodes of `step` (signed by `sign`);
+    /// `first` is the value at the step's start when it is known (the
+    /// previous step's end: the state is continuous there).
     fn nodes(
         &self,
         step: &Step<'_>,
-        sign: f64,
+        (sign, first): (f64, Option<f64>),
         unwrap: &mut [Option<f64>],
     ) -> Result<([f64; NODES + 1], [f64; NODES + 1])> {
         let (a, b) = step.span;
@@ -114,7 +117,10 @@ impl At<'_> {
             } else {
                 a + (b - a) * j as f64 / NODES as f64
             };
-            ws[j] = sign * self.value(step, ts[j], unwrap)?;
+            ws[j] = match first.filter(|_| j == 0) {
+                Some(w) => w,
+                None => sign * self.value(step, ts[j], unwrap)?,
+            };
         }
         Ok((ts, ws))
     }
@@ -182,10 +188,11 @@ impl Continuous {
     }
 
     /// The local extremes of peak response `k`, the extreme first (empty
-    /// when no step was taken).
-    pub fn extremes(&self, k: usize) -> Vec<Sample> {
+    /// when no step was taken); `end` gives the response at the run's end
+    /// with its gradient, asked for only when the response rises to it.
+    pub fn extremes(&self, k: usize, end: impl FnOnce() -> Sample) -> Vec<Sample> {
         match &self.tracks[k] {
-            Some(Track::Peak(p)) => p.extremes(),
+            Some(Track::Peak(p)) => p.extremes(p.rises_at_end.then(end)),
             _ => Vec::new(),
         }
     }
@@ -207,9 +214,9 @@ impl Continuous {
         }
     }
 
-    /// The final value of outputs of response `k` at the end state `y`
-    /// with its gradient along `lanes` (the angles unwrapped over the run's
-    /// steps).
+    /// Response `k` (a final value or a peak of outputs or of energies)
+    /// at the end state `y` with its gradient along `lanes` (the angles
+    /// unwrapped over the run's steps).
     pub fn final_value(
         &self,
         (sys, r, k): (&System, &Response, usize),
@@ -218,6 +225,7 @@ impl Continuous {
     ) -> (f64, Vec<f64>) {
         let mut unwrap = match &self.tracks[k] {
             Some(Track::Final(u)) => u.clone(),
+            Some(Track::Peak(p)) => p.unwrap.clone(),
             _ => vec![None; r.outputs.len()],
         };
         response_lanes(sys, r, y, lanes, &mut unwrap)
@@ -237,11 +245,15 @@ impl Continuous {
 struct PeakTrack {
     /// +1 for the largest value, −1 for the smallest.
     sign: f64,
-    /// The signed value at the node before the last step's end.
-    left: Option<f64>,
-    /// The extreme over the last node interval of the previous step, when
-    /// the response rose (signed) to that step's end.
-    pending: Option<Sample>,
+    /// The signed values at the last two nodes of the previous step (the
+    /// one before its end, and its end).
+    last: Option<(f64, f64)>,
+    /// Whether the previous step ended rising after a local extreme
+    /// already refined in it: its end is then no extreme.
+    refined_before_end: bool,
+    /// Whether the response rises (signed) at the last step's end: the
+    /// end of the run is then a candidate.
+    rises_at_end: bool,
     /// The refined local extremes (signed).
     found: Vec<Sample>,
     /// The response at the start of the run (a response constant over the
@@ -259,41 +271,61 @@ impl PeakTrack {
         };
         PeakTrack {
             sign,
-            left: None,
-            pending: None,
+            last: None,
+            refined_before_end: false,
+            rises_at_end: false,
             found: Vec::new(),
             start: None,
             unwrap,
         }
     }
 
+    /// One step: every node that is a local extreme of the node sequence
+    /// is refined over the node intervals beside it in this step. A step
+    /// that ends rising is probed just before its end: falling there, the
+    /// extreme lies in its last interval and is refined now (its
+    /// interpolant is gone afterwards); rising, the next step holds it
+    /// (its first node is then a local extreme of the sequence), or the
+    /// run's end does.
     fn step(&mut self, at: &At<'_>, step: &Step<'_>) -> Result<()> {
         if self.start.is_none() {
             let s = at.sample(step, step.span.0, &mut self.unwrap.clone())?;
             self.start = Some(self.signed(s));
         }
-        let (ts, ws) = at.nodes(step, self.sign, &mut self.unwrap)?;
-        let pending = self.pending.take();
+        let first = self.last.map(|l| l.1);
+        let (ts, ws) = at.nodes(step, (self.sign, first), &mut self.unwrap)?;
         for j in 0..NODES {
-            let left = if j == 0 { self.left } else { Some(ws[j - 1]) };
+            let left = if j == 0 {
+                self.last.map(|l| l.0)
+            } else {
+                Some(ws[j - 1])
+            };
             if left.is_some_and(|l| l > ws[j]) || ws[j] <= ws[j + 1] {
                 continue;
             }
-            let lo = ts[j.saturating_sub(1)];
-            let mut best = self.refine(at, step, (lo, ts[j + 1]))?;
-            if let Some(p) = pending.as_ref().filter(|_| j == 0) {
-                if p.1 > best.1 {
-                    best = p.clone();
-                }
+            if j == 0 && self.refined_before_end {
+                continue;
             }
-            self.found.push(best);
+            let lo = ts[j.saturating_sub(1)];
+            let found = self.refine(at, step, (lo, ts[j + 1]))?;
+            self.found.push(found);
         }
-        self.pending = if ws[NODES] > ws[NODES - 1] {
-            Some(self.refine(at, step, (ts[NODES - 1], ts[NODES]))?)
-        } else {
-            None
-        };
-        self.left = Some(ws[NODES - 1]);
+        let (a, b) = step.span;
+        let (before, end) = (ws[NODES - 1], ws[NODES]);
+        self.refined_before_end = false;
+        self.rises_at_end = false;
+        if end > before {
+            let probe = b - 1e-6 * (b - a);
+            let w = self.sign * at.value(step, probe, &mut self.unwrap.clone())?;
+            if w > end {
+                let found = self.refine(at, step, (ts[NODES - 1], b))?;
+                self.found.push(found);
+                self.refined_before_end = true;
+            } else {
+                self.rises_at_end = true;
+            }
+        }
+        self.last = Some((before, end));
         Ok(())
     }
 
@@ -326,11 +358,12 @@ impl PeakTrack {
     }
 
     /// The local extremes in the response's own sign, the extreme first,
-    /// then by decreasing (signed) value.
-    fn extremes(&self) -> Vec<Sample> {
+    /// then by decreasing (signed) value; `end` is the response at the
+    /// run's end (a candidate when it rises to it).
+    fn extremes(&self, end: Option<Sample>) -> Vec<Sample> {
         let mut all = self.found.clone();
-        if let Some(p) = &self.pending {
-            all.push(p.clone());
+        if self.rises_at_end {
+            all.extend(end.map(|s| self.signed(s)));
         }
         if all.is_empty() {
             all.extend(self.start.clone());
@@ -377,7 +410,7 @@ impl CrossTrack {
         if self.found.is_some() {
             return Ok(());
         }
-        let (ts, vs) = at.nodes(step, 1.0, &mut self.unwrap)?;
+        let (ts, vs) = at.nodes(step, (1.0, None), &mut self.unwrap)?;
         for v in vs {
             self.range = (self.range.0.min(v), self.range.1.max(v));
         }

@@ -70,7 +70,13 @@ fn evaluate(
             (None, v, g, Vec::new())
         }
         ResponseKind::Peak { .. } => {
-            let critical = end.continuous.extremes(k);
+            let at_end = || {
+                let lanes = lanes_of(&scene.params, end.s_end, end.y_end.len());
+                let t = scene.options.times.last().copied().unwrap_or(0.0);
+                let (v, g) = end.continuous.final_value((sys, r, k), end.y_end, &lanes);
+                (t, v, g)
+            };
+            let critical = end.continuous.extremes(k, at_end);
             let (t, value, gradient) = critical.first().cloned().ok_or_else(none)?;
             (Some(t), value, gradient, critical)
         }
