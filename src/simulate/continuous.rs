@@ -25,7 +25,11 @@
 //!   of the interpolant, found by bisection to the rounding of `t`;
 //!   `dt*/dp = −(∂y/∂p)(t*) / ẏ(t*)` (implicit function theorem), with the
 //!   slope `ẏ(t*)` a central difference of the interpolant over
-//!   `10⁻⁶` of the step (error `O(10⁻¹² h²)` relative).
+//!   `10⁻⁶` of the step (error `O(10⁻¹² h²)` relative). A level not
+//!   reached by the end gives the time extrapolated beyond it at the mean
+//!   rate the level asks from the start (`CrossTrack::result`):
+//!   continuous where the crossing leaves the run, so such a design is
+//!   infeasible under a bound on the time, not a failed run.
 //! - **Value at a time** of outputs: the interpolant of the step that
 //!   holds the time, with the interpolated sensitivities (exact at any
 //!   time, not only at an output time).
@@ -197,10 +201,12 @@ impl Continuous {
         }
     }
 
-    /// The first crossing of crossing response `k`.
-    pub fn crossing(&self, k: usize) -> Option<CrossingResult> {
+    /// The first crossing of crossing response `k`, or its time
+    /// extrapolated beyond the run's end when the level is not reached
+    /// (`CrossTrack::result`; `end` gives the response at the end).
+    pub fn crossing(&self, k: usize, end: impl FnOnce() -> Sample) -> Option<CrossingResult> {
         match &self.tracks[k] {
-            Some(Track::Crossing(c)) => Some(c.result()),
+            Some(Track::Crossing(c)) => Some(c.result(end)),
             _ => None,
         }
     }
@@ -226,6 +232,7 @@ impl Continuous {
         let mut unwrap = match &self.tracks[k] {
             Some(Track::Final(u)) => u.clone(),
             Some(Track::Peak(p)) => p.unwrap.clone(),
+            Some(Track::Crossing(c)) => c.unwrap.clone(),
             _ => vec![None; r.outputs.len()],
         };
         response_lanes(sys, r, y, lanes, &mut unwrap)
@@ -382,6 +389,8 @@ struct CrossTrack {
     found: Option<CrossingResult>,
     /// The range of the response over the nodes so far.
     range: (f64, f64),
+    /// The run's start time and the response's value there.
+    first: Option<(f64, f64)>,
     unwrap: Vec<Option<f64>>,
 }
 
@@ -392,6 +401,7 @@ impl CrossTrack {
             dir,
             found: None,
             range: (f64::INFINITY, f64::NEG_INFINITY),
+            first: None,
             unwrap,
         }
     }
@@ -411,6 +421,7 @@ impl CrossTrack {
             return Ok(());
         }
         let (ts, vs) = at.nodes(step, (1.0, None), &mut self.unwrap)?;
+        self.first.get_or_insert((ts[0], vs[0]));
         for v in vs {
             self.range = (self.range.0.min(v), self.range.1.max(v));
         }
@@ -450,10 +461,43 @@ impl CrossTrack {
         Ok(())
     }
 
-    fn result(&self) -> CrossingResult {
-        self.found
-            .clone()
-            .unwrap_or(Err(NoCrossing::Never(self.range.0, self.range.1)))
+    /// The first crossing; when the level is not reached by the end
+    /// (`end`: time, value and gradient there) on the asked side, the
+    /// crossing time extrapolated at the mean rate the level asks from
+    /// the start, `r = |L − y(t₀)| / (t_end − t₀)` (held fixed):
+    /// `t* = t_end + |L − y(t_end)| / r`, with `dt*/dp = ∓(∂y/∂p)(t_end)/r`.
+    /// It is continuous where the crossing leaves the run (`t* → t_end`),
+    /// so a design that does not reach the level is a value of the
+    /// response, beyond `t_end` (a bound on it is then violated, the run
+    /// is not failed).
+    fn result(&self, end: impl FnOnce() -> Sample) -> CrossingResult {
+        let never = Err(NoCrossing::Never(self.range.0, self.range.1));
+        if let Some(found) = &self.found {
+            return found.clone();
+        }
+        let Some((t0, v0)) = self.first else {
+            return never;
+        };
+        let (t_end, v, g) = end();
+        let short = match self.dir {
+            Direction::Up => self.level - v,
+            Direction::Down => v - self.level,
+            Direction::Either => (self.level - v).abs(),
+        };
+        let rate = (self.level - v0).abs() / (t_end - t0);
+        if !(short > 0.0 && rate > 0.0 && rate.is_finite()) {
+            return never;
+        }
+        // ∂(short)/∂p = ∓ ∂y/∂p.
+        let side = match self.dir {
+            Direction::Up => -1.0,
+            Direction::Down => 1.0,
+            Direction::Either => -(self.level - v).signum(),
+        };
+        Ok((
+            t_end + short / rate,
+            g.iter().map(|gi| side * gi / rate).collect(),
+        ))
     }
 }
 

@@ -59,6 +59,14 @@ fn evaluate(
         Error::numerical("simulate: responses", format!("response {name}: {detail}"))
     };
     let none = || fail("no samples (no output times or no step)".into());
+    // The response at the end state, with its gradient (a peak that rises
+    // to the end; a crossing not reached by it).
+    let at_end = || {
+        let lanes = lanes_of(&scene.params, end.s_end, end.y_end.len());
+        let t = scene.options.times.last().copied().unwrap_or(0.0);
+        let (v, g) = end.continuous.final_value((sys, r, k), end.y_end, &lanes);
+        (t, v, g)
+    };
     let (time, value, gradient, critical) = match r.kind {
         ResponseKind::Frequency { body, mode } => return frequency(sys, r, (body, mode), params),
         ResponseKind::Integral if energies => {
@@ -70,12 +78,6 @@ fn evaluate(
             (None, v, g, Vec::new())
         }
         ResponseKind::Peak { .. } => {
-            let at_end = || {
-                let lanes = lanes_of(&scene.params, end.s_end, end.y_end.len());
-                let t = scene.options.times.last().copied().unwrap_or(0.0);
-                let (v, g) = end.continuous.final_value((sys, r, k), end.y_end, &lanes);
-                (t, v, g)
-            };
             let critical = end.continuous.extremes(k, at_end);
             let (t, value, gradient) = critical.first().cloned().ok_or_else(none)?;
             (Some(t), value, gradient, critical)
@@ -111,10 +113,11 @@ fn evaluate(
             (Some(time), v, g, Vec::new())
         }
         ResponseKind::Crossing { level, direction } => {
-            let (t, g) =
-                end.continuous.crossing(k).ok_or_else(none)?.map_err(|e| {
-                    fail(no_crossing(r, &scene.options.times, e, (level, direction)))
-                })?;
+            let (t, g) = end
+                .continuous
+                .crossing(k, at_end)
+                .ok_or_else(none)?
+                .map_err(|e| fail(no_crossing(r, &scene.options.times, e, (level, direction))))?;
             (Some(t), t, g, Vec::new())
         }
     };

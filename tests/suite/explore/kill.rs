@@ -52,6 +52,39 @@ fn kill_after_rows(mut cmd: Command, runs: &std::path::Path) -> usize {
     rows_at_kill
 }
 
+/// Run `command study --resume` on one thread into `part` and compare
+/// `files` of study `k` with the uninterrupted run's in `full`.
+fn resume_to_the_same_tables(
+    [command, study]: [&str; 2],
+    (full, part): (&std::path::Path, &std::path::Path),
+    files: &[&str],
+) {
+    let part_s = part.to_str().unwrap();
+    let args = [
+        command,
+        study,
+        "--out",
+        part_s,
+        "--threads",
+        "1",
+        "--resume",
+        "-q",
+    ];
+    let out = plyscape(&args).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in files {
+        assert_eq!(
+            table_without(&full.join("k").join(f), &["wall_seconds"]),
+            table_without(&part.join("k").join(f), &["wall_seconds"]),
+            "{f}"
+        );
+    }
+}
+
 /// `plyscape run` killed in its multistart continues with `run --resume`:
 /// the multistart from its rows, the CMA-ES stage after it again, and
 /// every table equals an uninterrupted run's.
@@ -76,30 +109,11 @@ fn killed_run_resumes_to_the_same_tables() {
         &part.join("k/runs.csv"),
     );
     assert!((3..24).contains(&rows), "{rows} rows at kill");
-    let out = plyscape(&[
-        "run",
-        &study,
-        "--out",
-        part_s,
-        "--threads",
-        "1",
-        "--resume",
-        "-q",
-    ])
-    .output()
-    .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    resume_to_the_same_tables(
+        ["run", &study],
+        (&full, &part),
+        &["runs.csv", "optima.csv", "evolution.csv"],
     );
-    for f in ["runs.csv", "optima.csv", "evolution.csv"] {
-        assert_eq!(
-            table_without(&full.join("k").join(f), &["wall_seconds"]),
-            table_without(&part.join("k").join(f), &["wall_seconds"]),
-            "{f}"
-        );
-    }
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(part.join("k/manifest.json")).unwrap())
             .unwrap();
@@ -139,30 +153,11 @@ fn killed_multistart_resumes_to_the_same_tables() {
         "{rows_at_kill} rows at kill"
     );
 
-    let out = plyscape(&[
-        "multistart",
-        study,
-        "--out",
-        part_s,
-        "--threads",
-        "1",
-        "--resume",
-        "-q",
-    ])
-    .output()
-    .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    resume_to_the_same_tables(
+        ["multistart", study],
+        (&full, &part),
+        &["runs.csv", "optima.csv"],
     );
-    for f in ["runs.csv", "optima.csv"] {
-        assert_eq!(
-            table_without(&full.join("k").join(f), &["wall_seconds"]),
-            table_without(&part.join("k").join(f), &["wall_seconds"]),
-            "{f}"
-        );
-    }
     // The manifest records what was run.
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(part.join("k/manifest.json")).unwrap())
