@@ -140,9 +140,17 @@ impl Options {
             && self.times.windows(2).all(|w| w[1] > w[0])
             && self.times[self.times.len() - 1] > self.t0;
         if !ok {
+            let (first, last) = match (self.times.first(), self.times.last()) {
+                (Some(a), Some(b)) => (a.to_string(), b.to_string()),
+                _ => ("none".into(), "none".into()),
+            };
             return Err(Error::input(
                 "integrator.t_end",
-                format!("t0 = {}, outputs {:?}..", self.t0, self.times.first()),
+                format!(
+                    "t0 = {} s, {} output times from {first} s to {last} s",
+                    self.t0,
+                    self.times.len()
+                ),
                 "an end time > start time with increasing output times",
             ));
         }

@@ -112,3 +112,21 @@ fn piecewise_ramp_and_its_sensitivity_through_the_trait() {
         assert!((end - 3.0).abs() < 1e-8, "{method:?} y(2) = {end}");
     }
 }
+
+#[test]
+fn output_times_that_do_not_increase_are_named_plainly() {
+    let opts = Options {
+        method: Method::Tsit45,
+        rtol: 1e-6,
+        atol: 1e-8,
+        t0: 0.0,
+        times: vec![1.0, 0.5],
+        events: true,
+        sensitivity: SensitivityForm::Staggered,
+    };
+    let e = opts.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("2 output times from 1 s to 0.5 s") && !e.contains("Some("),
+        "{e}"
+    );
+}
