@@ -125,7 +125,21 @@ pub fn run_discrete(ctx: &Context) -> Result<Vec<DiscreteRow>> {
         let small = lattice
             .size()
             .is_some_and(|n| n <= section.exhaustive_limit);
+        // One line per stage on stderr (the stages run minutes on a
+        // scene, and print their results only at the end).
+        let stage = |what: String| {
+            if !ctx.quiet {
+                eprintln!(
+                    "discrete: {what} ({:.1} s so far)",
+                    t0.elapsed().as_secs_f64()
+                );
+            }
+        };
         if small {
+            stage(format!(
+                "exhaustive search over the {} designs of the set",
+                lattice.size().unwrap_or(0)
+            ));
             if let Some((all, found)) =
                 discrete::exhaustive(problem.as_ref(), &lattice, &cache, tol)?
             {
@@ -134,6 +148,10 @@ pub fn run_discrete(ctx: &Context) -> Result<Vec<DiscreteRow>> {
             }
         }
         for (id, x) in &optima {
+            stage(format!(
+                "optimum {id} of {}: rounded to the set, then a coordinate descent on it",
+                optima.len()
+            ));
             let (rounded, found) =
                 discrete::round_and_polish(problem.as_ref(), &lattice, &cache, x, tol)?;
             let once = Found {
@@ -144,6 +162,10 @@ pub fn run_discrete(ctx: &Context) -> Result<Vec<DiscreteRow>> {
             rows.push(row("rounded", Some(*id), &once));
             rows.push(row("rounded_polished", Some(*id), &found));
         }
+        stage(format!(
+            "CMA-ES on the set, {} designs asked for",
+            section.cmaes_samples
+        ));
         let found = discrete::cmaes_on_set(
             problem.as_ref(),
             &lattice,
