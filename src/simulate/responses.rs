@@ -4,7 +4,7 @@
 //! A sum of energies in the energy form ([`ResponseKind::energy_form`])
 //! is an integrated state (`integral`: its value at the end, its gradient
 //! the state's sensitivities at the end) or the sum at the end state
-//! (`final`: [`energy_lanes`] with the sensitivities at the end, lane-major
+//! (`final`: the sum with the sensitivities at the end, lane-major
 //! `s_end`). A peak (either form), a crossing time and an integral of
 //! outputs are read on the continuous solution
 //! ([`super::continuous`]: every local extreme in the peak's sense, the
@@ -16,7 +16,7 @@
 use super::continuous::Continuous;
 use super::sampled::{frequency, lanes_of};
 use crate::error::{Error, Result};
-use crate::mbs::responses::{energy_lanes, Direction, ResponseKind, ResponseValue};
+use crate::mbs::responses::{Direction, ResponseKind, ResponseValue};
 use crate::mbs::series::NoCrossing;
 use crate::mbs::{Param, System};
 use crate::scene::{Response, Scene};
@@ -82,19 +82,9 @@ fn evaluate(
             let (t, value, gradient) = critical.first().cloned().ok_or_else(none)?;
             (Some(t), value, gradient, critical)
         }
-        ResponseKind::Final if energies => {
-            let (value, gradient) = end_value(sys, r, end, params);
-            (
-                scene.options.times.last().copied(),
-                value,
-                gradient,
-                Vec::new(),
-            )
-        }
         ResponseKind::Final => {
-            let lanes = lanes_of(&scene.params, end.s_end, end.y_end.len());
-            let (v, g) = end.continuous.final_value((sys, r, k), end.y_end, &lanes);
-            (scene.options.times.last().copied(), v, g, Vec::new())
+            let (t, v, g) = at_end();
+            (Some(t), v, g, Vec::new())
         }
         ResponseKind::ValueAt { .. } | ResponseKind::Crossing { .. } if energies => {
             return Err(Error::numerical(
@@ -151,18 +141,6 @@ fn integrated(
         .map(|i| end.s_end[i * n + io + index])
         .collect();
     Ok((end.y_end[io + index], gradient))
-}
-
-/// A sum of energies at the end state, with its derivative along the lane
-/// of each parameter of `params` (the sensitivities at the end).
-fn end_value(sys: &System, r: &Response, end: &RunEnd<'_>, params: &[Param]) -> (f64, Vec<f64>) {
-    let n = end.y_end.len();
-    let lanes: Vec<(&[f64], Param)> = params
-        .iter()
-        .enumerate()
-        .map(|(i, p)| (&end.s_end[i * n..(i + 1) * n], *p))
-        .collect();
-    energy_lanes(sys, (&r.terms, r.scale), end.y_end, &lanes)
 }
 
 /// Why a response has no crossing time: it never crosses the level (with
