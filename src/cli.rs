@@ -232,7 +232,8 @@ pub fn execute(cli: Cli) -> Result<()> {
         Command::Evolve { study, common } => {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
             let _lock = lock(&cfg, "evolve", None)?;
-            crate::explore::run_evolve(&cfg.explore(Default::default()), None).map(|_| ())
+            crate::explore::run_evolve(&cfg.explore(Default::default()), None)?;
+            crate::explore::persist::journal::clear(&cfg.study.output_dir(&cfg.out)?)
         }
         Command::Compare {
             study,
@@ -242,7 +243,8 @@ pub fn execute(cli: Cli) -> Result<()> {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
             let ctx = cfg.explore(drive.resolve()?);
             let _lock = lock(&cfg, "compare", Some(&ctx))?;
-            crate::explore::run_compare(&ctx).map(|_| ())
+            crate::explore::run_compare(&ctx)?;
+            crate::explore::persist::journal::clear(&ctx.dir()?)
         }
         Command::Map {
             study,

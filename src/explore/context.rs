@@ -4,6 +4,7 @@
 
 use crate::error::{Error, Result};
 use crate::explore::persist::fingerprint::Fingerprint;
+use crate::explore::persist::journal::Journal;
 use crate::report::manifest::ShardRecord;
 use crate::study::Study;
 use serde::Serialize;
@@ -85,6 +86,14 @@ impl Context<'_> {
         let dir = base.join(format!("shard-{}-of-{}", s.index, s.count));
         std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
         Ok(dir)
+    }
+
+    /// The evaluation journal of `stage` in [`Context::dir`], continued
+    /// under `--resume` ([`crate::explore::persist::journal`]); `scope`
+    /// names what, beyond the study's evaluations, the stage's values
+    /// depend on.
+    pub fn journal(&self, stage: &str, scope: &str) -> Result<Journal> {
+        Journal::open(self.study, &self.dir()?, stage, scope, self.flags.resume)
     }
 
     /// Update `manifest.json` ([`crate::report::record_command`]) with the

@@ -15,13 +15,15 @@
 //! | [`front`] | `[front]` | certified Tchebycheff subproblems, NSGA-II, a grid of the box | `[front]` under `plyscape run` |
 //! | [`map`] | `[map]` | f and the constraints on a grid over two variables | `plyscape map` |
 //! | [`discrete`] | `[discrete]` | rounding and polishing, CMA-ES on the set, exhaustive search | `[discrete]` under `plyscape run` |
-//! | [`persist`] | — | `runs.csv` that survives a kill, the typed manifest entries, the study's fingerprint for `--resume` | — |
+//! | [`persist`] | — | `runs.csv` that survives a kill, the stages' evaluation journals, the typed manifest entries, the study's fingerprint for `--resume` | — |
 //!
 //! Every table is reproducible from the study file: random choices come
 //! from `[study] seed`, rows are sorted by start index, numbers round-trip
 //! exactly, and `manifest.json` records the study text, seed, threads and
 //! crate versions. `runs.csv` survives a kill ([`persist::tables`]);
-//! `--resume` continues a stopped multistart and `--shard i/n` splits one
+//! `--resume` continues a stopped multistart (CMA-ES, `[discrete]` and
+//! `[front]` from their evaluation journals, [`persist::journal`]) and
+//! `--shard i/n` splits one
 //! over machines, with `plyscape merge` ([`merge()`]) putting the pieces
 //! back together. A command gets the command line as a [`Context`].
 //!

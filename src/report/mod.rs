@@ -42,6 +42,28 @@ impl Progress {
         Progress { bar }
     }
 
+    /// A counter of steps whose total is not known beforehand (a
+    /// gradient front's evaluations), labelled `label`, counting `unit`.
+    pub fn counter(label: &str, unit: &str, quiet: bool) -> Progress {
+        let target = if quiet {
+            ProgressDrawTarget::hidden()
+        } else {
+            ProgressDrawTarget::stderr()
+        };
+        let bar = ProgressBar::with_draw_target(None, target);
+        let template = format!("{{prefix}} [{{elapsed_precise}}] {{pos}} {unit} {{msg}}");
+        if let Ok(style) = ProgressStyle::with_template(&template) {
+            bar.set_style(style);
+        }
+        bar.set_prefix(label.to_string());
+        Progress { bar }
+    }
+
+    /// One step done, the message kept.
+    pub fn tick(&self) {
+        self.bar.inc(1);
+    }
+
     /// One step done; `msg` replaces the message.
     pub fn inc(&self, msg: &str) {
         self.bar.set_message(msg.to_string());

@@ -26,9 +26,10 @@ pub struct RunConfig {
     /// Discard an earlier `runs.csv` instead of keeping it as
     /// `runs-<UTC time>.csv` (multistart without `--resume`).
     pub force: bool,
-    /// `run --resume`: every stage that keeps its progress in its tables
-    /// (the multistart, `[compare]`'s multistart, the map) continues from
-    /// them; the other stages run again.
+    /// `run --resume`: the multistart (also `[compare]`'s) and the map
+    /// continue from their tables, CMA-ES, `[discrete]` and `[front]` from
+    /// their evaluation journals
+    /// ([`crate::explore::persist::journal`]).
     pub resume: bool,
 }
 
@@ -282,9 +283,11 @@ pub fn section(key: &str) -> Option<&'static Section> {
 pub fn run_front(cfg: &RunConfig) -> Result<()> {
     let t0 = std::time::Instant::now();
     let dir = cfg.study.output_dir(&cfg.out)?;
-    let report = explore::front::command::run_front(&cfg.study, &dir, cfg.threads, cfg.quiet)?;
+    let ctx = cfg.explore(DriveFlags::default());
+    let report = explore::front::command::run_front(&ctx)?;
     let mut entry = serde_json::Map::new();
     entry.insert("wall_seconds".into(), t0.elapsed().as_secs_f64().into());
+    entry.insert("replayed".into(), report.replayed.into());
     for mf in &report.methods {
         let mut m = serde_json::json!({
             "points": mf.points.len(),
@@ -442,6 +445,8 @@ pub fn run_study(cfg: &RunConfig) -> Result<()> {
             ran += 1;
         }
     }
+    // Every stage ran to its end: their journals served their purpose.
+    explore::persist::journal::clear(&cfg.study.output_dir(&cfg.out)?)?;
     if ran == 0 {
         let working: Vec<&str> = SECTIONS
             .iter()

@@ -9,9 +9,12 @@ use crate::error::{Error, Result};
 use crate::explore::context::Context;
 use crate::explore::discrete::{self, Cache, Candidate, Found, Lattice};
 use crate::explore::multistart::section::multistart_section;
+use crate::explore::persist::journal::Journaled;
 use crate::explore::problem::build::problem;
+use crate::optimize::Problem;
 use crate::optimize::Variable;
 use crate::report::csv::num;
+use crate::report::Progress;
 use crate::study::Study;
 use std::path::Path;
 
@@ -104,7 +107,9 @@ pub fn run_discrete(ctx: &Context) -> Result<Vec<DiscreteRow>> {
     check(study)?;
     let section = discrete::lattice::section(study)?
         .ok_or_else(|| study.error("discrete", "(missing)", "a [discrete] table"))?;
-    let problem = problem(study)?;
+    let built = problem(study)?;
+    let journal = ctx.journal("discrete", "")?;
+    let problem = Journaled::new(built.as_ref(), &journal)?;
     let vars = problem.variables();
     let lattice = Lattice::new(vars, &section).map_err(study.locate(""))?;
     let tol = multistart_section(study)?.feasibility_tolerance;
@@ -127,33 +132,42 @@ pub fn run_discrete(ctx: &Context) -> Result<Vec<DiscreteRow>> {
             .is_some_and(|n| n <= section.exhaustive_limit);
         // One line per stage on stderr (the stages run minutes on a
         // scene, and print their results only at the end).
-        let stage = |what: String| {
+        // And a bar (or a counter) of the stage's evaluations.
+        let stage = |what: String, len: Option<usize>| {
+            journal.watch(None);
             if !ctx.quiet {
                 eprintln!(
                     "discrete: {what} ({:.1} s so far)",
                     t0.elapsed().as_secs_f64()
                 );
             }
+            journal.watch(Some(match len {
+                Some(n) => Progress::new("discrete", n as u64, ctx.quiet),
+                None => Progress::counter("discrete", "evaluations", ctx.quiet),
+            }));
         };
         if small {
-            stage(format!(
-                "exhaustive search over the {} designs of the set",
-                lattice.size().unwrap_or(0)
-            ));
-            if let Some((all, found)) =
-                discrete::exhaustive(problem.as_ref(), &lattice, &cache, tol)?
-            {
+            stage(
+                format!(
+                    "exhaustive search over the {} designs of the set",
+                    lattice.size().unwrap_or(0)
+                ),
+                lattice.size(),
+            );
+            if let Some((all, found)) = discrete::exhaustive(&problem, &lattice, &cache, tol)? {
                 rows.push(row("exhaustive", None, &found));
                 grid = Some(all);
             }
         }
         for (id, x) in &optima {
-            stage(format!(
-                "optimum {id} of {}: rounded to the set, then a coordinate descent on it",
-                optima.len()
-            ));
-            let (rounded, found) =
-                discrete::round_and_polish(problem.as_ref(), &lattice, &cache, x, tol)?;
+            stage(
+                format!(
+                    "optimum {id} of {}: rounded to the set, then a coordinate descent on it",
+                    optima.len()
+                ),
+                None,
+            );
+            let (rounded, found) = discrete::round_and_polish(&problem, &lattice, &cache, x, tol)?;
             let once = Found {
                 best: rounded,
                 evaluations: 1,
@@ -162,12 +176,15 @@ pub fn run_discrete(ctx: &Context) -> Result<Vec<DiscreteRow>> {
             rows.push(row("rounded", Some(*id), &once));
             rows.push(row("rounded_polished", Some(*id), &found));
         }
-        stage(format!(
-            "CMA-ES on the set, {} designs asked for",
-            section.cmaes_samples
-        ));
+        stage(
+            format!(
+                "CMA-ES on the set, {} designs asked for",
+                section.cmaes_samples
+            ),
+            None,
+        );
         let found = discrete::cmaes_on_set(
-            problem.as_ref(),
+            &problem,
             &lattice,
             &cache,
             section.cmaes_samples,
@@ -176,6 +193,7 @@ pub fn run_discrete(ctx: &Context) -> Result<Vec<DiscreteRow>> {
             tol,
         )?;
         rows.push(row("cmaes_discrete", None, &found));
+        journal.watch(None);
         Ok(())
     })?;
     let m = problem.n_constraints();
@@ -194,7 +212,9 @@ pub fn run_discrete(ctx: &Context) -> Result<Vec<DiscreteRow>> {
         "designs_on_the_set": lattice.size(),
         "feasibility_tolerance": tol,
         "wall_seconds": t0.elapsed().as_secs_f64(),
+        "replayed": journal.replayed(),
     });
+    journal.report("discrete", ctx.quiet);
     ctx.manifest(&dir, "discrete", entry)?;
     if !ctx.quiet {
         println!(

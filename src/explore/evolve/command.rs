@@ -8,6 +8,7 @@ use super::section::evolve_plan;
 use crate::error::Result;
 use crate::explore::context::Context;
 use crate::explore::multistart::section::MultistartSection;
+use crate::explore::persist::journal::Journaled;
 use crate::explore::persist::manifest::{
     CmaesRunEntry, EvolveEntry, EvolveSchedules, ScheduleEntry,
 };
@@ -21,8 +22,10 @@ use crate::optimize::Problem;
 /// convergence.svg and the manifest entry. `budget` stands in for an
 /// absent `[evolve] max_evaluations`.
 pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<Vec<search::Report>> {
-    let problem = problem(ctx.study)?;
+    let built = problem(ctx.study)?;
     let plan = evolve_plan(ctx.study)?;
+    let journal = ctx.journal("evolve", "")?;
+    let problem = Journaled::new(built.as_ref(), &journal)?;
     let ms = ctx.study.section::<MultistartSection>("multistart")?;
     let starts = ms.as_ref().map(|m| m.starts + m.points.len());
     // One feasibility tolerance for both methods: the multistart's.
@@ -46,29 +49,27 @@ pub fn run_evolve(ctx: &Context, budget: Option<usize>) -> Result<Vec<search::Re
             target: plan.section.target,
             active: plan.section.active,
         };
-        let report = search::run(
-            problem.as_ref(),
-            solver.as_ref(),
-            &request,
-            ctx.threads,
-            ctx.quiet,
-        )?;
+        let report = search::run(&problem, solver.as_ref(), &request, ctx.threads, ctx.quiet)?;
         if !ctx.quiet {
-            print_evolution(problem.as_ref(), &report);
+            print_evolution(&problem, &report);
         }
         reports.push(report);
     }
     tables::write_atomic(
         &dir.join("evolution.csv"),
-        &search::table(problem.as_ref(), &reports),
+        &search::table(&problem, &reports),
     )?;
     let tol_fun = plan.section.tol_fun.unwrap_or(1e-12);
     ctx.manifest(
         &dir,
         "evolve",
-        evolve_entry((max_evaluations, tol_fun), &reports),
+        EvolveEntry {
+            replayed: (journal.replayed() > 0).then(|| journal.replayed()),
+            ..evolve_entry((max_evaluations, tol_fun), &reports)
+        },
     )?;
-    convergence_plot(problem.as_ref(), &dir, None, &reports)?;
+    convergence_plot(&problem, &dir, None, &reports)?;
+    journal.report("evolve", ctx.quiet);
     Ok(reports)
 }
 
@@ -95,6 +96,7 @@ pub fn evolve_entry(
     EvolveEntry {
         max_evaluations,
         tol_fun,
+        replayed: None,
         schedules,
     }
 }

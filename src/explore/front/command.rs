@@ -54,7 +54,9 @@ use super::grid::{evaluate_grid, grid_size, MAX_GRID_DESIGNS};
 use super::outputs::write_outputs;
 pub use super::outputs::{FrontReport, MethodFront};
 use crate::error::{Error, Result};
+use crate::explore::context::Context;
 use crate::explore::local::settle::EndPolicy;
+use crate::explore::persist::journal::JournaledMulti;
 use crate::explore::problem::problems::ProblemSpec;
 use crate::explore::problem::scene_front::SceneFrontProblem;
 use crate::optimize::indicators::{hypervolume, igd};
@@ -63,6 +65,7 @@ use crate::optimize::mmfd::MmfdOptions;
 use crate::optimize::multiobjective::{non_dominated, MultiProblem, Oriented};
 use crate::optimize::nsga2::{self, Nsga2Options};
 use crate::report::csv::num;
+use crate::report::Progress;
 use crate::study::Study;
 use serde::Deserialize;
 use std::path::Path;
@@ -307,10 +310,15 @@ fn since(problem: &dyn MultiProblem, before: Option<usize>) -> Option<usize> {
 
 /// Run `[front]`: both methods (and the grid), the indicators, the tables
 /// and the plots in `dir`.
-pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Result<FrontReport> {
+pub fn run_front(ctx: &Context) -> Result<FrontReport> {
+    let (study, threads, quiet) = (ctx.study, ctx.threads, ctx.quiet);
+    let dir = &ctx.dir()?;
     let section = check(study)?;
-    let inner = multi_problem(study, &section)?;
-    let problem = oriented(inner.as_ref(), &section).map_err(study.locate("front"))?;
+    let built = multi_problem(study, &section)?;
+    let scope: Vec<&str> = section.objectives.iter().map(|o| o.name.as_str()).collect();
+    let journal = ctx.journal("front", &scope.join(","))?;
+    let inner = JournaledMulti::new(built.as_ref(), &journal)?;
+    let problem = oriented(&inner, &section).map_err(study.locate("front"))?;
     let m = section.objectives.len();
     let tol = section.feasibility_tolerance.unwrap_or(1e-6);
     let tolerances = KktTolerances {
@@ -331,6 +339,11 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
         seed: study.meta.seed,
     };
     let sims = problem.simulations();
+    journal.watch(Some(Progress::counter(
+        "front (gradient)",
+        "evaluations",
+        quiet,
+    )));
     let grad = gradient_front(&problem, &settings)?;
     let grad_sims = since(&problem, sims);
     let budget = section.evaluations.unwrap_or(grad.function_calls);
@@ -344,9 +357,15 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
     let pool = crate::explore::context::thread_pool(threads)?;
     let t = Instant::now();
     let sims = problem.simulations();
+    journal.watch(Some(Progress::new(
+        "front (NSGA-II)",
+        options.max_evaluations as u64,
+        quiet,
+    )));
     let evo = pool
         .install(|| nsga2::minimize(&problem, &options))
         .map_err(study.locate("front"))?;
+    journal.watch(None);
     let evo_seconds = t.elapsed().as_secs_f64();
     let evo_sims = since(&problem, sims);
     let mut methods = vec![
@@ -413,6 +432,7 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
         objectives: problem.objective_names(),
         methods,
         reference,
+        replayed: journal.replayed(),
     };
     write_outputs(
         &problem,
@@ -426,6 +446,7 @@ pub fn run_front(study: &Study, dir: &Path, threads: usize, quiet: bool) -> Resu
     if !quiet {
         print_methods(&report, dir);
     }
+    journal.report("front", quiet);
     Ok(report)
 }
 

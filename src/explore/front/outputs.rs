@@ -52,6 +52,9 @@ pub struct FrontReport {
     pub methods: Vec<MethodFront>,
     /// The reference point (minimized orientation, as evaluated).
     pub reference: Vec<f64>,
+    /// Evaluations served from the journal of a killed run (`run
+    /// --resume`).
+    pub replayed: usize,
 }
 
 /// How an evaluated objective vector is written: `sign · scale · f`.

@@ -117,6 +117,10 @@ pub struct EvolveEntry {
     pub max_evaluations: usize,
     /// CMA-ES TolFun.
     pub tol_fun: f64,
+    /// Evaluations served from the journal of a killed run (`run
+    /// --resume`; absent when none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replayed: Option<usize>,
     /// One schedule's fields, or the list of several.
     #[serde(flatten)]
     pub schedules: EvolveSchedules,
@@ -308,6 +312,7 @@ mod tests {
     #[test]
     fn evolve_entry_keeps_one_schedule_at_the_top_and_lists_several() {
         let one = EvolveEntry {
+            replayed: None,
             max_evaluations: 600,
             tol_fun: 1e-12,
             schedules: EvolveSchedules::One(schedule("ipop", 600)),
@@ -318,6 +323,7 @@ mod tests {
         assert!(v.get("schedules").is_none());
         assert_eq!(serde_json::from_value::<EvolveEntry>(v).unwrap(), one);
         let many = EvolveEntry {
+            replayed: None,
             max_evaluations: 600,
             tol_fun: 1e-6,
             schedules: EvolveSchedules::Many {

@@ -9,8 +9,14 @@
 //!   evaluation's result (64-bit FNV-1a of the parsed TOML values), and the
 //!   spot check of rows read back.
 //!
+//! - [`journal`]: every evaluation of a stage without tables of its own
+//!   (CMA-ES, `[discrete]`, `[front]`), appended as it finishes, served
+//!   back on `run --resume` so that the stage retraces its path without
+//!   simulating.
+//!
 //! No section and no command of its own: every command writes through it.
 
 pub mod fingerprint;
+pub mod journal;
 pub mod manifest;
 pub mod tables;

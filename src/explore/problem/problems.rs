@@ -13,12 +13,13 @@
 //! - `periodic2`: two periodic angles (degrees, period 180°) with four minima,
 //!   one of them on the seam `θ₁ = ±90°`; see [`Periodic2`].
 //!
-//! [`Costly`] burns a fixed CPU time per evaluation (a busy wait, so it
-//! occupies a core like a real simulation would) for performance
-//! measurements of the drivers.
+//! [`Costly`] (and [`CostlyMulti`] for the fronts) burns a fixed time per
+//! evaluation (a busy wait, so it occupies a core like a real simulation
+//! would, or a sleep) for performance measurements of the drivers and for
+//! runs slow enough to be killed in a test.
 
 use crate::error::{Error, Result};
-use crate::optimize::multiobjective::MultiProblem;
+use crate::optimize::multiobjective::{MultiEvaluation, MultiProblem};
 use crate::optimize::testproblems as tp;
 use crate::optimize::{Evaluation, Problem, Variable};
 use serde::Deserialize;
@@ -134,8 +135,8 @@ fn lookup(name: &str) -> Option<Constructor> {
 impl ProblemSpec {
     /// Build the named multi-objective problem (`[front]`): one of
     /// [`multi_problem_names`], with none of the single-objective keys
-    /// (`dimension`, `bounds`, `cost_ms`). Errors name the key within the
-    /// `[problem]` section.
+    /// (`dimension`, `bounds`), wrapped in [`CostlyMulti`] when `cost_ms >
+    /// 0`. Errors name the key within the `[problem]` section.
     pub fn build_multi(&self) -> Result<Box<dyn MultiProblem>> {
         let Some(Constructor::Multi(build)) = lookup(&self.name) else {
             return Err(Error::input(
@@ -150,7 +151,6 @@ impl ProblemSpec {
         let unused = [
             ("dimension", self.dimension.is_some()),
             ("bounds", self.bounds.is_some()),
-            ("cost_ms", self.cost_ms != 0.0),
         ];
         if let Some((key, _)) = unused.iter().find(|(_, set)| *set) {
             return Err(Error::input(
@@ -159,12 +159,18 @@ impl ProblemSpec {
                 format!("no `{key}` for {} (its size and box are fixed)", self.name),
             ));
         }
-        Ok(build())
+        Ok(match self.cost()? {
+            Some(cost) => Box::new(CostlyMulti {
+                inner: build(),
+                cost,
+            }),
+            None => build(),
+        })
     }
 
-    /// Build the named problem (wrapped in [`Costly`] when `cost_ms > 0`).
-    /// Errors name the key within the `[problem]` section.
-    pub fn build(&self) -> Result<Box<dyn Problem>> {
+    /// The time each evaluation burns (`cost_ms`, `cost_mode`); `None`
+    /// for none.
+    fn cost(&self) -> Result<Option<Cost>> {
         if !(self.cost_ms.is_finite() && self.cost_ms >= 0.0) {
             return Err(Error::input(
                 "cost_ms",
@@ -183,6 +189,16 @@ impl ProblemSpec {
                 ))
             }
         };
+        Ok((self.cost_ms > 0.0).then(|| Cost {
+            time: Duration::from_secs_f64(self.cost_ms * 1e-3),
+            sleep,
+        }))
+    }
+
+    /// Build the named problem (wrapped in [`Costly`] when `cost_ms > 0`).
+    /// Errors name the key within the `[problem]` section.
+    pub fn build(&self) -> Result<Box<dyn Problem>> {
+        let cost = self.cost()?;
         let entry = lookup(&self.name);
         let sized = matches!(entry, Some(Constructor::Sized(_)));
         if self.dimension.is_some() && !sized {
@@ -224,15 +240,10 @@ impl ProblemSpec {
             None => inner,
             Some(b) => Box::new(Rebounded::new(inner, b)?),
         };
-        if self.cost_ms > 0.0 {
-            Ok(Box::new(Costly {
-                inner,
-                cost: Duration::from_secs_f64(self.cost_ms * 1e-3),
-                sleep,
-            }))
-        } else {
-            Ok(inner)
-        }
+        Ok(match cost {
+            Some(cost) => Box::new(Costly { inner, cost }),
+            None => inner,
+        })
     }
 }
 
@@ -442,15 +453,37 @@ impl Problem for Periodic2 {
     }
 }
 
-/// Any problem plus a fixed time per evaluation: a busy wait on the
-/// monotonic clock (the thread really occupies a core), or a sleep.
+/// A fixed time per evaluation: a busy wait on the monotonic clock (the
+/// thread really occupies a core), or a sleep.
+#[derive(Debug, Clone, Copy)]
+pub struct Cost {
+    /// Time burnt per evaluation (with or without gradients).
+    pub time: Duration,
+    /// Sleep instead of spinning.
+    pub sleep: bool,
+}
+
+impl Cost {
+    /// Run `evaluate` and burn the rest of the time.
+    fn around<T>(&self, evaluate: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let out = evaluate();
+        if self.sleep {
+            std::thread::sleep(self.time.saturating_sub(start.elapsed()));
+        }
+        while start.elapsed() < self.time {
+            std::hint::spin_loop();
+        }
+        out
+    }
+}
+
+/// Any problem plus a [`Cost`] per evaluation.
 pub struct Costly {
     /// The problem that gives the numbers.
     pub inner: Box<dyn Problem>,
-    /// Time burnt per evaluation (with or without gradients).
-    pub cost: Duration,
-    /// Sleep instead of spinning.
-    pub sleep: bool,
+    /// The time each evaluation takes.
+    pub cost: Cost,
 }
 
 impl Problem for Costly {
@@ -461,18 +494,42 @@ impl Problem for Costly {
         self.inner.n_constraints()
     }
     fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
-        let start = Instant::now();
-        let out = self.inner.evaluate(x, gradients);
-        if self.sleep {
-            std::thread::sleep(self.cost.saturating_sub(start.elapsed()));
-        }
-        while start.elapsed() < self.cost {
-            std::hint::spin_loop();
-        }
-        out
+        self.cost.around(|| self.inner.evaluate(x, gradients))
     }
     fn name(&self) -> &str {
         self.inner.name()
+    }
+}
+
+/// Any multi-objective problem plus a [`Cost`] per evaluation.
+pub struct CostlyMulti {
+    /// The problem that gives the numbers.
+    pub inner: Box<dyn MultiProblem>,
+    /// The time each evaluation takes.
+    pub cost: Cost,
+}
+
+impl MultiProblem for CostlyMulti {
+    fn variables(&self) -> &[Variable] {
+        self.inner.variables()
+    }
+    fn objective_names(&self) -> Vec<String> {
+        self.inner.objective_names()
+    }
+    fn n_constraints(&self) -> usize {
+        self.inner.n_constraints()
+    }
+    fn evaluate(&self, x: &[f64], gradients: bool) -> Result<MultiEvaluation> {
+        self.cost.around(|| self.inner.evaluate(x, gradients))
+    }
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+    fn known_front(&self) -> Option<Vec<Vec<f64>>> {
+        self.inner.known_front()
+    }
+    fn start(&self) -> Vec<f64> {
+        self.inner.start()
     }
 }
 

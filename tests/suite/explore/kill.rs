@@ -31,15 +31,18 @@ fn plyscape(args: &[&str]) -> Command {
 /// Spawn `cmd`, kill it once `runs` holds 3 rows (or after 120 s), and
 /// return the rows on disk at the kill; the child must still have been
 /// running.
-fn kill_after_rows(mut cmd: Command, runs: &std::path::Path) -> usize {
+fn kill_after_rows(cmd: Command, runs: &std::path::Path) -> usize {
+    kill_at_lines(cmd, runs, 4) - 1
+}
+
+/// Spawn `cmd`, kill it once `file` holds `lines` lines (or after 120 s),
+/// and return the lines on disk at the kill; the child must still have
+/// been running.
+fn kill_at_lines(mut cmd: Command, file: &std::path::Path, lines: usize) -> usize {
     let mut child = cmd.spawn().unwrap();
     let t0 = Instant::now();
-    // Kill once a few rows (header + 3) are on disk.
-    loop {
-        let lines = std::fs::read_to_string(runs).map_or(0, |t| t.lines().count());
-        if lines >= 4 || t0.elapsed() > Duration::from_secs(120) {
-            break;
-        }
+    let count = || std::fs::read_to_string(file).map_or(0, |t| t.lines().count());
+    while count() < lines && t0.elapsed() < Duration::from_secs(120) {
         std::thread::sleep(Duration::from_millis(5));
     }
     let waited = t0.elapsed();
@@ -47,9 +50,12 @@ fn kill_after_rows(mut cmd: Command, runs: &std::path::Path) -> usize {
     let killed = child.wait().unwrap();
     // Killed by the signal, not finished: the child was still running.
     assert!(!killed.success(), "the child finished before the kill");
-    let rows_at_kill = std::fs::read_to_string(runs).unwrap().lines().count() - 1;
-    println!("killed after {waited:?} with {rows_at_kill} runs on disk");
-    rows_at_kill
+    let at_kill = count();
+    println!(
+        "killed after {waited:?} with {at_kill} lines in {}",
+        file.display()
+    );
+    at_kill
 }
 
 /// Run `command study --resume` on one thread into `part` and compare
@@ -124,6 +130,91 @@ fn killed_run_resumes_to_the_same_tables() {
             .unwrap()
             <= 21
     );
+}
+
+/// A study whose `[problem]` lines are `problem`, and the same study
+/// with every evaluation sleeping 20 ms: (fast, slow) paths in `dir`.
+fn fast_and_slow(dir: &std::path::Path, problem: &str, rest: &str) -> (String, String) {
+    let write = |name: &str, cost: &str| {
+        let p = dir.join(name);
+        let text = format!("[study]\nname = \"k\"\nseed = 3\n[problem]\n{problem}{cost}{rest}");
+        std::fs::write(&p, text).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    (
+        write("k.toml", ""),
+        write("slow.toml", "cost_ms = 20.0\ncost_mode = \"sleep\"\n"),
+    )
+}
+
+/// `plyscape run` killed in its CMA-ES stage, its `[discrete]` search and
+/// its `[front]` continues with `run --resume` from the stage's
+/// evaluation journal: the tables equal an uninterrupted run's, the
+/// journal served the evaluations done before the kill, and the finished
+/// run leaves no journal behind.
+#[test]
+fn a_run_killed_in_cmaes_discrete_or_front_resumes_to_the_same_tables() {
+    let tmp = temp_dir("kill-stages");
+    let dir = tmp.path().to_path_buf();
+    let single = "[multistart]\nsampler = \"sobol\"\nstarts = 4\n\
+        [evolve]\nmax_evaluations = 300\n\
+        [discrete]\ncmaes_samples = 60\n\
+        [[discrete.variables]]\nname = \"x1\"\nstep = 0.5\n\
+        [[discrete.variables]]\nname = \"x2\"\nstep = 0.5\n";
+    let front = "[front]\nobjectives = [{ name = \"f1\" }, { name = \"f2\" }]\n\
+        subproblems = 4\npopulation = 20\nevaluations = 200\n";
+    let cases = [
+        (
+            "himmelblau",
+            single,
+            "evolve",
+            &["runs.csv", "evolution.csv", "discrete.csv"][..],
+        ),
+        (
+            "himmelblau",
+            single,
+            "discrete",
+            &["evolution.csv", "discrete.csv", "discrete_grid.csv"],
+        ),
+        (
+            "zdt1",
+            front,
+            "front",
+            &["front.csv", "front_ends.csv", "front_summary.csv"],
+        ),
+    ];
+    for (problem, rest, stage, files) in cases {
+        let case = dir.join(stage);
+        std::fs::create_dir_all(&case).unwrap();
+        let (study, slow) = fast_and_slow(&case, &format!("name = \"{problem}\"\n"), rest);
+        let (full, part) = (case.join("full"), case.join("part"));
+        let (full_s, part_s) = (full.to_str().unwrap(), part.to_str().unwrap());
+        let st = plyscape(&["run", &study, "--out", full_s, "--threads", "2", "-q"])
+            .status()
+            .unwrap();
+        assert!(st.success());
+        assert!(
+            !full.join("k/journal").exists(),
+            "a finished run keeps no journal"
+        );
+        let journal = part.join(format!("k/journal/{stage}.log"));
+        let lines = kill_at_lines(
+            plyscape(&["run", &slow, "--out", part_s, "--threads", "2", "-q"]),
+            &journal,
+            40,
+        );
+        assert!(lines >= 40, "{stage}: {lines} lines");
+        resume_to_the_same_tables(["run", &study], (&full, &part), files);
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(part.join("k/manifest.json")).unwrap())
+                .unwrap();
+        let replayed = m["commands"][stage]["replayed"].as_u64().unwrap_or(0);
+        assert!(
+            replayed as usize >= lines - 2,
+            "{stage}: {replayed} served of {lines}"
+        );
+        assert!(!part.join("k/journal").exists());
+    }
 }
 
 #[test]
