@@ -95,8 +95,8 @@ mod sparse;
 mod tests;
 
 pub use derivatives::{
-    has_repeated, Cluster, DerivativeOptions, DesignDerivative, MassDerivative, ModeUpdate,
-    VariableDerivatives,
+    has_repeated, keep_whole_clusters, Cluster, DerivativeOptions, DesignDerivative,
+    MassDerivative, ModeUpdate, VariableDerivatives,
 };
 pub use export::{mode_shape_rows, DofLabel, ModeShapeRow};
 pub use modes::{sign_normalize, ModalOptions, ModalStats, Modes};

@@ -162,6 +162,12 @@ pub trait Problem: Sync {
     fn last_evaluated(&self) -> Option<Vec<f64>> {
         None
     }
+    /// What the evaluations so far need the user to know, one line each
+    /// (e.g. a scene's mode count that split a repeated eigenvalue at some
+    /// design; default: nothing).
+    fn notes(&self) -> Vec<String> {
+        Vec::new()
+    }
     /// The relative integration tolerance of a problem whose evaluation
     /// integrates a motion (`None`: a closed form, exact to rounding).
     fn tolerance(&self) -> Option<f64> {
@@ -246,6 +252,9 @@ impl Problem for Counted<'_> {
     }
     fn last_evaluated(&self) -> Option<Vec<f64>> {
         self.last.lock().ok().and_then(|l| l.clone())
+    }
+    fn notes(&self) -> Vec<String> {
+        self.inner.notes()
     }
 }
 

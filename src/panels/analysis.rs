@@ -10,8 +10,8 @@ use super::rigid::RigidFrame;
 use crate::error::{Error, Result};
 use crate::fe::{Derivatives, Panel, PanelSystem};
 use crate::modal::{
-    has_repeated, DerivativeOptions, DesignDerivative, MassDerivative, ModalOptions, ModalSolver,
-    ModeUpdate, Modes, VariableDerivatives,
+    has_repeated, keep_whole_clusters, DerivativeOptions, DesignDerivative, MassDerivative,
+    ModalOptions, ModalSolver, ModeUpdate, Modes, VariableDerivatives,
 };
 use std::collections::HashMap;
 use std::time::Instant;
@@ -46,6 +46,11 @@ pub struct PanelModes {
     pub rigid_content: Vec<f64>,
     /// The panel's rigid frame (all node masses, `RᵀMR`) for this lay-up.
     pub frame: RigidFrame,
+    /// The elastic modes asked for, when that count split a repeated
+    /// eigenvalue at this lay-up and the cluster's kept members were
+    /// dropped ([`crate::modal::keep_whole_clusters`]; `modes` holds the
+    /// count used).
+    pub asked: Option<usize>,
 }
 
 /// Lay-up as `[a/b/c]` in degrees (rounded to 0.01°).
@@ -202,6 +207,10 @@ impl PanelAnalysis {
             // solve, so the elastic derivatives are the same.
             remove_rigid_modes(&mut modes, &mut [], &self.sys)?;
         }
+        // A count that splits a repeated eigenvalue at this lay-up drops
+        // the cluster whole (with or without derivatives, so that an
+        // evaluation with gradients uses the basis of one without).
+        let asked = keep_whole_clusters(&mut modes, DerivativeOptions::default().cluster_tol);
         let derivatives = self.derivatives(laminate, &modes)?;
         let t3 = Instant::now();
         let labels = (0..modes.lambda.len())
@@ -238,6 +247,7 @@ impl PanelAnalysis {
             nodes: self.panel.mesh.nodes.clone(),
             rigid_content,
             frame,
+            asked,
         })
     }
 

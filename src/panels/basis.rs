@@ -123,6 +123,9 @@
 //! `R`): nothing is dropped.
 //!
 //! # Repeated eigenvalues
+//! A mode count that ends inside a cluster at this lay-up leaves the
+//! cluster out whole ([`crate::modal::keep_whole_clusters`]): the basis
+//! has fewer modes and `rigid.split` holds `(asked, computed)`.
 //! In the updated-mode approach, the eigenvector derivatives of a cluster
 //! of (nearly) repeated eigenvalues refer to adjacent vectors that depend
 //! on the design variable ([`crate::modal::Cluster`]); one basis cannot
@@ -242,6 +245,7 @@ impl BasisBuilder {
             content: run.rigid_content.clone(),
             dropped: Vec::new(),
             limit: 1.0,
+            split: run.asked.map(|a| (a, run.modes.lambda.len())),
         };
         let n = keep.len();
         // Scatter the kept columns of a free-DOF matrix (n_dof × computed)

@@ -690,6 +690,16 @@ pub fn rigid_summary(scene: &Scene) -> (Vec<String>, Vec<String>) {
                 .collect();
             line += &format!("; dropped (content > {}): {}", r.limit, d.join(", "));
         }
+        if let Some((asked, used)) = r.split {
+            line +=
+                &format!("; {asked} elastic modes asked split a repeated eigenvalue: {used} used");
+            warnings.push(format!(
+                "warning: {}: {asked} elastic modes split a repeated eigenvalue at this lay-up \
+                 (the last mode asked and the first left out differ by less than 1e-6 \
+                 relative); the cluster is left out whole: {used} modes used",
+                b.name
+            ));
+        }
         for d in &r.dropped {
             warnings.push(format!(
                 "warning: {}: mode {} ({:.3} Hz) dropped from the modal basis: rigid-body \

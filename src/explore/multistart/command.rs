@@ -90,12 +90,16 @@ pub fn multistart_with(
             violation_checks: checks,
             rtol: problem.tolerance(),
             noise: noise.1.as_ref().map(NoiseRecord::of),
+            notes: problem.notes(),
         }),
     };
     ctx.manifest(&dir, "multistart", done)?;
     every_run_failed(&report)?;
     if !ctx.quiet {
         print_optima(problem, &report);
+        for n in problem.notes() {
+            eprintln!("note: {n}");
+        }
     }
     // `[robustness]`: optima.csv again, with the worst-case columns.
     robustness::apply(ctx, problem, &report.optima, &dir)?;

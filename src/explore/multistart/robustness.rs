@@ -269,12 +269,18 @@ pub fn apply(
     let vars = problem.variables();
     let pool = crate::explore::context::thread_pool(ctx.threads)?;
     let seed = ctx.study.meta.seed;
+    let bar = crate::report::Progress::new("robustness", optima.len() as u64, ctx.quiet);
     let robust: Vec<Robustness> = pool.install(|| {
         optima
             .iter()
-            .map(|o| assess(problem, &o.x, &s.tolerance, s.samples, seed))
+            .map(|o| {
+                let r = assess(problem, &o.x, &s.tolerance, s.samples, seed);
+                bar.tick();
+                r
+            })
             .collect::<Result<_>>()
     })?;
+    bar.finish();
     let m = problem.n_constraints();
     let table = optima_table(vars, m, optima, &robust);
     crate::explore::persist::tables::write_atomic(&dir.join("optima.csv"), &table)?;

@@ -446,6 +446,9 @@ impl Problem for Journaled<'_> {
     fn tolerance(&self) -> Option<f64> {
         self.inner.tolerance()
     }
+    fn notes(&self) -> Vec<String> {
+        self.inner.notes()
+    }
 }
 
 /// A multi-objective problem whose evaluations go through a [`Journal`].

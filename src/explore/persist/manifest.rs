@@ -71,6 +71,10 @@ pub struct MultistartCounts {
     /// "measured"`; absent otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub noise: Option<NoiseRecord>,
+    /// What the problem's evaluations reported ([`crate::optimize::Problem::notes`]:
+    /// a mode count that split a repeated eigenvalue at some lay-up).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 /// The noise of the evaluation measured at one design (ECNoise,
@@ -297,6 +301,7 @@ mod tests {
                         allowance: 3e-8,
                         evaluations: 24,
                     }),
+                    notes: vec![],
                 }),
             },
         };

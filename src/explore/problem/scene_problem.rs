@@ -149,6 +149,10 @@ pub struct SceneProblem {
     study_tolerances: (f64, f64),
     /// What `rtol = "auto"` measured and chose.
     choice: Option<Choice>,
+    /// Per flexible body, the mode counts `(asked, used)` of the
+    /// evaluations whose lay-up had a repeated eigenvalue at the asked
+    /// count (the cluster left out whole), with the number of evaluations.
+    splits: std::sync::Mutex<std::collections::BTreeMap<(String, usize, usize), usize>>,
 }
 
 /// Raw response values (and their gradients per degree of each variable).
@@ -211,6 +215,7 @@ impl SceneProblem {
             study: study.name(),
             study_tolerances: (0.0, 0.0),
             choice: None,
+            splits: Default::default(),
         };
         problem.study_tolerances = problem.tolerances();
         problem.set_references(study, &spec)?;
@@ -442,6 +447,7 @@ impl SceneProblem {
             .build_profiled(&laminates, lanes, false)
             .map_err(at)?;
         self.ties.apply_scene(&self.plan, &mut scene, x)?;
+        self.note_splits(&scene);
         // Frequencies alone need no integration.
         let (responses, stats) = if names.iter().all(|n| self.is_frequency(&n.0)) {
             (frequencies(&scene).map_err(at)?, Default::default())
@@ -502,6 +508,19 @@ impl SceneProblem {
             gradients: gradients.then_some(grads),
             profile,
         })
+    }
+
+    /// Count the bodies of `scene` whose mode count split a repeated
+    /// eigenvalue ([`crate::mbs::RigidScreen::split`]).
+    fn note_splits(&self, scene: &crate::scene::Scene) {
+        let Ok(mut splits) = self.splits.lock() else {
+            return;
+        };
+        for b in &scene.model.bodies {
+            if let Some((asked, used)) = b.flex.as_ref().and_then(|f| f.basis.rigid.split) {
+                *splits.entry((b.name.clone(), asked, used)).or_default() += 1;
+            }
+        }
     }
 
     /// [`Problem::evaluate`] with what the evaluation computed and where
@@ -677,6 +696,23 @@ impl Problem for SceneProblem {
     }
     fn name(&self) -> &str {
         &self.study
+    }
+    /// One line per body and mode count whose count split a repeated
+    /// eigenvalue at some evaluated lay-up.
+    fn notes(&self) -> Vec<String> {
+        let Ok(splits) = self.splits.lock() else {
+            return Vec::new();
+        };
+        splits
+            .iter()
+            .map(|((body, asked, used), n)| {
+                format!(
+                    "{body}: {asked} elastic modes split a repeated eigenvalue at the lay-up of \
+                     {n} evaluation(s); {used} modes were used there (the cluster left out \
+                     whole)"
+                )
+            })
+            .collect()
     }
     fn tolerance(&self) -> Option<f64> {
         Some(self.tolerances().0)

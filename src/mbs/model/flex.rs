@@ -113,6 +113,11 @@ pub struct RigidScreen {
     /// The content above which modes were dropped
     /// ([`ModalBasis::screened`]); 1 if the basis was not screened.
     pub limit: f64,
+    /// `(asked, computed)`: the elastic modes asked for, when that count
+    /// split a repeated eigenvalue and the split cluster's members were
+    /// left out whole (`computed` of them kept; content and drops above
+    /// count among those).
+    pub split: Option<(usize, usize)>,
 }
 
 /// The modal data of a flexible body: everything the multibody kernel
@@ -363,6 +368,7 @@ impl ModalBasis {
                 content: keep.iter().map(|&j| self.rigid.content[j]).collect(),
                 dropped,
                 limit,
+                split: self.rigid.split,
             },
             geometric: self.geometric.as_ref().map(|g| g.picked(&keep)),
         })

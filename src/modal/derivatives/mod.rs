@@ -194,6 +194,34 @@ pub fn has_repeated(modes: &Modes, cluster_tol: f64) -> bool {
         .any(|&(_, r)| r > 1)
 }
 
+/// Keep clusters whole: when the first mode left out (`next_lambda`) and
+/// the last one kept are one repeated eigenvalue (closer than
+/// `cluster_tol`, as [`find_clusters`] groups them), drop the kept members
+/// of that cluster, so that the basis spans either the whole eigenspace or
+/// none of it (a part of it would be an arbitrary choice of vectors within
+/// it, and its derivatives do not exist). Returns the count before the
+/// drop, or `None` when nothing was dropped: no split, or every mode kept
+/// is in the split cluster (left to the mode-count check, which refuses
+/// it).
+pub fn keep_whole_clusters(modes: &mut Modes, cluster_tol: f64) -> Option<usize> {
+    let k = modes.lambda.len();
+    let next = modes.next_lambda?;
+    let mut c = k;
+    let mut above = next;
+    while c > 0 && close(modes.lambda[c - 1], above, modes.shift, cluster_tol) {
+        above = modes.lambda[c - 1];
+        c -= 1;
+    }
+    if c == k || c == 0 {
+        return None;
+    }
+    modes.next_lambda = Some(modes.lambda[c]);
+    modes.lambda.truncate(c);
+    modes.residuals.truncate(c);
+    modes.modes = modes.modes.subcols(0, c).to_owned();
+    Some(k)
+}
+
 /// Group consecutive eigenvalues into clusters: `(first, len)`.
 fn find_clusters(lambda: &[f64], shift: f64, tol: f64) -> Vec<(usize, usize)> {
     let mut out = Vec::new();
