@@ -227,7 +227,8 @@ pub fn execute(cli: Cli) -> Result<()> {
             let cfg = RunConfig::resolve(Some(&study), &common)?;
             let ctx = cfg.explore(drive.resolve()?);
             let _lock = lock(&cfg, "multistart", Some(&ctx))?;
-            crate::explore::run_multistart(&ctx).map(|_| ())
+            crate::explore::run_multistart(&ctx)?;
+            crate::explore::persist::journal::clear(&ctx.dir()?)
         }
         Command::Evolve { study, common } => {
             let cfg = RunConfig::resolve(Some(&study), &common)?;

@@ -10,10 +10,12 @@ use crate::explore::context::Context;
 use crate::explore::local::settle::DEFAULT_NOISE;
 use crate::explore::local::{solvers, violation};
 use crate::explore::persist::fingerprint;
+use crate::explore::persist::journal::Journaled;
 use crate::explore::persist::manifest::{MultistartCounts, MultistartEntry, NoiseRecord};
 use crate::explore::problem::build::problem;
 use crate::optimize::noise::{estimate, Measured, NoiseOptions};
 use crate::optimize::Problem;
+use crate::report::Progress;
 use std::path::{Path, PathBuf};
 
 /// `plyscape multistart`: runs, optima, manifest.
@@ -208,7 +210,18 @@ fn violation_checks(
         return Ok((0, 0));
     }
     let tol = report.tolerances.feasibility;
-    let checks = violation::check(problem, &sample, tol);
+    // The descents run for minutes on a scene: journaled (resumable) and
+    // counted on stderr.
+    let journal = ctx.journal("violation_checks", "")?;
+    let journaled = Journaled::new(problem, &journal)?;
+    journal.watch(Some(Progress::counter(
+        "violation checks",
+        "evaluations",
+        ctx.quiet,
+    )));
+    let checks = violation::check(&journaled, &sample, tol);
+    journal.watch(None);
+    journal.report("violation checks", ctx.quiet);
     let table = violation::table(problem, &checks, tol);
     crate::explore::persist::tables::write_atomic(&dir.join("violation_checks.csv"), &table)?;
     let reached = checks.iter().filter(|c| c.reached(tol)).count();
