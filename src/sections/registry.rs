@@ -408,6 +408,21 @@ pub fn check_sections(study: &Study) -> Result<()> {
 /// values refused) and checked as far as that needs no computation. The
 /// drivers' `[problem]` is checked first, once for all of them.
 pub fn check_study(study: &Study) -> Result<()> {
+    // `[scene_problem]` is read only through `[problem] name = "scene"`:
+    // beside another problem nothing would check it (a NaN bound in it
+    // passed silently).
+    let problem = study.table.get("problem").and_then(|p| p.get("name"));
+    if study.has("scene_problem") && problem.and_then(|n| n.as_str()) != Some("scene") {
+        let shown = problem.map_or("(none)".to_string(), |n| n.to_string());
+        return Err(study.error(
+            "scene_problem",
+            "(table)",
+            format!(
+                "no [scene_problem] unless [problem] name = \"scene\" reads it (`problem.name` \
+                 is {shown}): remove the section or set the name"
+            ),
+        ));
+    }
     let present = || study.table.keys().filter_map(|k| section(k));
     if present().any(|s| s.uses_problem) {
         explore::check_problem(study)?;

@@ -398,4 +398,15 @@ fn a_bad_late_section_is_refused_before_any_work() {
         assert!(e.starts_with("late.toml") && e.contains(key), "{e}");
         assert!(!dir.join("late/runs.csv").exists(), "{late}: work was done");
     }
+    // A section nothing reads (with a NaN bound) is refused, not passed.
+    let unused = "[scene_problem]\nstart = [0.0]\n[[scene_problem.variables]]\n\
+        name = \"a\"\nbounds = [nan, 1.0]\nsets = [\"p:theta_1\"]\n";
+    let s = study("late", &format!("{}{unused}", himmelblau(6, "")));
+    let e = plyscape::sections::registry::check_study(&s)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("scene_problem") && e.contains("\"himmelblau\""),
+        "{e}"
+    );
 }
