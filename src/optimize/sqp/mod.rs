@@ -82,8 +82,13 @@ pub struct SqpOptions {
     /// Feasibility (`max g <= feasibility`), active set and stationarity
     /// of the certificate that may also end the run; stationarity 1e-8.
     pub tolerances: KktTolerances,
-    /// Scaled length of the first unconstrained step: 0.1 (a tenth of each
-    /// variable's range).
+    /// Scaled length of the first unconstrained step: 0.02 (a fiftieth of
+    /// each variable's range). With a tenth, the SAR problem's first step
+    /// from 55°/−55° went 18° along the peak-U3 constraint's tangent and
+    /// landed at g = 0.25 in an infeasible valley the run never left (460
+    /// f + 136 g, then rescued); with a fiftieth SQP converges there in 12
+    /// f + 13 g. The Hock–Schittkowski runs pay 54 f + 51 g for it instead
+    /// of 50 f + 48 g (2026-12-02; docs/exploration.md).
     pub first_step: f64,
     /// Armijo's fraction η of the predicted merit decrease: 1e-4.
     pub armijo: f64,
@@ -105,7 +110,7 @@ impl Default for SqpOptions {
                 active: 1e-4,
                 stationarity: 1e-8,
             },
-            first_step: 0.1,
+            first_step: 0.02,
             armijo: 1e-4,
             max_line_evaluations: 10,
             speculative: true,

@@ -75,9 +75,10 @@ fn hock_schittkowski_runs_reach_the_published_optima() {
         );
     }
     eprintln!("total {} f + {} g", total.0, total.1);
-    // Measured 50 f + 48 g (54 f + 53 g before the model's self-scaling);
+    // Measured 54 f + 51 g with the first step a fiftieth of the range (50
+    // f + 48 g with a tenth, 54 f + 53 g before the model's self-scaling);
     // scipy 1.17.1's SLSQP on the same problems and starts takes 114 f +
     // 53 g (scripts/peers/slsqp_hs.py, results/sqp_peers/slsqp.csv). A
     // rise past these pins is a regression.
-    assert!(total.0 <= 50 && total.1 <= 48, "{total:?}");
+    assert!(total.0 <= 54 && total.1 <= 51, "{total:?}");
 }

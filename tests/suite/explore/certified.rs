@@ -123,9 +123,10 @@ fn hs100_with_sqp_certifies_every_run_for_fewer_calls() {
     assert_eq!(converged, 20);
     assert!((f - HS100_F).abs() <= 1e-6 * HS100_F, "f = {f}");
     assert!(sqp < mmfd, "SQP {sqp} calls, MMFD {mmfd}");
-    // Measured 599 (1919 before the model's self-scaling, optimize::sqp
-    // step 5); a rise past it is a regression.
-    assert!(sqp <= 599, "SQP {sqp} calls");
+    // Measured 633 with the first step a fiftieth of the range (599 with a
+    // tenth, 1919 before the model's self-scaling, optimize::sqp step 5);
+    // a rise past it is a regression.
+    assert!(sqp <= 633, "SQP {sqp} calls");
 }
 
 /// `[multistart] noise = "measured"` on HS 100: the allowance is rounding
