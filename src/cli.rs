@@ -55,7 +55,8 @@ pub enum Command {
         #[command(flatten)]
         common: Common,
         /// Continue a killed run: the multistart (also `[compare]`'s) and
-        /// the map continue from their tables; the other stages run again.
+        /// the map from their tables, CMA-ES, `[discrete]`, `[front]` and
+        /// the violation checks from their evaluation journals.
         #[arg(long)]
         resume: bool,
     },

@@ -27,32 +27,26 @@ pub struct Progress {
 impl Progress {
     /// A bar for `len` steps labelled `label`.
     pub fn new(label: &str, len: u64, quiet: bool) -> Progress {
-        let target = if quiet {
-            ProgressDrawTarget::hidden()
-        } else {
-            ProgressDrawTarget::stderr()
-        };
-        let bar = ProgressBar::with_draw_target(Some(len), target);
-        if let Ok(style) =
-            ProgressStyle::with_template("{prefix} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
-        {
-            bar.set_style(style);
-        }
-        bar.set_prefix(label.to_string());
-        Progress { bar }
+        let template = "{prefix} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}";
+        Self::styled(label, Some(len), template, quiet)
     }
 
     /// A counter of steps whose total is not known beforehand (a
     /// gradient front's evaluations), labelled `label`, counting `unit`.
     pub fn counter(label: &str, unit: &str, quiet: bool) -> Progress {
+        let template = format!("{{prefix}} [{{elapsed_precise}}] {{pos}} {unit} {{msg}}");
+        Self::styled(label, None, &template, quiet)
+    }
+
+    /// A bar of `len` steps (`None`: not known) drawn with `template`.
+    fn styled(label: &str, len: Option<u64>, template: &str, quiet: bool) -> Progress {
         let target = if quiet {
             ProgressDrawTarget::hidden()
         } else {
             ProgressDrawTarget::stderr()
         };
-        let bar = ProgressBar::with_draw_target(None, target);
-        let template = format!("{{prefix}} [{{elapsed_precise}}] {{pos}} {unit} {{msg}}");
-        if let Ok(style) = ProgressStyle::with_template(&template) {
+        let bar = ProgressBar::with_draw_target(len, target);
+        if let Ok(style) = ProgressStyle::with_template(template) {
             bar.set_style(style);
         }
         bar.set_prefix(label.to_string());

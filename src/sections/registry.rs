@@ -386,7 +386,7 @@ pub fn check_sections(study: &Study) -> Result<()> {
         if !known.contains(&key.as_str()) {
             let closest = known
                 .iter()
-                .min_by_key(|k| edit_distance(k, key))
+                .min_by_key(|k| crate::study::edit_distance(k, key))
                 .copied()
                 .unwrap_or("study");
             return Err(study.error(
@@ -431,22 +431,6 @@ pub fn check_study(study: &Study) -> Result<()> {
         (s.check)(study)?;
     }
     Ok(())
-}
-
-/// Levenshtein distance of two names (insertions, deletions, substitutions).
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
-            prev = cur;
-        }
-    }
-    row[b.len()]
 }
 
 /// `plyscape run`: every section the study asks for, in the order of
@@ -505,6 +489,6 @@ mod tests {
             "{e}"
         );
         assert!(e.contains("study, modes, scene, multistart"), "{e}");
-        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(crate::study::edit_distance("kitten", "sitting"), 3);
     }
 }

@@ -693,9 +693,10 @@ pub fn rigid_summary(scene: &Scene) -> (Vec<String>, Vec<String>) {
         if let Some((asked, used)) = r.split {
             line +=
                 &format!("; {asked} elastic modes asked split a repeated eigenvalue: {used} used");
+            let tol = crate::modal::DerivativeOptions::default().cluster_tol;
             warnings.push(format!(
                 "warning: {}: {asked} elastic modes split a repeated eigenvalue at this lay-up \
-                 (the last mode asked and the first left out differ by less than 1e-6 \
+                 (the last mode asked and the first left out differ by less than {tol:e} \
                  relative); the cluster is left out whole: {used} modes used",
                 b.name
             ));

@@ -223,25 +223,28 @@ fn expectation(msg: &str) -> String {
 /// insertions, deletions, substitutions), when it is within
 /// `max(2, len/3)` edits.
 fn nearest<'a>(typed: &str, names: impl Iterator<Item = &'a str>) -> Option<&'a str> {
-    let t: Vec<char> = typed.to_lowercase().chars().collect();
-    let limit = (t.len() / 3).max(2);
+    let t = typed.to_lowercase();
+    let limit = (t.chars().count() / 3).max(2);
     names
-        .map(|n| (edits(&t, &n.to_lowercase().chars().collect::<Vec<_>>()), n))
+        .map(|n| (edit_distance(&t, &n.to_lowercase()), n))
         .filter(|(d, _)| *d <= limit)
         .min_by_key(|(d, _)| *d)
         .map(|(_, n)| n)
 }
 
-/// The edit distance between `a` and `b` (one row of the table at a time).
-fn edits(a: &[char], b: &[char]) -> usize {
+/// The edit distance between `a` and `b` (Levenshtein: insertions,
+/// deletions, substitutions of characters; one row of the table at a
+/// time).
+pub fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
     let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.iter().enumerate() {
+    for (i, ca) in a.chars().enumerate() {
         let mut diagonal = row[0];
         row[0] = i + 1;
         for (j, cb) in b.iter().enumerate() {
             let next = (row[j + 1] + 1)
                 .min(row[j] + 1)
-                .min(diagonal + usize::from(ca != cb));
+                .min(diagonal + usize::from(ca != *cb));
             diagonal = row[j + 1];
             row[j + 1] = next;
         }

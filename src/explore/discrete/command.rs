@@ -11,8 +11,7 @@ use crate::explore::discrete::{self, Cache, Candidate, Found, Lattice};
 use crate::explore::multistart::section::multistart_section;
 use crate::explore::persist::journal::Journaled;
 use crate::explore::problem::build::problem;
-use crate::optimize::Problem;
-use crate::optimize::Variable;
+use crate::optimize::{Problem, Variable};
 use crate::report::csv::num;
 use crate::report::Progress;
 use crate::study::Study;
@@ -131,8 +130,8 @@ pub fn run_discrete(ctx: &Context) -> Result<Vec<DiscreteRow>> {
             .size()
             .is_some_and(|n| n <= section.exhaustive_limit);
         // One line per stage on stderr (the stages run minutes on a
-        // scene, and print their results only at the end).
-        // And a bar (or a counter) of the stage's evaluations.
+        // scene, and print their results only at the end), then a bar (or
+        // a counter) of the stage's evaluations.
         let stage = |what: String, len: Option<usize>| {
             journal.watch(None);
             if !ctx.quiet {

@@ -203,7 +203,7 @@ impl Journal {
                     self.path.display(),
                     format!(
                         "a journal this code reproduces, but at x = {x:?} it holds {:?} and the \
-                         evaluation gives {:?}: the code or the table changed; rerun without \
+                         evaluation gives {:?}: the code or the journal changed; rerun without \
                          --resume",
                         &stored[..stored.len().min(4)],
                         &now[..now.len().min(4)]
@@ -325,22 +325,21 @@ fn split(v: &[f64], gradients: bool, n: usize, (k, m): (usize, usize)) -> Option
 /// Objectives, constraints and (gradients of both).
 type Parts = (Vec<f64>, Vec<f64>, Option<(Vec<Vec<f64>>, Vec<Vec<f64>>)>);
 
-/// Rows of gradients (of the objectives, of the constraints).
-type Rows<'a> = (&'a Vec<Vec<f64>>, &'a Vec<Vec<f64>>);
-
-fn join(f: &[f64], g: &[f64], grads: Option<Rows>) -> Vec<f64> {
+/// `[f.., g..]`, then with the objectives' gradient rows `gf` also those
+/// rows and the constraints' (`gg`; none for a problem without
+/// constraints).
+fn join(f: &[f64], g: &[f64], gf: Option<&[Vec<f64>]>, gg: Option<&[Vec<f64>]>) -> Vec<f64> {
     let mut v: Vec<f64> = f.iter().chain(g).copied().collect();
-    if let Some((gf, gg)) = grads {
-        v.extend(gf.iter().chain(gg).flatten());
+    if let Some(gf) = gf {
+        v.extend(gf.iter().chain(gg.unwrap_or_default()).flatten());
     }
     v
 }
 
 impl Values for Evaluation {
     fn values(&self) -> Vec<f64> {
-        let gf = self.grad_f.clone().map(|r| vec![r]);
-        let grads = gf.as_ref().zip(self.grad_g.as_ref());
-        join(&[self.f], &self.g, grads)
+        let gf = self.grad_f.as_ref().map(std::slice::from_ref);
+        join(&[self.f], &self.g, gf, self.grad_g.as_deref())
     }
     fn from_values(v: &[f64], gradients: bool, n: usize, km: (usize, usize)) -> Option<Self> {
         let (f, g, grads) = split(v, gradients, n, km)?;
@@ -362,7 +361,8 @@ impl Values for MultiEvaluation {
         join(
             &self.f,
             &self.g,
-            self.grad_f.as_ref().zip(self.grad_g.as_ref()),
+            self.grad_f.as_deref(),
+            self.grad_g.as_deref(),
         )
     }
     fn from_values(v: &[f64], gradients: bool, n: usize, km: (usize, usize)) -> Option<Self> {
@@ -552,6 +552,15 @@ mod tests {
             MultiEvaluation::from_values(&m.values(), false, 3, (2, 0)),
             Some(m)
         );
+        // Gradients without constraints (`grad_g` absent) keep their length.
+        let free = Evaluation {
+            f: 1.0,
+            g: vec![],
+            grad_f: Some(vec![2.0]),
+            grad_g: None,
+        };
+        let back = Evaluation::from_values(&free.values(), true, 1, (1, 0)).unwrap();
+        assert_eq!((back.grad_f, back.grad_g), (Some(vec![2.0]), Some(vec![])));
         // A record of the wrong length for the problem is not an evaluation.
         assert!(Evaluation::from_values(&[1.0, 2.0], false, 2, (1, 2)).is_none());
     }
@@ -620,7 +629,7 @@ mod tests {
         let j = Journal::open(&s, &dir, "front", "f1,f2", true).unwrap();
         let e = Journaled::new(&p, &j).err().unwrap();
         assert!(
-            e.to_string().contains("the code or the table changed"),
+            e.to_string().contains("the code or the journal changed"),
             "{e}"
         );
         let _ = std::fs::remove_dir_all(&dir);

@@ -196,9 +196,9 @@ pub fn has_repeated(modes: &Modes, cluster_tol: f64) -> bool {
 
 /// Keep clusters whole: when the first mode left out (`next_lambda`) and
 /// the last one kept are one repeated eigenvalue (closer than
-/// `cluster_tol`, as the clusters of the derivatives are grouped), drop the kept members
-/// of that cluster, so that the basis spans either the whole eigenspace or
-/// none of it (a part of it would be an arbitrary choice of vectors within
+/// `cluster_tol`, as the derivatives group clusters), drop the kept
+/// members of that cluster, so that the basis spans either the whole
+/// eigenspace or none of it (a part of it would be an arbitrary choice of vectors within
 /// it, and its derivatives do not exist). Returns the count before the
 /// drop, or `None` when nothing was dropped: no split, or every mode kept
 /// is in the split cluster (left to the mode-count check, which refuses

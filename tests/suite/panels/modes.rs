@@ -529,9 +529,13 @@ fn a_mode_count_inside_a_repeated_pair_drops_the_pair_whole() {
     let r = with.run(&laminate, j + 1).unwrap();
     assert_eq!(r.asked, Some(j + 1));
     assert_eq!(r.modes.lambda.len(), j, "{:?}", r.modes.lambda);
-    for (a, b) in r.modes.lambda.iter().zip(&all) {
-        assert!((a - b).abs() < 1e-9 * b, "{a} vs {b}");
-    }
+    let worst = (r.modes.lambda.iter().zip(&all))
+        .map(|(a, b)| (a - b).abs() / b)
+        .fold(0.0, f64::max);
+    // Measured 3.6e-15 (another Lanczos run of the same pencil; the
+    // free-free plate's 3- and 4-mode runs differ by 2.2e-12).
+    println!("modes below the pair against the 14-mode run: {worst:.1e} relative");
+    assert!(worst < 1e-9, "{worst:e}");
     assert_eq!(r.derivatives[0].dlambda.len(), j);
     // A count that splits nothing is kept as asked.
     let whole = with.run(&laminate, j + 2).unwrap();
