@@ -162,6 +162,12 @@ pub trait Problem: Sync {
     fn last_evaluated(&self) -> Option<Vec<f64>> {
         None
     }
+    /// The last evaluation with gradients and its design, when the problem
+    /// keeps it (a [`Counted`] does): a certificate at that design needs no
+    /// new evaluation.
+    fn last_gradient(&self) -> Option<(Vec<f64>, Evaluation)> {
+        None
+    }
     /// What the evaluations so far need the user to know, one line each
     /// (e.g. a scene's mode count that split a repeated eigenvalue at some
     /// design; default: nothing).
@@ -195,6 +201,8 @@ pub struct Counted<'a> {
     gradient_calls: AtomicUsize,
     /// The design of the last evaluation.
     last: std::sync::Mutex<Option<Vec<f64>>>,
+    /// The last evaluation with gradients, with its design.
+    last_gradient: std::sync::Mutex<Option<(Vec<f64>, Evaluation)>>,
 }
 
 impl<'a> Counted<'a> {
@@ -205,6 +213,7 @@ impl<'a> Counted<'a> {
             function_calls: AtomicUsize::new(0),
             gradient_calls: AtomicUsize::new(0),
             last: std::sync::Mutex::new(inner.last_evaluated()),
+            last_gradient: std::sync::Mutex::new(inner.last_gradient()),
         }
     }
     /// Function evaluations so far.
@@ -239,7 +248,13 @@ impl Problem for Counted<'_> {
         if gradients {
             self.gradient_calls.fetch_add(1, Ordering::Relaxed);
         }
-        self.inner.evaluate(x, gradients)
+        let e = self.inner.evaluate(x, gradients)?;
+        if gradients {
+            if let Ok(mut last) = self.last_gradient.lock() {
+                *last = Some((x.to_vec(), e.clone()));
+            }
+        }
+        Ok(e)
     }
     fn name(&self) -> &str {
         self.inner.name()
@@ -252,6 +267,9 @@ impl Problem for Counted<'_> {
     }
     fn last_evaluated(&self) -> Option<Vec<f64>> {
         self.last.lock().ok().and_then(|l| l.clone())
+    }
+    fn last_gradient(&self) -> Option<(Vec<f64>, Evaluation)> {
+        self.last_gradient.lock().ok().and_then(|l| l.clone())
     }
     fn notes(&self) -> Vec<String> {
         self.inner.notes()

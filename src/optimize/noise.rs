@@ -381,6 +381,12 @@ impl Measured {
             Noise::StepTooLarge => self.first_order_f / scale,
         }
     }
+
+    /// The constraints' allowance, absolute: 3σ of the noisiest constraint
+    /// with a level (0 without constraints or without any level).
+    pub fn allowance_g(&self) -> f64 {
+        3.0 * self.max_g().unwrap_or(0.0)
+    }
 }
 
 #[cfg(test)]

@@ -288,6 +288,7 @@ fn measure_at(
             polish: true,
             rescue: true,
             noise: measured[0].allowance(),
+            noise_g: measured[0].allowance_g(),
         };
         let row = one_run(
             problem,

@@ -8,10 +8,11 @@ use super::section::{compare_section, evolve_plan};
 use crate::error::{Error, Result};
 use crate::explore::context::Context;
 use crate::explore::local::settle;
-use crate::explore::multistart::command::multistart_with;
+use crate::explore::multistart::command::{multistart_with, noise_allowance};
 use crate::explore::multistart::section::multistart_plan;
 use crate::explore::persist::tables;
 use crate::explore::problem::build::problem;
+use crate::optimize::noise::Measured;
 use crate::optimize::{Counted, Problem};
 
 /// Which of a method's designs a comparison row holds.
@@ -102,9 +103,16 @@ pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
     let budget = ms.function_calls + plan.starts.filter_evaluations;
     let evs = run_evolve(ctx, Some(budget))?;
     let dir = ctx.dir()?;
-    let policy = plan
-        .section
-        .end_policy(ms.noise.unwrap_or(settle::DEFAULT_NOISE));
+    // The multistart's allowance; a multistart read back from complete
+    // tables has none, and the first start's noise is measured again.
+    let (noise, noise_g) = match ms.noise {
+        Some(n) => n,
+        None => {
+            let (f, m) = noise_allowance(ctx, problem.as_ref(), &plan)?;
+            (f, m.as_ref().map_or(0.0, Measured::allowance_g))
+        }
+    };
+    let policy = plan.section.end_policy(noise, noise_g);
     let tolerance = policy.tolerances.feasibility;
     let base = ComparisonRow {
         method: format!("multistart-{}", plan.section.method.name()),

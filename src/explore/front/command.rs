@@ -49,7 +49,7 @@
 //!   start design and the analytic front (two objectives) when known;
 //!   `front_design.svg` (two variables): the same designs in design space.
 
-use super::gradient::{gradient_front, GradientSettings};
+use super::gradient::{gradient_front, subproblem_noise, GradientSettings};
 use super::grid::{evaluate_grid, grid_size, MAX_GRID_DESIGNS};
 use super::outputs::write_outputs;
 pub use super::outputs::{FrontReport, MethodFront};
@@ -325,6 +325,13 @@ pub fn run_front(ctx: &Context) -> Result<FrontReport> {
         feasibility: tol,
         ..KktTolerances::default()
     };
+    let (noise, noise_g, noise_calls) =
+        subproblem_noise(&problem, study.meta.seed).map_err(study.locate("front"))?;
+    if !quiet {
+        println!(
+            "  noise of the objectives at the start: allowance {noise:.2e} ({noise_calls} function calls)"
+        );
+    }
     let settings = GradientSettings {
         subproblems: section.subproblems,
         threads,
@@ -333,7 +340,8 @@ pub fn run_front(ctx: &Context) -> Result<FrontReport> {
             tolerances,
             polish: true,
             rescue: true,
-            noise: crate::explore::local::settle::DEFAULT_NOISE,
+            noise,
+            noise_g,
         },
         anchor_starts: section.anchor_starts,
         seed: study.meta.seed,

@@ -46,6 +46,7 @@ use crate::optimize::mo_testproblems::simplex_lattice;
 use crate::optimize::multiobjective::{
     non_dominated, EpsilonConstraint, MultiProblem, Tchebycheff,
 };
+use crate::optimize::noise::{estimate, NoiseOptions};
 use crate::optimize::{NoObserver, Problem};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -195,6 +196,34 @@ fn objectives(
     *calls += 1;
     let e = problem.evaluate(x, false)?;
     Ok(e.f.iter().all(|v| v.is_finite()).then_some(e.f))
+}
+
+/// The noise allowance of the subproblems' ends (`EndPolicy::noise`):
+/// the largest over the objectives of ECNoise's allowance at the start
+/// design (3σ of the objective relative to `max(|f_i|, 1)`,
+/// [`crate::optimize::noise::Measured::allowance`]; 0 for an objective
+/// smooth at every step tried, as a closed form is); the constraints'
+/// allowance (absolute, [`crate::optimize::noise::Measured::allowance_g`])
+/// over the problem's constraints and the objectives themselves, which
+/// the ε-constraint subproblems bound; and the function calls it took. A
+/// scalarization weighs the objectives, so its noise relative to its own
+/// value is at most about the largest of theirs.
+pub fn subproblem_noise(problem: &dyn MultiProblem, seed: u64) -> Result<(f64, f64, usize)> {
+    let x0 = problem.start();
+    let m = problem.objective_names().len();
+    let (mut allowance, mut allowance_g): (f64, f64) = (0.0, 0.0);
+    let mut calls = 0;
+    for i in 0..m {
+        let mut w = vec![0.0; m];
+        w[i] = 1.0;
+        let one = EpsilonConstraint::new(problem, w, vec![]);
+        let measured = estimate(&one, &x0, seed, &NoiseOptions::default())?;
+        allowance = allowance.max(measured.allowance());
+        let sigma_f = measured.noise_f.sigma().unwrap_or(0.0);
+        allowance_g = allowance_g.max(measured.allowance_g()).max(3.0 * sigma_f);
+        calls += measured.evaluations;
+    }
+    Ok((allowance, allowance_g, calls))
 }
 
 /// Build the front's gradient side (see the module doc).

@@ -59,13 +59,6 @@ use crate::optimize::{
     Counted, IterRecord, LocalOutcome, NoObserver, Observer, Problem, Termination,
 };
 
-/// The noise allowance of runs that do not measure their noise
-/// (`[multistart] noise` not `"measured"`, and the front's subproblems):
-/// 1e-6 of `max(|f|, 1)`. It is the allowance the studies ran with before
-/// the noise was measured; ECNoise gives the SAR evaluation at rtol 1e-6
-/// σ = 4.2e-7 of f (`results/sar_accuracy/noise.csv`), so 3σ = 1.3e-6.
-pub const DEFAULT_NOISE: f64 = 1e-6;
-
 /// What happens at the end of every local run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EndPolicy {
@@ -83,6 +76,12 @@ pub struct EndPolicy {
     /// more (`[multistart] noise`: measured by ECNoise, see
     /// [`crate::optimize::noise::Measured::allowance`], or given).
     pub noise: f64,
+    /// The constraints' noise, absolute (3σ of the noisiest,
+    /// [`crate::optimize::noise::Measured::allowance_g`]; 0 when not
+    /// measured): [`strictly_feasible`] nudges a design this far below
+    /// `g = 0` (at least 1e-12), so that its `max g <= 0` is not a jump of
+    /// the noise.
+    pub noise_g: f64,
 }
 
 /// A settled run end.
@@ -282,6 +281,7 @@ pub enum PolishEnd {
     Kept(Termination, f64),
     /// The polish failed (the error's message).
     Failed(String),
+
     /// The certificate at the solver's end could not be computed (the
     /// error's message); no polish ran.
     CertificateFailed(String),
@@ -295,6 +295,7 @@ impl PolishEnd {
             PolishEnd::Replaced(t) => t.to_string(),
             PolishEnd::Kept(t, f) => format!("kept: the polish ended worse ({t}, f = {f})"),
             PolishEnd::Failed(e) => format!("error: {e}"),
+
             PolishEnd::CertificateFailed(e) => format!("error: certificate: {e}"),
         }
     }
@@ -559,10 +560,7 @@ fn settle_end(
         gradient_calls: calls.1,
         last: outcome.iterations,
     };
-    let options = MmfdOptions {
-        noise: policy.noise,
-        ..MmfdOptions::polish_for(tol)
-    };
+    let options = MmfdOptions::polish_for(tol).with_noise(policy.noise);
     let polished = LocalSolver::minimize(&options, &counted, &outcome.x, &mut continued);
     let last = continued.last;
     let polished = polished.and_then(|p| {
@@ -643,10 +641,13 @@ pub fn strictly_feasible(
         return Ok(None);
     }
     let ev = problem.evaluate(&end.x, true)?;
-    Ok(kkt::nudge_inside(problem, &end.x, &ev)?.map(|(x, e)| {
-        let m = e.max_g();
-        (x, e.f, m)
-    }))
+    let margin = policy.noise_g.max(1e-12);
+    Ok(
+        kkt::nudge_inside(problem, &end.x, &ev, margin)?.map(|(x, e)| {
+            let m = e.max_g();
+            (x, e.f, m)
+        }),
+    )
 }
 
 #[cfg(test)]

@@ -27,6 +27,7 @@ fn policy(polish: bool) -> EndPolicy {
         polish,
         rescue: false,
         noise: 1e-6,
+        noise_g: 0.0,
     }
 }
 

@@ -7,7 +7,6 @@ use super::section::{multistart_plan, MultistartPlan, NoiseAllowance};
 use super::{driver, optimum_report, robustness};
 use crate::error::{Error, Result};
 use crate::explore::context::Context;
-use crate::explore::local::settle::DEFAULT_NOISE;
 use crate::explore::local::{solvers, violation};
 use crate::explore::persist::fingerprint;
 use crate::explore::persist::journal::Journaled;
@@ -63,7 +62,7 @@ pub fn multistart_with(
         shard: ctx.flags.shard,
         quiet: ctx.quiet,
         history_start: report_plan.as_ref().map(|_| optimum_report::REPORTED_START),
-        end: section.end_policy(noise.0),
+        end: section.end_policy(noise.0, noise.1.as_ref().map_or(0.0, Measured::allowance_g)),
     };
     let mut report = driver::run(
         problem,
@@ -131,15 +130,15 @@ fn every_run_failed(report: &driver::Report) -> Result<()> {
 
 /// `[multistart] noise`: the allowance given, or ECNoise's at the first
 /// start (3σ of f; [`crate::optimize::noise::Measured::allowance`]) with
-/// the measurement.
-fn noise_allowance(
+/// the measurement (0 without starts: no run uses it).
+pub(crate) fn noise_allowance(
     ctx: &Context,
     problem: &dyn Problem,
     plan: &MultistartPlan,
 ) -> Result<(f64, Option<Measured>)> {
     let x0 = match (plan.section.noise, plan.starts.points.first()) {
         (NoiseAllowance::Given(v), _) => return Ok((v, None)),
-        (NoiseAllowance::Measured(_), None) => return Ok((DEFAULT_NOISE, None)),
+        (NoiseAllowance::Measured(_), None) => return Ok((0.0, None)),
         (NoiseAllowance::Measured(_), Some(x0)) => x0,
     };
     let m = estimate(problem, x0, ctx.study.meta.seed, &NoiseOptions::default())?;
@@ -165,8 +164,9 @@ fn level(m: &Measured) -> String {
 
 /// With `[multistart] noise = "measured"`: ECNoise at every certified
 /// optimum (the same options and seed as at the first start), written to
-/// `optima.csv`'s noise columns ([`driver::NOISE_COLUMNS`]) and printed.
-fn noise_at_optima(
+/// `optima.csv`'s noise columns ([`driver::NOISE_COLUMNS`]) and printed
+/// (also by `plyscape merge`, at the merged optima).
+pub(crate) fn noise_at_optima(
     ctx: &Context,
     problem: &dyn Problem,
     report: &mut driver::Report,

@@ -79,10 +79,11 @@ pub struct Report {
     /// The iteration records of [`Settings::history_start`], with their
     /// wall times, when that start ran in this invocation.
     pub history: Option<TimedHistory>,
-    /// The noise allowance the runs' ends were settled with (set by the
-    /// multistart command; `None` where a report is read back, as by
-    /// `merge`).
-    pub noise: Option<f64>,
+    /// The noise allowances the runs' ends were settled with, of f
+    /// (relative) and of g (absolute; [`crate::explore::local::settle::EndPolicy`]),
+    /// set by the multistart command; `None` where a report is read back,
+    /// as by `merge`.
+    pub noise: Option<(f64, f64)>,
 }
 
 impl Report {
@@ -358,7 +359,7 @@ pub fn run(
     Ok(Report {
         new_runs,
         history,
-        noise: Some(settings.end.noise),
+        noise: Some((settings.end.noise, settings.end.noise_g)),
         ..report
     })
 }
@@ -550,6 +551,7 @@ mod tests {
             polish: true,
             rescue: true,
             noise: 1e-6,
+            noise_g: 0.0,
         };
         let row = one_run(&p, fails, &end, 3, &[0.0, 1.0], &mut NoObserver);
         assert!(row.result.is_none() && row.exit.contains("singular"));

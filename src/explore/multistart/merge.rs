@@ -2,9 +2,9 @@
 //! its own `shard-i-of-n/` directory) put back together into the tables an
 //! unsharded run gives.
 
-use super::command::print_optima;
+use super::command::{noise_at_optima, print_optima};
 use super::driver::{self, Shard};
-use super::section::{multistart_plan, MultistartPlan};
+use super::section::{multistart_plan, MultistartPlan, NoiseAllowance};
 use crate::error::{Error, Result};
 use crate::explore::context::{Context, DriveFlags};
 use crate::explore::persist::fingerprint::{self, Fingerprint};
@@ -67,7 +67,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<driver::Report
         .iter()
         .filter_map(|m| multistart_entry(m)?.detail.counts.map(|c| c.wall_seconds))
         .fold(0.0, f64::max);
-    let report = driver::finish(vars, m, rows, plan.tolerances, &dir, wall)?;
+    let mut report = driver::finish(vars, m, rows, plan.tolerances, &dir, wall)?;
     // The manifest's thread count: the largest any shard used.
     let threads = manifests.iter().map(|m| m.threads).max().unwrap_or(1);
     let ctx = Context {
@@ -77,6 +77,11 @@ pub fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<driver::Report
         quiet,
         flags: DriveFlags::default(),
     };
+    // The noise at the merged optima, as an unsharded run measures it (the
+    // same seed: the same tables).
+    if let NoiseAllowance::Measured(_) = plan.section.noise {
+        noise_at_optima(&ctx, problem.as_ref(), &mut report, &dir)?;
+    }
     let entry = MergeEntry {
         complete: true,
         merged_from: dirs.iter().map(|d| d.display().to_string()).collect(),

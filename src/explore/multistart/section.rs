@@ -10,7 +10,6 @@
 use super::cluster::Tolerances;
 use super::sampling::{self, Sampler};
 use crate::error::{Error, Result};
-use crate::explore::local::settle::DEFAULT_NOISE;
 use crate::explore::local::solvers::{LocalMethod, MmfdPreset, MmfdSettings};
 use crate::optimize::Problem;
 use crate::study::Study;
@@ -92,10 +91,11 @@ pub struct MultistartSection {
     pub mmfd: MmfdSettings,
     /// The rise of f, relative to `max(|f|, 1)`, that the polish tolerates
     /// among designs within the evaluation's noise: a number, or
-    /// `"measured"` (ECNoise at the first start before the runs, 8
-    /// function calls or more: 3σ of f; `crate::optimize::noise`), which
-    /// also measures it at every certified optimum (`optima.csv`'s
-    /// `noise_*` columns). Default [`DEFAULT_NOISE`].
+    /// `"measured"` (the default: ECNoise at the first start before the
+    /// runs, 8 function calls or more: 3σ of f, 0 where f is smooth at
+    /// every step tried, as a closed form is; `crate::optimize::noise`),
+    /// which also measures it at every certified optimum (`optima.csv`'s
+    /// `noise_*` columns).
     #[serde(default)]
     pub noise: NoiseAllowance,
 }
@@ -120,7 +120,7 @@ pub enum Measure {
 
 impl Default for NoiseAllowance {
     fn default() -> Self {
-        NoiseAllowance::Given(DEFAULT_NOISE)
+        NoiseAllowance::Measured(Measure::Measured)
     }
 }
 
@@ -134,14 +134,16 @@ impl MultistartSection {
         }
     }
 
-    /// What happens at every run's end, with the noise allowance `noise`
-    /// (given, or measured by the command).
-    pub fn end_policy(&self, noise: f64) -> crate::explore::local::settle::EndPolicy {
+    /// What happens at every run's end, with the noise allowances `noise`
+    /// of f (relative; given, or measured by the command) and `noise_g`
+    /// of the constraints (absolute; 0 when not measured).
+    pub fn end_policy(&self, noise: f64, noise_g: f64) -> crate::explore::local::settle::EndPolicy {
         crate::explore::local::settle::EndPolicy {
             tolerances: self.kkt_tolerances(),
             polish: self.polish,
             rescue: self.rescue,
             noise,
+            noise_g,
         }
     }
 }

@@ -108,6 +108,8 @@ pub struct SceneProblemSpec {
     /// `[scene.integrator] rtol`, atol following at the scene's ratio) or
     /// `"auto"`, the loosest whose measured noise sits a decade below the
     /// feasibility tolerance ([`super::accuracy`]). Default: the scene's.
+    /// The constraint bounds and the objective's divisor are computed at
+    /// it (with `"auto"`, again once it is chosen).
     pub rtol: Option<RtolSetting>,
 }
 
@@ -218,12 +220,12 @@ impl SceneProblem {
             splits: Default::default(),
         };
         problem.study_tolerances = problem.tolerances();
+        if let Some(RtolSetting::Given(r)) = spec.rtol {
+            problem.set_tolerance(r);
+        }
         problem.set_references(study, &spec)?;
         match spec.rtol {
-            None => {}
-            Some(RtolSetting::Given(r)) => {
-                problem.set_tolerance(r);
-            }
+            None | Some(RtolSetting::Given(_)) => {}
             Some(RtolSetting::Auto(_)) => {
                 // τ of the study: [multistart]'s, read raw (the problem
                 // sits below the drivers), else the drivers' default.
@@ -254,6 +256,11 @@ impl SceneProblem {
                     }
                 };
                 problem.choice = Some(choice);
+                // The bounds and the divisor again, at the tolerance chosen:
+                // a bound "at the start's value" then holds the start on
+                // it, not 1e-5 off by the scene tolerance's error.
+                problem.constraints.clear();
+                problem.set_references(study, &spec)?;
             }
         }
         Ok(problem)
@@ -338,8 +345,9 @@ impl SceneProblem {
 
     /// Integrate with the tolerances `rtol` and `atol` from now on
     /// (overrides `[scene.integrator]`; the constraint bounds and the
-    /// objective's divisor stay those of the study's own tolerances: the
-    /// problem is the same, evaluated more or less accurately).
+    /// objective's divisor stay those the problem was built with: the
+    /// problem is the same, evaluated more or less accurately; the
+    /// study's `rtol` is set before they are computed).
     pub fn set_tolerances(&mut self, rtol: f64, atol: f64) {
         self.plan.set_tolerances(rtol, atol);
     }

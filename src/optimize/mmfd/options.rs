@@ -85,8 +85,10 @@ pub struct MmfdOptions {
     /// the decreases left near an optimum fall below the evaluation's noise.
     pub slope_search: bool,
     /// The relative noise of f that the slope search tolerates as a rise
-    /// (of `max(|f|, 1)`): 1e-6 in the polish, the relative tolerance at
-    /// which the scenes integrate their motion; 0 in DOT's settings.
+    /// (of `max(|f|, 1)`): 0 for a function exact to rounding (DOT's
+    /// settings and the polish's own); the drivers give the noise they
+    /// measured (ECNoise, `crate::optimize::noise`) with
+    /// [`MmfdOptions::with_noise`].
     pub noise: f64,
 }
 
@@ -148,7 +150,8 @@ impl MmfdOptions {
     /// round-off level (DELOBJ 1e-12 for 3 iterations, no DABOBJ), a first
     /// step that seeks 1 % of |f| and moves each variable at most 5 % of
     /// its range per trial, 200 iterations, and the slope search where f's
-    /// decrease is lost in its noise.
+    /// decrease is lost in its noise (none tolerated until
+    /// [`MmfdOptions::with_noise`] says how much there is).
     pub fn polish_for(tol: &KktTolerances) -> MmfdOptions {
         MmfdOptions {
             ct: -tol.active.max(1e-12),
@@ -162,10 +165,17 @@ impl MmfdOptions {
             kt_tolerance: 0.5 * tol.stationarity,
             kt_scale: KtScale::Gradient,
             slope_search: true,
-            noise: 1e-6,
             ..MmfdOptions::default()
         }
         .with_feasibility(tol.feasibility)
+    }
+
+    /// The slope search tolerating a rise of f of `noise · max(|f|, 1)`:
+    /// the evaluation's measured noise (3σ of f relative,
+    /// `crate::optimize::noise::Measured::allowance`).
+    pub fn with_noise(mut self, noise: f64) -> MmfdOptions {
+        self.noise = noise;
+        self
     }
 
     /// CTMIN set to the feasibility tolerance `tol` (at least 1e-12, as

@@ -159,8 +159,8 @@ fn measured_noise_is_reported_at_the_optima_and_keeps_every_end() {
     assert_eq!(column(&o, "noise_failed")[0], "");
     let n: usize = column(&o, "noise_evaluations")[0].parse().unwrap();
     assert!(n >= 8, "{n}");
-    // The same study without the key: no noise columns.
-    let plain = hs100("method = \"sqp\"\n")
+    // The same study with an allowance given: no noise columns.
+    let plain = hs100("method = \"sqp\"\nnoise = 1e-9\n")
         .replace("name = \"hs100\"\nseed", "name = \"hs100_plain\"\nseed");
     let s = study("hs100_plain", &plain);
     explore::run_multistart(&ctx(&s, &dir, 2, DriveFlags::default())).unwrap();

@@ -64,8 +64,9 @@ fn measured_noise_of_an_analytic_problem_is_rounding() {
                 [multistart]\nstarts = 4\nnoise = \"measured\"\n";
     let s = study("hn", text);
     let r = explore::run_multistart(&ctx(&s, &dir, 1, DriveFlags::default())).unwrap();
-    let allowance = r.noise.expect("set by the command");
+    let (allowance, allowance_g) = r.noise.expect("set by the command");
     assert!((0.0..1e-12).contains(&allowance), "{allowance}");
+    assert_eq!(allowance_g, 0.0, "Himmelblau has no constraints");
     let manifest = plyscape::report::read_manifest(&dir.join("hn")).unwrap();
     let noise = &manifest["commands"]["multistart"]["noise"];
     assert!(noise["evaluations"].as_u64().unwrap() >= 8, "{noise}");
