@@ -312,6 +312,7 @@ pub fn ordered_cholesky<T: Scalar>(
         a[i * n + i] = a[i * n + i] * si * si + regt;
     }
     let mut rank = 0;
+    let mut lk: Vec<T> = Vec::with_capacity(n);
     for k in 0..n {
         let d = a[k * n + k];
         if d.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) {
@@ -324,17 +325,21 @@ pub fn ordered_cholesky<T: Scalar>(
         a[k * n + k] = lkk;
         let inv = T::one() / lkk;
         let rows = &pattern.col_rows[k];
+        // Column k of L, also gathered into `lk` (contiguous) for the
+        // update of the rows below it, which does not write column k.
+        lk.clear();
         for &r in rows {
-            a[r * n + k] *= inv;
+            let v = &mut a[r * n + k];
+            *v *= inv;
+            lk.push(*v);
         }
-        for (ir, &r) in rows.iter().enumerate() {
-            let lr = a[r * n + k];
+        for (ir, (&r, &lr)) in rows.iter().zip(&lk).enumerate() {
             if lr.is_exact_zero() {
                 continue;
             }
-            for &c in &rows[..=ir] {
-                let lc = a[c * n + k];
-                a[r * n + c] -= lr * lc;
+            let row = &mut a[r * n..(r + 1) * n];
+            for (&c, &lc) in rows[..=ir].iter().zip(&lk[..=ir]) {
+                row[c] -= lr * lc;
             }
         }
     }
