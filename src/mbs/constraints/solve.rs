@@ -106,6 +106,17 @@ impl System {
         let inv = &ws.inv_order;
         let permuted: Vec<(usize, usize)> = edges.iter().map(|&(r, c)| (inv[r], inv[c])).collect();
         ws.spd.set_pattern(CholPattern::new(m, &permuted));
+        // Where each Gram entry `(x, c ≤ x)` of each body lands in the
+        // permuted lower triangle, in the order `solve` adds them.
+        ws.scatter.clear();
+        for bb in &ws.blocks {
+            for (x, r) in bb.rows.iter().enumerate() {
+                for q in &bb.rows[..=x] {
+                    let (pr, pc) = (inv[*r], inv[*q]);
+                    ws.scatter.push(pr.max(pc) * m + pr.min(pc));
+                }
+            }
+        }
     }
 
     /// Solve for the multipliers and accelerations with the rows, applied
@@ -135,16 +146,13 @@ impl System {
                 sol.rhs[r] -= bb.g[(k - 1) * k + i];
             }
         }
-        let inv = &ws.inv_order;
-        ws.a.clear();
-        ws.a.resize(m * m, 0.0);
+        ws.spd.zero_matrix(&mut ws.a, m);
+        let mut at = ws.scatter.iter();
         for bb in &ws.blocks {
             let k = bb.rows.len() + 1;
-            for (x, r) in bb.rows.iter().enumerate() {
-                for (c, q) in bb.rows[..=x].iter().enumerate() {
-                    let (pr, pc) = (inv[*r], inv[*q]);
-                    let (hi, lo) = if pr >= pc { (pr, pc) } else { (pc, pr) };
-                    ws.a[hi * m + lo] += bb.g[x * k + c];
+            for x in 0..bb.rows.len() {
+                for (g, &e) in bb.g[x * k..x * k + x + 1].iter().zip(at.by_ref()) {
+                    ws.a[e] += g;
                 }
             }
         }
@@ -158,14 +166,7 @@ impl System {
         let mut ndrop = 0;
         for (r, _) in sol.dropped.iter().enumerate().filter(|(_, d)| **d) {
             ndrop += 1;
-            let p = inv[r];
-            for c in 0..p {
-                ws.a[p * m + c] = 0.0;
-            }
-            for q in p + 1..m {
-                ws.a[q * m + p] = 0.0;
-            }
-            ws.a[p * m + p] = 1.0;
+            ws.spd.unit_row(&mut ws.a, m, ws.inv_order[r]);
             sol.rhs[r] = 0.0;
         }
         let f = spd_factor(

@@ -22,6 +22,45 @@ impl SpdScratch {
         self.pattern = pattern;
     }
 
+    /// Make `a` the zero `m × m` matrix as far as [`spd_factor`] reads
+    /// it: a matrix of another size is replaced by zeros; one of this
+    /// size has only the entries of the pattern (the diagonal and the
+    /// possible nonzeros of `L`) set to zero, `m + nnz(L)` stores instead
+    /// of `m²` (the SAR constraint-space matrix: 660 of 4225). Sound
+    /// while nothing writes `a` outside the pattern: the factorization
+    /// does not, and the caller scatters only entries of the matrix's own
+    /// pattern, which the symbolic factorization contains.
+    pub fn zero_matrix(&mut self, a: &mut Vec<f64>, m: usize) {
+        if a.len() != m * m {
+            a.clear();
+            a.resize(m * m, 0.0);
+            return;
+        }
+        let pattern = self.pattern(m);
+        for (i, cols) in pattern.row_cols.iter().enumerate() {
+            for &j in cols {
+                a[i * m + j] = 0.0;
+            }
+            a[i * m + i] = 0.0;
+        }
+    }
+
+    /// Replace row and column `p` of the lower triangle of `a` by the
+    /// unit row (a row left out of the solve: its multiplier is zero):
+    /// the entries of the pattern in row `p` and column `p` are set to
+    /// zero, the diagonal to one; the others are zero already
+    /// ([`SpdScratch::zero_matrix`]).
+    pub fn unit_row(&mut self, a: &mut [f64], m: usize, p: usize) {
+        let pattern = self.pattern(m);
+        for &c in &pattern.row_cols[p] {
+            a[p * m + c] = 0.0;
+        }
+        for &q in &pattern.col_rows[p] {
+            a[q * m + p] = 0.0;
+        }
+        a[p * m + p] = 1.0;
+    }
+
     /// The pattern for an `m × m` matrix: the one set, or a dense one.
     fn pattern(&mut self, m: usize) -> &CholPattern {
         if self.pattern.n != m {
@@ -273,6 +312,7 @@ pub fn ordered_cholesky<T: Scalar>(
         a[i * n + i] = a[i * n + i] * si * si + regt;
     }
     let mut rank = 0;
+    let mut lk: Vec<T> = Vec::with_capacity(n);
     for k in 0..n {
         let d = a[k * n + k];
         if d.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) {
@@ -285,17 +325,21 @@ pub fn ordered_cholesky<T: Scalar>(
         a[k * n + k] = lkk;
         let inv = T::one() / lkk;
         let rows = &pattern.col_rows[k];
+        // Column k of L, also gathered into `lk` (contiguous) for the
+        // update of the rows below it, which does not write column k.
+        lk.clear();
         for &r in rows {
-            a[r * n + k] *= inv;
+            let v = &mut a[r * n + k];
+            *v *= inv;
+            lk.push(*v);
         }
-        for (ir, &r) in rows.iter().enumerate() {
-            let lr = a[r * n + k];
+        for (ir, (&r, &lr)) in rows.iter().zip(&lk).enumerate() {
             if lr.is_exact_zero() {
                 continue;
             }
-            for &c in &rows[..=ir] {
-                let lc = a[c * n + k];
-                a[r * n + c] -= lr * lc;
+            let row = &mut a[r * n..(r + 1) * n];
+            for (&c, &lc) in rows[..=ir].iter().zip(&lk[..=ir]) {
+                row[c] -= lr * lc;
             }
         }
     }

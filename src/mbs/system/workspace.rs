@@ -105,6 +105,10 @@ pub struct Workspace<T: Scalar> {
     pub(crate) pvals: Vec<T>,
     /// Position of each row in the fill-reducing order.
     pub(crate) inv_order: Vec<usize>,
+    /// Per Gram entry of the body blocks (body by body, row by row, the
+    /// lower triangle): its index in the permuted constraint-space
+    /// matrix `a` (row-major `m × m`, lower triangle).
+    pub(crate) scatter: Vec<usize>,
     pub(crate) spd: SpdScratch,
     /// Applied generalized forces, all bodies (velocity layout).
     pub q: Vec<T>,
@@ -282,6 +286,7 @@ impl<T: Scalar> Workspace<T> {
             inv_spare: Vec::new(),
             kinetic: Vec::new(),
             inv_order: Vec::new(),
+            scatter: Vec::new(),
             spd: Default::default(),
             q: Vec::new(),
             rank: 0,
