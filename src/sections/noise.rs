@@ -79,7 +79,7 @@ pub struct NoiseSpec {
     /// tolerance (default false).
     #[serde(default)]
     pub solve: bool,
-    /// The local search's method (as `[multistart] method`; default mmfd).
+    /// The local search's method (as `[multistart] method`; default sqp).
     #[serde(default)]
     pub method: LocalMethod,
     /// The local search's feasibility tolerance (default 1e-6).

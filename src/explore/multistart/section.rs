@@ -279,7 +279,7 @@ mod tests {
         ));
         let p = problem(&s).unwrap();
         let plan = multistart_plan(&s, p.as_ref()).unwrap();
-        assert_eq!(plan.section.method, LocalMethod::Mmfd);
+        assert_eq!(plan.section.method, LocalMethod::Sqp);
         assert_eq!(plan.section.sampler, Sampler::Lhs);
         assert_eq!(plan.starts.points.len(), 6);
         assert_eq!(plan.starts.points[0], [1.0, 2.0]);

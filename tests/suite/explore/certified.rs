@@ -9,10 +9,17 @@ use plyscape::explore::{self, DriveFlags};
 /// 100) and its standard start (1, 2, 0, 4, 0, 1, 1).
 const HS100_F: f64 = 680.630_057_3;
 
+/// The HS 100 multistart with `extra` keys; MMFD (DOT's settings) unless
+/// `extra` names the method.
 fn hs100(extra: &str) -> String {
+    let method = if extra.contains("method") {
+        ""
+    } else {
+        "method = \"mmfd\"\n"
+    };
     format!(
         "[study]\nname = \"hs100\"\nseed = 3\n[problem]\nname = \"hs100\"\n\
-         [multistart]\nsampler = \"lhs\"\nstarts = 19\npoints = [[1.0, 2.0, 0.0, 4.0, 0.0, 1.0, 1.0]]\n{extra}"
+         [multistart]\n{method}sampler = \"lhs\"\nstarts = 19\npoints = [[1.0, 2.0, 0.0, 4.0, 0.0, 1.0, 1.0]]\n{extra}"
     )
 }
 

@@ -4,10 +4,17 @@ use crate::common::explore::{column, ctx, study, table_without};
 use crate::common::temp_dir;
 use plyscape::explore::{self, DriveFlags};
 
+/// A compare study: the MMFD multistart (unless `extra` names the method;
+/// CMA-ES gets its calls as budget), then CMA-ES.
 fn text(name: &str, problem: &str, extra: &str) -> String {
+    let method = if extra.contains("method") {
+        ""
+    } else {
+        "method = \"mmfd\"\n"
+    };
     format!(
         "[study]\nname = \"{name}\"\nseed = 4\n[problem]\nname = \"{problem}\"\n\
-         [multistart]\nsampler = \"sobol\"\nstarts = 16\n{extra}[compare]\n[map]\nresolution = 21\n"
+         [multistart]\n{method}sampler = \"sobol\"\nstarts = 16\n{extra}[compare]\n[map]\nresolution = 21\n"
     )
 }
 

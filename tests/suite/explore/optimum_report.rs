@@ -17,7 +17,7 @@ use std::path::Path;
 
 const HS22: &str = "[study]\nname = \"rep_hs22\"\nseed = 7\n\
     [problem]\nname = \"hs22\"\n\
-    [multistart]\nsampler = \"sobol\"\nstarts = 8\nfeasible_only = true\npoints = [[0.0, 1.0]]\n\
+    [multistart]\nmethod = \"mmfd\"\nsampler = \"sobol\"\nstarts = 8\nfeasible_only = true\npoints = [[0.0, 1.0]]\n\
     [optimum_report]\n";
 
 /// A table as rows of text, header first.
