@@ -373,8 +373,6 @@ mod tests {
         }
     }
 
-    /// The disc problem (f = x + y on x² + y² <= 1): at x* = −(1, 1)/√2 the
-    /// multiplier is 1/√2 (∇f = (1, 1) = −λ (−√2, −√2), closed form).
     /// A certificate at the design of the last evaluation with gradients
     /// reuses it: through a counter (and a counter started from it, as the
     /// drivers nest them) no call is counted; elsewhere one gradient call.
@@ -394,6 +392,8 @@ mod tests {
         assert_eq!((inner.function_calls(), inner.gradient_calls()), (1, 1));
     }
 
+    /// The disc problem (f = x + y on x² + y² <= 1): at x* = −(1, 1)/√2 the
+    /// multiplier is 1/√2 (∇f = (1, 1) = −λ (−√2, −√2), closed form).
     /// Beyond the tolerance the end is infeasible and not a stationary
     /// point of the violation; on the tolerance a nudge reaches max g <= 0.
     #[test]

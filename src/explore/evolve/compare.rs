@@ -12,7 +12,6 @@ use crate::explore::multistart::command::{multistart_with, noise_allowance};
 use crate::explore::multistart::section::multistart_plan;
 use crate::explore::persist::tables;
 use crate::explore::problem::build::problem;
-use crate::optimize::noise::Measured;
 use crate::optimize::{Counted, Problem};
 
 /// Which of a method's designs a comparison row holds.
@@ -105,14 +104,11 @@ pub fn run_compare(ctx: &Context) -> Result<Vec<ComparisonRow>> {
     let dir = ctx.dir()?;
     // The multistart's allowance; a multistart read back from complete
     // tables has none, and the first start's noise is measured again.
-    let (noise, noise_g) = match ms.noise {
+    let noise = match ms.noise {
         Some(n) => n,
-        None => {
-            let (f, m) = noise_allowance(ctx, problem.as_ref(), &plan)?;
-            (f, m.as_ref().map_or(0.0, Measured::allowance_g))
-        }
+        None => noise_allowance(ctx, problem.as_ref(), &plan)?.0,
     };
-    let policy = plan.section.end_policy(noise, noise_g);
+    let policy = plan.section.end_policy(noise);
     let tolerance = policy.tolerances.feasibility;
     let base = ComparisonRow {
         method: format!("multistart-{}", plan.section.method.name()),

@@ -281,7 +281,6 @@ pub enum PolishEnd {
     Kept(Termination, f64),
     /// The polish failed (the error's message).
     Failed(String),
-
     /// The certificate at the solver's end could not be computed (the
     /// error's message); no polish ran.
     CertificateFailed(String),
@@ -295,7 +294,6 @@ impl PolishEnd {
             PolishEnd::Replaced(t) => t.to_string(),
             PolishEnd::Kept(t, f) => format!("kept: the polish ended worse ({t}, f = {f})"),
             PolishEnd::Failed(e) => format!("error: {e}"),
-
             PolishEnd::CertificateFailed(e) => format!("error: certificate: {e}"),
         }
     }

@@ -62,7 +62,7 @@ pub fn multistart_with(
         shard: ctx.flags.shard,
         quiet: ctx.quiet,
         history_start: report_plan.as_ref().map(|_| optimum_report::REPORTED_START),
-        end: section.end_policy(noise.0, noise.1.as_ref().map_or(0.0, Measured::allowance_g)),
+        end: section.end_policy(noise.0),
     };
     let mut report = driver::run(
         problem,
@@ -128,17 +128,19 @@ fn every_run_failed(report: &driver::Report) -> Result<()> {
     ))
 }
 
-/// `[multistart] noise`: the allowance given, or ECNoise's at the first
-/// start (3σ of f; [`crate::optimize::noise::Measured::allowance`]) with
-/// the measurement (0 without starts: no run uses it).
+/// `[multistart] noise`: the allowances of f and of g (see
+/// [`super::section::MultistartSection::end_policy`]): f's given (g's
+/// then 0), or ECNoise's at the first start (3σ;
+/// [`crate::optimize::noise::Measured::allowance`] and `allowance_g`) with
+/// the measurement (0 without starts: no run uses them).
 pub(crate) fn noise_allowance(
     ctx: &Context,
     problem: &dyn Problem,
     plan: &MultistartPlan,
-) -> Result<(f64, Option<Measured>)> {
+) -> Result<((f64, f64), Option<Measured>)> {
     let x0 = match (plan.section.noise, plan.starts.points.first()) {
-        (NoiseAllowance::Given(v), _) => return Ok((v, None)),
-        (NoiseAllowance::Measured(_), None) => return Ok((0.0, None)),
+        (NoiseAllowance::Given(v), _) => return Ok(((v, 0.0), None)),
+        (NoiseAllowance::Measured(_), None) => return Ok(((0.0, 0.0), None)),
         (NoiseAllowance::Measured(_), Some(x0)) => x0,
     };
     let m = estimate(problem, x0, ctx.study.meta.seed, &NoiseOptions::default())?;
@@ -150,7 +152,7 @@ pub(crate) fn noise_allowance(
             m.evaluations
         );
     }
-    Ok((m.allowance(), Some(m)))
+    Ok(((m.allowance(), m.allowance_g()), Some(m)))
 }
 
 /// The noise of f for the terminal: relative to |f|, or why it was not

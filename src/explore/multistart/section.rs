@@ -134,10 +134,13 @@ impl MultistartSection {
         }
     }
 
-    /// What happens at every run's end, with the noise allowances `noise`
-    /// of f (relative; given, or measured by the command) and `noise_g`
-    /// of the constraints (absolute; 0 when not measured).
-    pub fn end_policy(&self, noise: f64, noise_g: f64) -> crate::explore::local::settle::EndPolicy {
+    /// What happens at every run's end, with the noise allowances
+    /// `(noise, noise_g)` of f (relative; given, or measured by the
+    /// command) and of the constraints (absolute; 0 when not measured).
+    pub fn end_policy(
+        &self,
+        (noise, noise_g): (f64, f64),
+    ) -> crate::explore::local::settle::EndPolicy {
         crate::explore::local::settle::EndPolicy {
             tolerances: self.kkt_tolerances(),
             polish: self.polish,
