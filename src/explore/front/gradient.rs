@@ -37,7 +37,7 @@
 
 use crate::error::{Error, Result};
 use crate::explore::local::settle::EndPolicy;
-use crate::explore::local::solvers::LocalSolver;
+use crate::explore::local::solvers::{LocalMethod, LocalSolver};
 use crate::explore::multistart::driver::one_run;
 use crate::explore::persist::tables::{class_name, RunRecord};
 use crate::optimize::kkt::EndClass;
@@ -47,6 +47,7 @@ use crate::optimize::multiobjective::{
     non_dominated, EpsilonConstraint, MultiProblem, Tchebycheff,
 };
 use crate::optimize::noise::{estimate, NoiseOptions};
+use crate::optimize::sqp::SqpOptions;
 use crate::optimize::{NoObserver, Problem};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -65,8 +66,16 @@ pub struct GradientSettings {
     pub subproblems: usize,
     /// Worker threads.
     pub threads: usize,
-    /// MMFD's options for every subproblem.
+    /// The local solver of every anchor and subproblem (`[front] method`):
+    /// MMFD with `mmfd`, or SQP with `sqp`.
+    pub method: LocalMethod,
+    /// MMFD's options.
     pub mmfd: MmfdOptions,
+    /// SQP's options.
+    pub sqp: SqpOptions,
+    /// Subproblems placed in the largest gaps of the front found so far,
+    /// after the lattice's (two objectives; [`super::gaps`]).
+    pub refine: usize,
     /// Certificate and polish of every end.
     pub end: EndPolicy,
     /// Starts of each anchor's first run: the start design, then uniform
@@ -166,14 +175,23 @@ fn between_anchors(
     )
 }
 
-/// One settled MMFD run of `p` from `x0`.
-fn solve(p: &dyn Problem, s: &GradientSettings, index: usize, x0: &[f64]) -> RunRecord {
-    let solver: &dyn LocalSolver = &s.mmfd;
-    one_run(p, solver, &s.end, index, x0, &mut NoObserver)
+impl GradientSettings {
+    /// The local solver of `method`.
+    pub fn solver(&self) -> &dyn LocalSolver {
+        match self.method {
+            LocalMethod::Sqp => &self.sqp,
+            _ => &self.mmfd,
+        }
+    }
+}
+
+/// One settled run of `p` from `x0` by the settings' solver.
+pub(super) fn solve(p: &dyn Problem, s: &GradientSettings, index: usize, x0: &[f64]) -> RunRecord {
+    one_run(p, s.solver(), &s.end, index, x0, &mut NoObserver)
 }
 
 /// Is the run's end certified (converged and feasible to the tolerance)?
-fn certified(run: &RunRecord, tol: f64) -> bool {
+pub(super) fn certified(run: &RunRecord, tol: f64) -> bool {
     run.certificate
         .as_ref()
         .is_some_and(|c| c.class == EndClass::Converged && c.max_g <= tol)
@@ -182,7 +200,7 @@ fn certified(run: &RunRecord, tol: f64) -> bool {
 
 /// The objectives at a certified end's design (its first `n` values),
 /// counted into `calls`.
-fn objectives(
+pub(super) fn objectives(
     problem: &dyn MultiProblem,
     run: &RunRecord,
     tol: f64,
@@ -313,7 +331,10 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
     let runs: Vec<Result<(RunRecord, usize)>> = pool.install(|| {
         refs.par_iter()
             .enumerate()
-            .map(|(k, r)| subproblem(problem, s, (k, r), (&ideal, &scale), &anchor_x, &x0))
+            .map(|(k, r)| {
+                let start = between_anchors(problem, &anchor_x, r).unwrap_or_else(|| x0.clone());
+                subproblem(problem, s, (k, r), (&ideal, &scale), &start, &x0)
+            })
             .collect()
     });
     for (k, run) in runs.into_iter().enumerate() {
@@ -326,6 +347,11 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
             run,
             f,
         });
+    }
+    // Subproblems in the largest gaps of the front found so far.
+    if m == 2 && s.refine > 0 {
+        let norm = (ideal.as_slice(), scale.as_slice());
+        extra_calls += super::gaps::refine(problem, s, &pool, norm, &x0, &mut ends)?;
     }
     // 3. The non-dominated certified ends.
     let points = non_dominated_ends(problem.variables().len(), &ends);
@@ -443,15 +469,15 @@ fn ideal_and_nadir(anchor_f: &[&Vec<f64>], m: usize) -> (Vec<f64>, Vec<f64>, Vec
 }
 
 /// Subproblem `k` with reference weights `r`: the Tchebycheff problem
-/// normalised by `(ideal, scale)`, from the anchors' blend and once more
-/// from `x0` when that run is not certified; with the 2 probe evaluations
-/// of its start.
-fn subproblem(
+/// normalised by `(ideal, scale)`, from `x_start` (the anchors' blend, or
+/// a point of the front found so far) and once more from `x0` when that
+/// run is not certified; with the 2 probe evaluations of its start.
+pub(super) fn subproblem(
     problem: &dyn MultiProblem,
     s: &GradientSettings,
     (k, r): (usize, &Vec<f64>),
     (ideal, scale): (&[f64], &[f64]),
-    anchor_x: &[Option<Vec<f64>>],
+    x_start: &[f64],
     x0: &[f64],
 ) -> Result<(RunRecord, usize)> {
     let tol = s.end.tolerances.feasibility;
@@ -463,10 +489,9 @@ fn subproblem(
         RHO,
         (-(m as f64) - 1.0, f64::MAX / 4.0),
     )?;
-    let x_start = between_anchors(problem, anchor_x, r).unwrap_or_else(|| x0.to_vec());
     // (x, t0) from the anchors' blend and from the start design
     // (one evaluation each, counted); t's upper bound admits both.
-    let from_blend = t_probe.start(&x_start)?;
+    let from_blend = t_probe.start(x_start)?;
     let from_x0 = t_probe.start(x0)?;
     let t_hi = from_blend[x0.len()].max(from_x0[x0.len()]).max(0.0) + 1.0;
     let p = Tchebycheff::new(
@@ -489,7 +514,7 @@ fn subproblem(
 
 /// The non-dominated certified ends: (design, objectives) of the ends
 /// with objectives, the first `n` coordinates of each design.
-fn non_dominated_ends(n: usize, ends: &[SubproblemEnd]) -> Vec<(Vec<f64>, Vec<f64>)> {
+pub(super) fn non_dominated_ends(n: usize, ends: &[SubproblemEnd]) -> Vec<(Vec<f64>, Vec<f64>)> {
     let kept: Vec<(Vec<f64>, Vec<f64>)> = ends
         .iter()
         .filter_map(|e| {

@@ -14,6 +14,7 @@
 //!   `front.svg`, ...), with the hypervolume and IGD of each method.
 
 pub mod command;
+pub mod gaps;
 pub mod gradient;
 pub mod grid;
 pub mod outputs;
