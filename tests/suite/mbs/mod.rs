@@ -13,6 +13,7 @@ mod prismatic;
 mod sar;
 mod sar_clamp;
 mod sar_flex;
+mod sar_fold;
 mod sar_holddown;
 mod slider_crank;
 mod stiffening;

@@ -62,7 +62,7 @@ fn law_integral(law: &PiecewiseLaw, a: f64, b: f64) -> f64 {
 }
 
 /// The R3 actuator of a SAR scene: its Eq. (32) law and damper c.
-fn actuator(scene: &plyscape::scene::Scene) -> (PiecewiseLaw, f64) {
+pub(super) fn actuator(scene: &plyscape::scene::Scene) -> (PiecewiseLaw, f64) {
     match scene.model.forces.first() {
         Some(Force::Rotational {
             law: Some(law),
@@ -84,7 +84,7 @@ fn actuator(scene: &plyscape::scene::Scene) -> (PiecewiseLaw, f64) {
 /// ~h⁴ stays far below both tests' bounds, the trapezoid rule would leave
 /// ~1e-11 J on the coarse scene).
 /// Returns (largest |ΔE − W|, largest |ΔE|, the damper's work) [J].
-fn balance(sim: &Simulation, law: &PiecewiseLaw, c: f64) -> (f64, f64, f64) {
+pub(super) fn balance(sim: &Simulation, law: &PiecewiseLaw, c: f64) -> (f64, f64, f64) {
     let (ca, cr, ce) = (
         col(sim, "R3.angle"),
         col(sim, "R3.rate"),

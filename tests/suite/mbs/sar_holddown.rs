@@ -58,7 +58,7 @@ fn response(sim: &Simulation, name: &str) -> (f64, Vec<f64>) {
 /// their derivatives): per moving body three translations, three small
 /// rotations in body axes (quaternion `q ⊗ (1, h/2·e_k)`) and its modal
 /// coordinates; step `h` in m, rad and modal units.
-fn fd_jacobian(sys: &System, y: &[f64], h: f64) -> DMatrix<f64> {
+pub(super) fn fd_jacobian(sys: &System, y: &[f64], h: f64) -> DMatrix<f64> {
     let mut ws = Workspace::empty();
     let phi = |y: &[f64], ws: &mut Workspace<f64>| -> Vec<f64> {
         sys.load(0.0, y, ws);
@@ -113,7 +113,7 @@ fn singular_values(g: &DMatrix<f64>) -> Vec<f64> {
 /// Numerical rank: singular values above `1e-7 σ_max`, with the check that
 /// the spectrum has a clear gap there (no value in [1e-9, 1e-5] σ_max), so
 /// the count does not depend on the threshold.
-fn rank(g: &DMatrix<f64>) -> usize {
+pub(super) fn rank(g: &DMatrix<f64>) -> usize {
     let s = singular_values(g);
     let top = s[0];
     assert!(
