@@ -1,6 +1,6 @@
 //! `[front]`: the Pareto front of two or three objectives, from the
 //! gradient side ([`crate::explore::front::gradient`]: certified Tchebycheff
-//! subproblems solved by MMFD) and from NSGA-II
+//! subproblems solved by MMFD or SQP, `method`) and from NSGA-II
 //! ([`crate::optimize::nsga2`]), with their indicators.
 //!
 //! Budgets: the gradient side runs `subproblems` subproblems (plus one

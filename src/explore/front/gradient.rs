@@ -1,6 +1,6 @@
 //! The gradient side of a Pareto front: a parallel multistart of
-//! scalarized subproblems, each solved by MMFD with the objectives' exact
-//! gradients and settled (certified, polished) as a multistart run is
+//! scalarized subproblems, each solved by MMFD or SQP (`[front] method`)
+//! with the objectives' exact gradients and settled (certified, polished) as a multistart run is
 //! ([`crate::explore::local::settle`]).
 //!
 //! 1. **Anchors** (one per objective `i`, in parallel): minimize `f_i` from
@@ -27,6 +27,8 @@
 //!    its smallest feasible value, `t ∈ [−m − 1, max(t0, 0) + 1]`, and
 //!    once more from the start design when that run does not end
 //!    certified (both counted).
+//!    With `refine` (two objectives), further subproblems where the front
+//!    found so far has its largest gaps ([`super::gaps`]).
 //! 3. **The front**: the ends certified `converged` (feasible, Kuhn–Tucker)
 //!    of the lexicographic anchors and the subproblems, evaluated once more
 //!    for their objectives, and of those the non-dominated ones (equal

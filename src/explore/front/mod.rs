@@ -4,7 +4,8 @@
 //!   NSGA-II budget and population, the optional grid.
 //! - Algorithms: the gradient side ([`gradient`]: anchors, then certified
 //!   Tchebycheff subproblems `min_x max_i w_i (f_i − z_i)/(N_i − z_i)`
-//!   solved by MMFD and settled as a multistart run); NSGA-II
+//!   solved by MMFD or SQP and settled as a multistart run, with
+//!   further subproblems in the largest gaps of its front, [`gaps`]); NSGA-II
 //!   ([`crate::optimize::nsga2`]); a grid of `N` values per variable over
 //!   the box ([`grid`]) as a yardstick. The objectives are an analytic
 //!   multi-objective problem or the scene's responses
