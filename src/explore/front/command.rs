@@ -41,8 +41,11 @@
 //!   the union's nadir plus a tenth of its ideal-to-nadir range in each
 //!   objective (`(1.1, 1.1)` on ZDT1).
 //! - `front_ends.csv`: every run of the gradient side (label, class,
-//!   exit, calls, Kuhn–Tucker residual, end design, objectives of the ends
-//!   that enter the front), to see which ends were certified and why not.
+//!   exit, calls, Kuhn–Tucker residual, what became of the end in the
+//!   front (`front`: `point`, `dominated by <run>`, `equal to <run>`,
+//!   `not certified (<class>)`, `anchor start`), end design, objectives
+//!   of the certified ends), to see which ends were certified and why not,
+//!   and why an end is not a point of the front.
 //! - `grid.csv` (with `grid`): every grid design, its objectives (own
 //!   sign and unit), `max_g`, and the error of a failed evaluation.
 //! - `front.svg`: the first two objectives, every method's front, the

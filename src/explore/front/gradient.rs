@@ -46,7 +46,7 @@ use crate::optimize::kkt::EndClass;
 use crate::optimize::mmfd::MmfdOptions;
 use crate::optimize::mo_testproblems::simplex_lattice;
 use crate::optimize::multiobjective::{
-    non_dominated, EpsilonConstraint, MultiProblem, Tchebycheff,
+    dominates, non_dominated, EpsilonConstraint, MultiProblem, Tchebycheff,
 };
 use crate::optimize::noise::{estimate, NoiseOptions};
 use crate::optimize::sqp::SqpOptions;
@@ -512,6 +512,41 @@ pub(super) fn subproblem(
     again.function_calls += run.function_calls;
     again.gradient_calls += run.gradient_calls;
     Ok((again, 2))
+}
+
+/// What became of each end in the front (`front_ends.csv`'s `front`):
+/// `point` (on the gradient side's front), `dominated by <label>`, `equal
+/// to <label>` (the same objectives as an earlier end's), `not certified
+/// (<class>)`, `objectives not finite`, or `anchor start` (a first anchor
+/// run, whose end enters the front only through its lexicographic
+/// refinement).
+pub fn front_roles(ends: &[SubproblemEnd]) -> Vec<String> {
+    ends.iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let Some(f) = &e.f else {
+                return if e.label.starts_with("anchor-") {
+                    "anchor start".to_string()
+                } else if !e.certified {
+                    format!("not certified ({})", class_name(&e.run))
+                } else {
+                    "objectives not finite".to_string()
+                };
+            };
+            let others = ends.iter().enumerate().filter(|(j, _)| *j != i);
+            let with_f = others.filter_map(|(j, o)| o.f.as_ref().map(|g| (j, o, g)));
+            let mut equal = None;
+            for (j, o, g) in with_f {
+                if dominates(g, f) {
+                    return format!("dominated by {}", o.label);
+                }
+                if j < i && g == f && equal.is_none() {
+                    equal = Some(o.label.clone());
+                }
+            }
+            equal.map_or_else(|| "point".to_string(), |l| format!("equal to {l}"))
+        })
+        .collect()
 }
 
 /// The non-dominated certified ends: (design, objectives) of the ends

@@ -153,8 +153,11 @@ pub fn write_outputs(
 /// `front_ends.csv`: every run of the gradient side, in order (anchors
 /// from each start, lexicographic anchors, subproblems): its label, class
 /// (`converged` ends are certified), the solver's exit, calls, the
-/// Kuhn–Tucker residual, the end design (without the subproblem's `t`)
-/// and, for the ends that enter the front, the objectives in their units.
+/// Kuhn–Tucker residual, what became of the end in the front
+/// ([`super::gradient::front_roles`]: `point`, `dominated by <run>`, `equal
+/// to <run>`, `not certified (<class>)`, `anchor start`), the end design
+/// (without the subproblem's `t`) and, for the certified ends, the
+/// objectives in their units.
 fn write_ends(
     problem: &dyn MultiProblem,
     ends: &[SubproblemEnd],
@@ -170,14 +173,17 @@ fn write_ends(
         "function_calls",
         "gradient_calls",
         "kt_residual",
+        "front",
     ]
     .map(String::from)
     .to_vec();
     header.extend(vars.iter().map(|v| format!("x_{}", v.name)));
     header.extend(columns.iter().cloned());
+    let roles = super::gradient::front_roles(ends);
     let rows: Vec<Vec<String>> = ends
         .iter()
-        .map(|e| {
+        .zip(roles)
+        .map(|(e, role)| {
             let mut r = vec![
                 e.label.clone(),
                 class_name(&e.run).to_string(),
@@ -185,6 +191,7 @@ fn write_ends(
                 e.run.function_calls.to_string(),
                 e.run.gradient_calls.to_string(),
                 field(e.run.certificate.as_ref().and_then(|c| c.kt_residual)),
+                role,
             ];
             match &e.run.result {
                 Some(end) => r.extend(end.x[..vars.len()].iter().map(|&v| num(v))),

@@ -65,6 +65,30 @@ fn the_shipped_fronts_reach_the_analytic_fronts() {
                 assert!(tail < 1e-3, "{file}: {row:?}");
             }
         }
+        // Every end says what became of it; the `point`s are the front.
+        let ends = table_without(&dir.join("front_ends.csv"), &[]);
+        let role = column(&ends, "front");
+        let points = front[1..].iter().filter(|r| r[0] == gradient).count();
+        assert_eq!(
+            role.iter().filter(|r| *r == "point").count(),
+            points,
+            "{file}"
+        );
+        for (r, class) in role.iter().zip(column(&ends, "class")) {
+            let known = [
+                "point",
+                "dominated by ",
+                "equal to ",
+                "not certified (",
+                "anchor start",
+            ];
+            assert!(known.iter().any(|k| r.starts_with(k)), "{file}: {r}");
+            assert_eq!(
+                r.starts_with("not certified"),
+                class != "converged" && !r.starts_with("anchor"),
+                "{file}: {r} {class}"
+            );
+        }
         assert!(dir.join("front.svg").exists());
     }
 }
