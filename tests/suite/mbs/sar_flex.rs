@@ -107,6 +107,20 @@ pub(super) fn balance(sim: &Simulation, law: &PiecewiseLaw, c: f64) -> (f64, f64
     (worst, scale, damper)
 }
 
+/// Assert a balance of [`balance`], `(worst, scale, damper)`: the largest
+/// |ΔE − W| within `bound` of the largest |ΔE| (printed with `what`).
+pub(super) fn assert_balanced(what: &str, (worst, scale, damper): (f64, f64, f64), bound: f64) {
+    println!(
+        "{what}: worst |ΔE − W| {worst:e} J of {scale:e} J ({:.2e} relative), damper work \
+         {damper:e} J",
+        worst / scale
+    );
+    assert!(
+        scale > 0.0 && worst < bound * scale,
+        "{what}: balance error {worst:e} of {scale:e} J"
+    );
+}
+
 #[test]
 fn flexible_sar_runs_balances_energy_and_stays_near_rigid() {
     let flex = coarse(55.0, false, true);

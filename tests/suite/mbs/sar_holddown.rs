@@ -9,10 +9,10 @@
 //! gradient of panel 2's part of Ψ₀ matches central differences of whole
 //! simulations.
 
+use super::sar_flex::{actuator, assert_balanced, balance};
 use crate::common::sar::CoarseSar;
-use crate::common::tables::column_index;
 use nalgebra::DMatrix;
-use plyscape::mbs::{Force, System, Workspace};
+use plyscape::mbs::{System, Workspace};
 use plyscape::scene::Scene;
 use plyscape::simulate::{simulate, Simulation};
 
@@ -39,12 +39,8 @@ fn run(scene: &Scene) -> Simulation {
     simulate(scene).unwrap().1
 }
 
-/// The index of history column `name` (by header prefix).
-fn col(sim: &Simulation, name: &str) -> usize {
-    column_index(&sim.headers, name)
-}
-
-fn response(sim: &Simulation, name: &str) -> (f64, Vec<f64>) {
+/// The value and gradient of response `name` of a run.
+pub(super) fn response(sim: &Simulation, name: &str) -> (f64, Vec<f64>) {
     let r = sim
         .responses
         .iter()
@@ -123,6 +119,21 @@ pub(super) fn rank(g: &DMatrix<f64>) -> usize {
     s.iter().filter(|v| **v > 1e-7 * top).count()
 }
 
+/// The redundant rows are named `<joint>.<equation>` of the scene's
+/// joints, and the constraints hold over the run (largest residual of all
+/// rows at the output times below 1e-8).
+pub(super) fn rows_named_and_held(scene: &Scene, sim: &Simulation) {
+    for label in &sim.redundant_rows {
+        let (joint, _) = label.split_once('.').unwrap();
+        assert!(scene.model.joint(joint).is_some(), "{label}");
+    }
+    assert!(
+        sim.max_violation < 1e-8,
+        "violation {:e}",
+        sim.max_violation
+    );
+}
+
 #[test]
 fn holddown_loads_panel_2_and_reports_its_redundant_rows() {
     let scene = coarse(55.0, false);
@@ -153,16 +164,7 @@ fn holddown_loads_panel_2_and_reports_its_redundant_rows() {
     assert_eq!(dropped.len(), sim.redundant);
     assert_eq!(rank(&g_kept), full);
     assert_eq!(g_kept.nrows(), full, "the kept rows are independent");
-    // Names are <joint>.<equation> of the scene's joints.
-    for label in &sim.redundant_rows {
-        let (joint, _) = label.split_once('.').unwrap();
-        assert!(scene.model.joint(joint).is_some(), "{label}");
-    }
-    assert!(
-        sim.max_violation < 1e-8,
-        "violation {:e}",
-        sim.max_violation
-    );
+    rows_named_and_held(&scene, &sim);
 
     // Panel 2 carries strain energy. In the reference scene (R1, R2
     // locked) U2 is round-off, max 6e-26 J against a peak U3 of 9e-6 J
@@ -185,47 +187,14 @@ fn holddown_loads_panel_2_and_reports_its_redundant_rows() {
 /// E(t) − E(0) = −∫_{θ0}^{θ(t)} m dθ − c ∫ θ̇² dt: no gravity, no modal
 /// damping, the R3 actuator (Eq. 32, τ = −M(θ, θ̇),
 /// docs/sar_reconstruction.md §5) the only non-conservative force; the
-/// spherical locks D and E are ideal and do no work. In 0–0.5 s θ stays
-/// in the first piece of the law, m = v + s(a − θ), whose integral is
-/// closed form; the damper term is Simpson's rule on the 5 ms grid (θ̇ ~
-/// 1e-3 rad/s, quadrature error far below the bound).
+/// spherical locks D and E are ideal and do no work (the balance of
+/// `sar_flex::balance`: the law's integral in closed form, the damper's
+/// work by Simpson's rule on the output grid). Measured 1.4e-10 relative
+/// at rtol 1e-10 (the reference scene: 1.5e-9, tests/suite/mbs/sar_flex.rs);
+/// the same bound as there.
 fn work_energy_balance(scene: &Scene, sim: &Simulation) {
-    let Some(Force::Rotational {
-        law: Some(law),
-        damping: c,
-        ..
-    }) = scene.model.forces.first()
-    else {
-        panic!("expected the R3 actuator first");
-    };
-    let (ca, cr, ce) = (
-        col(sim, "R3.angle"),
-        col(sim, "R3.rate"),
-        col(sim, "energy"),
-    );
-    let r0 = &sim.rows[0];
-    let seg = law.segment(r0[ca]).clone();
-    let potential = |th: f64| {
-        let d = th - r0[ca];
-        seg.value * d + seg.slope * (seg.anchor * d - 0.5 * (th * th - r0[ca] * r0[ca]))
-    };
-    let (mut damper, mut worst, mut scale) = (0.0, 0.0f64, 0.0f64);
-    for k in (2..sim.rows.len()).step_by(2) {
-        let (a, m, b) = (&sim.rows[k - 2], &sim.rows[k - 1], &sim.rows[k]);
-        assert_eq!(law.segment(b[ca]), &seg, "θ left the first piece");
-        let dt = b[0] - a[0];
-        damper += c * dt / 6.0 * (a[cr].powi(2) + 4.0 * m[cr].powi(2) + b[cr].powi(2));
-        let de = b[ce] - r0[ce];
-        worst = worst.max((de + potential(b[ca]) + damper).abs());
-        scale = scale.max(de.abs());
-    }
-    println!("worst |ΔE − W| {worst:e} J of {scale:e} J");
-    // Measured 1.4e-10 relative at rtol 1e-10 (the reference scene:
-    // 1.5e-9, tests/suite/mbs/sar_flex.rs); the same bound as there.
-    assert!(
-        scale > 0.0 && worst < 1e-8 * scale,
-        "{worst:e} of {scale:e}"
-    );
+    let (law, c) = actuator(scene);
+    assert_balanced("hold-down", balance(sim, &law, c), 1e-8);
 }
 
 #[test]
