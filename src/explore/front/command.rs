@@ -43,9 +43,9 @@
 //! - `front_ends.csv`: every run of the gradient side (label, class,
 //!   exit, calls, Kuhn–Tucker residual, what became of the end in the
 //!   front (`front`: `point`, `dominated by <run>`, `equal to <run>`,
-//!   `not certified (<class>)`, `anchor start`), end design, objectives
-//!   of the certified ends), to see which ends were certified and why not,
-//!   and why an end is not a point of the front.
+//!   `not certified (<class>)`, `objectives not finite`, `anchor start`),
+//!   end design, objectives of the certified ends), to see which ends were
+//!   certified and why not, and why an end is not a point of the front.
 //! - `grid.csv` (with `grid`): every grid design, its objectives (own
 //!   sign and unit), `max_g`, and the error of a failed evaluation.
 //! - `front.svg`: the first two objectives, every method's front, the
@@ -59,21 +59,20 @@ pub use super::outputs::{FrontReport, MethodFront};
 use crate::error::{Error, Result};
 use crate::explore::context::Context;
 use crate::explore::local::settle::EndPolicy;
-use crate::explore::local::solvers::LocalMethod;
+use crate::explore::local::solvers::{local, LocalMethod, MmfdPreset, MmfdSettings};
 use crate::explore::persist::journal::JournaledMulti;
 use crate::explore::problem::problems::ProblemSpec;
 use crate::explore::problem::scene_front::SceneFrontProblem;
 use crate::optimize::indicators::{hypervolume, igd};
 use crate::optimize::kkt::KktTolerances;
-use crate::optimize::mmfd::MmfdOptions;
 use crate::optimize::multiobjective::{non_dominated, MultiProblem, Oriented};
 use crate::optimize::nsga2::{self, Nsga2Options};
-use crate::optimize::sqp::SqpOptions;
 use crate::report::csv::num;
 use crate::report::Progress;
 use crate::study::Study;
 use serde::Deserialize;
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Whether a study minimizes or maximizes an objective.
@@ -371,9 +370,12 @@ pub fn run_front(ctx: &Context) -> Result<FrontReport> {
     let settings = GradientSettings {
         subproblems: section.subproblems,
         threads,
-        method: section.method,
-        mmfd: MmfdOptions::standard().with_feasibility(tol),
-        sqp: SqpOptions::default().with_feasibility(tol),
+        solver: Arc::from(local(
+            section.method,
+            &MmfdSettings::default(),
+            MmfdPreset::Standard,
+            tol,
+        )?),
         refine: section.refine,
         end: EndPolicy {
             tolerances,
@@ -417,7 +419,7 @@ pub fn run_front(ctx: &Context) -> Result<FrontReport> {
     let evo_sims = since(&problem, sims);
     let mut methods = vec![
         MethodFront {
-            method: format!("{}-tchebycheff", section.method.name()),
+            method: format!("{}-tchebycheff", settings.solver.name()),
             points: grad.points.clone(),
             function_calls: grad.function_calls,
             gradient_calls: grad.gradient_calls,

@@ -40,7 +40,7 @@ use super::gradient::{certified, non_dominated_ends, objectives, subproblem};
 use super::gradient::{GradientSettings, SubproblemEnd};
 use crate::error::Result;
 use crate::explore::persist::tables::RunRecord;
-use crate::optimize::multiobjective::MultiProblem;
+use crate::optimize::multiobjective::{dominates, MultiProblem};
 use rayon::prelude::*;
 
 /// Subproblems per round.
@@ -60,13 +60,18 @@ fn distance(a: &[f64; 2], b: &[f64; 2]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
 }
 
-/// The certified non-dominated points of `ends`, normalized by
-/// `(ideal, scale)` and sorted by `u_1`.
-fn front(n: usize, ends: &[SubproblemEnd], (ideal, scale): (&[f64], &[f64])) -> Vec<Found> {
+/// Objectives `f` normalized by `(ideal, scale)`: `u_i = (f_i − z_i)/s_i`.
+fn normalized(f: &[f64], (ideal, scale): (&[f64], &[f64])) -> [f64; 2] {
+    [(f[0] - ideal[0]) / scale[0], (f[1] - ideal[1]) / scale[1]]
+}
+
+/// The certified non-dominated points of `ends`, normalized by `norm`
+/// and sorted by `u_1`.
+fn front(n: usize, ends: &[SubproblemEnd], norm: (&[f64], &[f64])) -> Vec<Found> {
     let mut pts: Vec<Found> = non_dominated_ends(n, ends)
         .into_iter()
         .map(|(x, f)| Found {
-            u: [(f[0] - ideal[0]) / scale[0], (f[1] - ideal[1]) / scale[1]],
+            u: normalized(&f, norm),
             x,
             f,
         })
@@ -86,8 +91,7 @@ fn is_closed(closed: &[(Vec<f64>, Vec<f64>)], a: &[f64], b: &[f64]) -> bool {
 fn fills(a: &Found, b: &Found, u: &[f64; 2]) -> bool {
     let inside = u[0] > a.u[0] && u[0] < b.u[0];
     let apart = distance(u, &a.u) > SHORTEST && distance(u, &b.u) > SHORTEST;
-    let dominated = |p: &[f64; 2]| p[0] <= u[0] && p[1] <= u[1];
-    inside && apart && !dominated(&a.u) && !dominated(&b.u)
+    inside && apart && !dominates(&a.u, u) && !dominates(&b.u, u)
 }
 
 /// The open gaps of `pts` longer than [`SHORTEST`], largest first (ties
@@ -118,54 +122,64 @@ fn blend(problem: &dyn MultiProblem, a: &Found, b: &Found) -> Vec<f64> {
         .collect()
 }
 
-/// One batch of gap subproblems `(gap index, start)`, solved in parallel
-/// and appended to `ends` (labels `gap-<k>` from `*used`); returns the
-/// gaps each end filled.
-#[allow(clippy::too_many_arguments)]
-fn batch(
-    problem: &dyn MultiProblem,
-    s: &GradientSettings,
-    pool: &rayon::ThreadPool,
-    norm: (&[f64], &[f64]),
-    x0: &[f64],
-    pts: &[Found],
-    jobs: Vec<(usize, Vec<f64>)>,
-    (ends, used, extra): (&mut Vec<SubproblemEnd>, &mut usize, &mut usize),
-) -> Result<Vec<usize>> {
-    let tol = s.end.tolerances.feasibility;
-    let index = ends.len();
-    let runs: Vec<Result<(RunRecord, usize)>> = pool.install(|| {
-        jobs.par_iter()
-            .enumerate()
-            .map(|(j, (i, x))| {
-                let r = halving(&pts[*i], &pts[i + 1]);
-                subproblem(problem, s, (index + j, &r), norm, x, x0)
-            })
-            .collect()
-    });
-    let mut filled = Vec::new();
-    for ((i, _), run) in jobs.iter().zip(runs) {
-        let (run, probes) = run?;
-        *extra += probes;
-        let f = objectives(problem, &run, tol, extra)?;
-        let u = f.as_ref().map(|f| {
-            [
-                (f[0] - norm.0[0]) / norm.1[0],
-                (f[1] - norm.0[1]) / norm.1[1],
-            ]
-        });
-        if u.is_some_and(|u| fills(&pts[*i], &pts[i + 1], &u)) {
-            filled.push(*i);
-        }
-        ends.push(SubproblemEnd {
-            label: format!("gap-{used}"),
-            certified: certified(&run, tol),
-            run,
-            f,
-        });
-        *used += 1;
+/// What every batch of gap subproblems shares.
+struct Refiner<'a> {
+    problem: &'a dyn MultiProblem,
+    s: &'a GradientSettings,
+    pool: &'a rayon::ThreadPool,
+    norm: (&'a [f64], &'a [f64]),
+    x0: &'a [f64],
+    /// The number of ends before the first gap run (labels `gap-<k>`
+    /// count from there).
+    first: usize,
+    /// Function calls not counted in the runs.
+    extra: usize,
+}
+
+impl Refiner<'_> {
+    /// Gap runs so far.
+    fn used(&self, ends: &[SubproblemEnd]) -> usize {
+        ends.len() - self.first
     }
-    Ok(filled)
+
+    /// One batch of gap subproblems `(gap index, start)`, solved in
+    /// parallel and appended to `ends`; returns the gaps the ends filled.
+    fn batch(
+        &mut self,
+        pts: &[Found],
+        jobs: Vec<(usize, Vec<f64>)>,
+        ends: &mut Vec<SubproblemEnd>,
+    ) -> Result<Vec<usize>> {
+        let (problem, s, norm, x0) = (self.problem, self.s, self.norm, self.x0);
+        let tol = s.end.tolerances.feasibility;
+        let index = ends.len();
+        let runs: Vec<Result<(RunRecord, usize)>> = self.pool.install(|| {
+            jobs.par_iter()
+                .enumerate()
+                .map(|(j, (i, x))| {
+                    let r = halving(&pts[*i], &pts[i + 1]);
+                    subproblem(problem, s, (index + j, &r), norm, x, x0)
+                })
+                .collect()
+        });
+        let mut filled = Vec::new();
+        for ((i, _), run) in jobs.iter().zip(runs) {
+            let (run, probes) = run?;
+            self.extra += probes;
+            let f = objectives(problem, &run, tol, &mut self.extra)?;
+            let u = f.as_ref().map(|f| normalized(f, norm));
+            if u.is_some_and(|u| fills(&pts[*i], &pts[i + 1], &u)) {
+                filled.push(*i);
+            }
+            ends.push(SubproblemEnd {
+                label: format!("gap-{}", self.used(ends)),
+                certified: certified(&run, tol),
+                run,
+                f,
+            });
+        }
+        Ok(filled)
+    }
 }
 
 /// Run the refinement of the module doc, appending its runs to `ends`;
@@ -180,11 +194,19 @@ pub fn refine(
     ends: &mut Vec<SubproblemEnd>,
 ) -> Result<usize> {
     let n = problem.variables().len();
+    let mut r = Refiner {
+        problem,
+        s,
+        pool,
+        norm,
+        x0,
+        first: ends.len(),
+        extra: 0,
+    };
     let mut closed: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
-    let (mut extra, mut used) = (0, 0);
-    while used < s.refine {
+    while r.used(ends) < s.refine {
         let pts = front(n, ends, norm);
-        let gaps = open_gaps(&pts, &closed, ROUND.min(s.refine - used));
+        let gaps = open_gaps(&pts, &closed, ROUND.min(s.refine - r.used(ends)));
         if gaps.is_empty() {
             break;
         }
@@ -194,25 +216,22 @@ pub fn refine(
             .iter()
             .map(|&i| (i, blend(problem, &pts[i], &pts[i + 1])))
             .collect();
-        let acc = (&mut *ends, &mut used, &mut extra);
-        let filled = batch(problem, s, pool, norm, x0, &pts, jobs, acc)?;
+        let filled = r.batch(&pts, jobs, ends)?;
         let unfilled: Vec<usize> = gaps.into_iter().filter(|i| !filled.contains(i)).collect();
-        let budget = s.refine.saturating_sub(used);
         let jobs: Vec<(usize, Vec<f64>)> = unfilled
             .iter()
             .flat_map(|&i| [(i, pts[i].x.clone()), (i, pts[i + 1].x.clone())])
-            .take(budget)
+            .take(s.refine - r.used(ends))
             .collect();
         let tried: Vec<usize> = jobs.iter().map(|j| j.0).collect();
-        let acc = (&mut *ends, &mut used, &mut extra);
-        let again = batch(problem, s, pool, norm, x0, &pts, jobs, acc)?;
+        let again = r.batch(&pts, jobs, ends)?;
         for i in unfilled {
             if tried.contains(&i) && !again.contains(&i) {
                 closed.push((pts[i].f.clone(), pts[i + 1].f.clone()));
             }
         }
     }
-    Ok(extra)
+    Ok(r.extra)
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! The gradient side of a Pareto front: a parallel multistart of
 //! scalarized subproblems, each solved by MMFD or SQP (`[front] method`)
-//! with the objectives' exact gradients and settled (certified, polished) as a multistart run is
-//! ([`crate::explore::local::settle`]).
+//! with the objectives' exact gradients and settled (certified, polished)
+//! as a multistart run is ([`crate::explore::local::settle`]).
 //!
 //! 1. **Anchors** (one per objective `i`, in parallel): minimize `f_i` from
 //!    the problem's start design and `anchor_starts − 1` seeded uniform
@@ -39,21 +39,18 @@
 
 use crate::error::{Error, Result};
 use crate::explore::local::settle::EndPolicy;
-use crate::explore::local::solvers::{LocalMethod, LocalSolver};
+use crate::explore::local::solvers::LocalSolver;
 use crate::explore::multistart::driver::one_run;
 use crate::explore::persist::tables::{class_name, RunRecord};
 use crate::optimize::kkt::EndClass;
-use crate::optimize::mmfd::MmfdOptions;
 use crate::optimize::mo_testproblems::simplex_lattice;
-use crate::optimize::multiobjective::{
-    dominates, non_dominated, EpsilonConstraint, MultiProblem, Tchebycheff,
-};
+use crate::optimize::multiobjective::{dominates, EpsilonConstraint, MultiProblem, Tchebycheff};
 use crate::optimize::noise::{estimate, NoiseOptions};
-use crate::optimize::sqp::SqpOptions;
 use crate::optimize::{NoObserver, Problem};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Relative cap `τ` of the lexicographic anchors.
@@ -62,19 +59,15 @@ pub const ANCHOR_CAP: f64 = 1e-4;
 pub const RHO: f64 = 1e-4;
 
 /// What the gradient side needs besides the problem.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct GradientSettings {
     /// Number of subproblems `K` (at most; see the module doc).
     pub subproblems: usize,
     /// Worker threads.
     pub threads: usize,
-    /// The local solver of every anchor and subproblem (`[front] method`):
-    /// MMFD with `mmfd`, or SQP with `sqp`.
-    pub method: LocalMethod,
-    /// MMFD's options.
-    pub mmfd: MmfdOptions,
-    /// SQP's options.
-    pub sqp: SqpOptions,
+    /// The local solver of every anchor and subproblem (`[front] method`,
+    /// built by [`crate::explore::local::solvers::local`]).
+    pub solver: Arc<dyn LocalSolver>,
     /// Subproblems placed in the largest gaps of the front found so far,
     /// after the lattice's (two objectives; [`super::gaps`]).
     pub refine: usize,
@@ -177,19 +170,9 @@ fn between_anchors(
     )
 }
 
-impl GradientSettings {
-    /// The local solver of `method`.
-    pub fn solver(&self) -> &dyn LocalSolver {
-        match self.method {
-            LocalMethod::Sqp => &self.sqp,
-            _ => &self.mmfd,
-        }
-    }
-}
-
 /// One settled run of `p` from `x0` by the settings' solver.
 pub(super) fn solve(p: &dyn Problem, s: &GradientSettings, index: usize, x0: &[f64]) -> RunRecord {
-    one_run(p, s.solver(), &s.end, index, x0, &mut NoObserver)
+    one_run(p, s.solver.as_ref(), &s.end, index, x0, &mut NoObserver)
 }
 
 /// Is the run's end certified (converged and feasible to the tolerance)?
@@ -514,23 +497,52 @@ pub(super) fn subproblem(
     Ok((again, 2))
 }
 
-/// What became of each end in the front (`front_ends.csv`'s `front`):
-/// `point` (on the gradient side's front), `dominated by <label>`, `equal
-/// to <label>` (the same objectives as an earlier end's), `not certified
-/// (<class>)`, `objectives not finite`, or `anchor start` (a first anchor
-/// run, whose end enters the front only through its lexicographic
-/// refinement).
-pub fn front_roles(ends: &[SubproblemEnd]) -> Vec<String> {
+/// What became of an end in the front (`front_ends.csv`'s `front`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum FrontRole {
+    /// A point of the gradient side's front.
+    Point,
+    /// Dominated by the end with this label.
+    DominatedBy(String),
+    /// The same objectives as the earlier end with this label.
+    EqualTo(String),
+    /// Not certified; its class.
+    NotCertified(&'static str),
+    /// Certified, but its objectives are not finite.
+    NotFinite,
+    /// A first anchor run, whose end enters the front only through its
+    /// lexicographic refinement.
+    AnchorStart,
+}
+
+impl std::fmt::Display for FrontRole {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FrontRole::Point => f.write_str("point"),
+            FrontRole::DominatedBy(l) => write!(f, "dominated by {l}"),
+            FrontRole::EqualTo(l) => write!(f, "equal to {l}"),
+            FrontRole::NotCertified(c) => write!(f, "not certified ({c})"),
+            FrontRole::NotFinite => f.write_str("objectives not finite"),
+            FrontRole::AnchorStart => f.write_str("anchor start"),
+        }
+    }
+}
+
+/// What became of each end: dominated by any other end with objectives,
+/// equal to an earlier one, or a point of the front (the non-dominated
+/// filter of [`crate::optimize::multiobjective::non_dominated`], equal
+/// points once).
+pub fn front_roles(ends: &[SubproblemEnd]) -> Vec<FrontRole> {
     ends.iter()
         .enumerate()
         .map(|(i, e)| {
             let Some(f) = &e.f else {
                 return if e.label.starts_with("anchor-") {
-                    "anchor start".to_string()
+                    FrontRole::AnchorStart
                 } else if !e.certified {
-                    format!("not certified ({})", class_name(&e.run))
+                    FrontRole::NotCertified(class_name(&e.run))
                 } else {
-                    "objectives not finite".to_string()
+                    FrontRole::NotFinite
                 };
             };
             let others = ends.iter().enumerate().filter(|(j, _)| *j != i);
@@ -538,31 +550,24 @@ pub fn front_roles(ends: &[SubproblemEnd]) -> Vec<String> {
             let mut equal = None;
             for (j, o, g) in with_f {
                 if dominates(g, f) {
-                    return format!("dominated by {}", o.label);
+                    return FrontRole::DominatedBy(o.label.clone());
                 }
                 if j < i && g == f && equal.is_none() {
                     equal = Some(o.label.clone());
                 }
             }
-            equal.map_or_else(|| "point".to_string(), |l| format!("equal to {l}"))
+            equal.map_or(FrontRole::Point, FrontRole::EqualTo)
         })
         .collect()
 }
 
-/// The non-dominated certified ends: (design, objectives) of the ends
-/// with objectives, the first `n` coordinates of each design.
+/// The non-dominated certified ends (the [`FrontRole::Point`]s):
+/// (design, objectives), the first `n` coordinates of each design.
 pub(super) fn non_dominated_ends(n: usize, ends: &[SubproblemEnd]) -> Vec<(Vec<f64>, Vec<f64>)> {
-    let kept: Vec<(Vec<f64>, Vec<f64>)> = ends
-        .iter()
-        .filter_map(|e| {
-            let f = e.f.clone()?;
-            Some((e.run.result.as_ref()?.x[..n].to_vec(), f))
-        })
-        .collect();
-    let fs: Vec<Vec<f64>> = kept.iter().map(|c| c.1.clone()).collect();
-    non_dominated(&fs)
-        .into_iter()
-        .map(|i| kept[i].clone())
+    ends.iter()
+        .zip(front_roles(ends))
+        .filter(|(_, role)| *role == FrontRole::Point)
+        .filter_map(|(e, _)| Some((e.run.result.as_ref()?.x[..n].to_vec(), e.f.clone()?)))
         .collect()
 }
 

@@ -191,7 +191,7 @@ fn write_ends(
                 e.run.function_calls.to_string(),
                 e.run.gradient_calls.to_string(),
                 field(e.run.certificate.as_ref().and_then(|c| c.kt_residual)),
-                role,
+                role.to_string(),
             ];
             match &e.run.result {
                 Some(end) => r.extend(end.x[..vars.len()].iter().map(|&v| num(v))),

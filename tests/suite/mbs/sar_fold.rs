@@ -52,14 +52,16 @@ fn fold_scene_rank_mobility_violation_and_energy_balance() {
     // Rigid: 69 equations (3 revolutes × 5 + 18 spherical × 3), rank 59,
     // mobility 11 × 6 − 59 = 7 (θ_R3 and the spins of the six
     // spherical–spherical bars), as the study header states.
-    let (m, r, rigid) = ranks(&coarse(3, 55.0, false, false));
+    let rigid_scene = coarse(3, 55.0, false, false);
+    let (m, r, rigid) = ranks(&rigid_scene);
+    let moving = rigid_scene.model.bodies.iter().filter(|b| !b.fixed).count();
     println!(
-        "rigid: {m} equations, rank {r}, kernel redundant {}",
+        "rigid: {m} equations, rank {r}, kernel redundant {}, {moving} moving bodies",
         rigid.redundant
     );
     assert_eq!((m, r), (69, 59));
     assert_eq!(rigid.redundant, m - r);
-    assert_eq!(11 * 6 - r, 7);
+    assert_eq!(6 * moving - r, 7, "mobility");
 
     // Flexible: the kernel's redundant rows are those the Jacobian's rank
     // leaves over, and they name joints of the scene.
@@ -157,6 +159,8 @@ fn psi0_gradient_error(panel: usize) -> f64 {
 fn fold_psi0_ply_angle_gradients_match_central_differences() {
     for panel in [2, 3] {
         let rel = psi0_gradient_error(panel);
+        // Measured 2.5e-7 (panel 2) and 2.9e-7 (panel 3), the central
+        // difference's truncation and the integrator's 1e-10; bound 1e-5.
         assert!(rel < 1e-5, "panel {panel}: relative error {rel:e}");
     }
 }
