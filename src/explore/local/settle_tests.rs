@@ -84,6 +84,19 @@ fn an_end_at_a_local_minimum_of_the_violation_is_infeasible_and_stationary() {
         s.polish
     );
     assert!((s.outcome.x[0] - X_STAR).abs() < 1e-6);
+    // The same end left by a solver whose own moves toward the feasible
+    // set failed there (SQP's failed line searches, MMFD's `infeasible`):
+    // not polished, and the end stays the solver's.
+    for t in [Termination::LineSearchFailed, Termination::Infeasible] {
+        let stuck = LocalOutcome {
+            termination: t.clone(),
+            ..end(&p, 1.9)
+        };
+        let s = settle(&p, None, stuck, &policy(true), &mut NoObserver);
+        assert_eq!(s.polish, PolishEnd::NotRun, "{t}");
+        assert_eq!(s.certificate.unwrap().class, EndClass::Infeasible);
+        assert_eq!((s.outcome.x, s.outcome.termination), (vec![1.9], t));
+    }
 }
 
 #[test]
