@@ -21,8 +21,16 @@
 //!    along `x + α d` from α = 1: accepted when
 //!    `φ(α) <= φ(0) + η α Dφ` (Armijo, η = `armijo`) with the directional
 //!    derivative `Dφ = ∇fᵀd + Σ μ_j (max(0, g_j + ∇g_jᵀd) − max(0, g_j))`;
-//!    else α shrinks to the minimizer of the quadratic through `φ(0)`,
-//!    `Dφ` and `φ(α)`, kept in `[0.1 α, 0.5 α]`. The full step is
+//!    and `φ(α) < φ(0)` (where `η α Dφ` is below the round-off of `φ(0)`,
+//!    Armijo's test alone accepts no decrease at all); else α shrinks to
+//!    the minimizer of the quadratic through `φ(0)`, `Dφ` and `φ(α)`,
+//!    kept in `[0.1 α, 0.5 α]`. A trial design equal to the current one
+//!    (`α d` below the round-off of `x`) ends the search without a step.
+//!    Before these two rules, a Tchebycheff subproblem of the deployable
+//!    panel's front, at a point where constraint noise of about 1e-9
+//!    defeated every step, accepted steps of `α = 1e-9` that left the
+//!    design unchanged, each one resetting the count of failed searches,
+//!    and spent 100 iterations and 1574 function calls there. The full step is
 //!    evaluated with its gradients (`speculative`) once full steps are
 //!    being accepted: an accepted step then costs one function and one
 //!    gradient call, as the next iteration needs its gradients anyway.
@@ -410,10 +418,15 @@ impl Sqp {
         for _ in 0..self.options.max_line_evaluations {
             let z: Vec<f64> = d.iter().map(|v| alpha * v).collect();
             let x = self.moved(problem, &cur.x, &z);
+            if x == cur.x {
+                // The step no longer moves the design (below round-off):
+                // nothing is left to search along d.
+                return Ok(None);
+            }
             let with_gradients = self.options.speculative && alpha == 1.0 && self.full_steps;
             let ev = evaluate(problem, &x, with_gradients)?;
             let phi = ev.f + penalty(&self.mu, &ev.g);
-            if phi <= phi0 + self.options.armijo * alpha * dphi {
+            if phi < phi0 && phi <= phi0 + self.options.armijo * alpha * dphi {
                 self.full_steps = alpha == 1.0;
                 let ev = if with_gradients {
                     ev

@@ -82,3 +82,35 @@ fn hock_schittkowski_runs_reach_the_published_optima() {
     // rise past these pins is a regression.
     assert!(total.0 <= 54 && total.1 <= 51, "{total:?}");
 }
+
+/// A line search never accepts a step that leaves the design or the merit
+/// unchanged: from x = 1 along a direction far below the round-off of x,
+/// every trial is x itself, and Armijo's bound rounds to φ(0).
+#[test]
+fn a_step_below_round_off_is_no_step() {
+    fn k(x: &[f64]) -> (f64, Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+        (x[0], vec![], vec![1.0], vec![])
+    }
+    let p = Analytic {
+        name: "linear".into(),
+        variables: vec![Variable::bounded("x", -10.0, 10.0).unwrap()],
+        n_constraints: 0,
+        kernel: k,
+        x0: vec![1.0],
+        optima: vec![vec![-10.0]],
+        f_opt: -10.0,
+    };
+    let mut solver = Sqp::new(&p, &[1.0], SqpOptions::default()).unwrap();
+    let mut ap = ArgminProblem::new(Counted::new(&p));
+    solver.start(&mut ap).unwrap();
+    let cur = solver.current.clone().unwrap();
+    let found = solver.line_search(&mut ap, &cur, &[-1e-20]).unwrap();
+    assert!(
+        found.is_none(),
+        "accepted {:?}",
+        found.map(|(a, q)| (a, q.x))
+    );
+    // A real step is still taken.
+    let found = solver.line_search(&mut ap, &cur, &[-0.01]).unwrap();
+    assert!(found.is_some_and(|(_, q)| q.f < cur.f));
+}
