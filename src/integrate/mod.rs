@@ -36,13 +36,20 @@
 //! (`g_p = 0`), and `g_y v` is [`OdeModel::crossing_dir`].
 
 mod block_lu;
+mod erk;
+#[cfg(test)]
+mod erk_tests;
 mod fused;
 mod legs;
 mod ode;
 mod options;
+mod pair;
+#[cfg(test)]
+mod pair_tests;
 mod plain;
 mod sens;
 mod step;
+mod stepper;
 #[cfg(test)]
 mod tests;
 
