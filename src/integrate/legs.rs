@@ -10,14 +10,17 @@
 //! method is a [`super::Method`] variant with its scheme; a new form is
 //! an [`Integrand`].
 
+use super::erk::Erk;
 use super::ode::OdeModel;
 use super::options::{Options, Scheme, Stats};
+use super::pair::Pair;
 use super::step::{DenseState, Step, StepWatch};
+use super::stepper::{Diffsol, Stepper};
 use crate::error::{Error, Result};
 use diffsol::error::DiffsolError;
 use diffsol::{
     FaerContext, FaerMat, FaerVec, LinearSolver, OdeEquationsImplicit, OdeSolverMethod,
-    OdeSolverProblem, OdeSolverStopReason, Tableau, Vector,
+    OdeSolverProblem, OdeSolverStopReason, Tableau,
 };
 use std::cell::{Cell, RefCell};
 use std::time::Instant;
@@ -86,6 +89,13 @@ pub(super) trait Integrand {
         let problem = self.problem();
         let state = problem.rk_state(&tableau)?;
         problem.explicit_rk_solver(state, tableau)
+    }
+
+    /// An explicit pair stepped here ([`Erk`]) on the problem: the states
+    /// alone or with the lanes in the state (the fused form).
+    fn erk(&self, pair: Pair) -> Result<Erk<'_, Self::Eqn>> {
+        Erk::new(self.problem(), pair)
+            .map_err(|e| Error::numerical(format!("{}: solver set-up", Self::PLACE), e))
     }
 
     /// Run `leg`, which builds an implicit solver (its linear solver
@@ -199,18 +209,18 @@ impl<'c, M: OdeModel> Legs<'c, M> {
         loop {
             let leg = match self.opts.method.scheme() {
                 Scheme::Bdf => integrand.implicit(|| {
-                    self.drive(integrand.bdf().map_err(setup)?, (&mut observe, within))
+                    let solver = Diffsol::new(integrand.bdf().map_err(setup)?);
+                    self.drive(solver, (&mut observe, within))
                 })?,
                 Scheme::Sdirk(tableau) => integrand.implicit(|| {
-                    self.drive(
-                        integrand.sdirk(tableau).map_err(setup)?,
-                        (&mut observe, within),
-                    )
+                    let solver = Diffsol::new(integrand.sdirk(tableau).map_err(setup)?);
+                    self.drive(solver, (&mut observe, within))
                 })?,
-                Scheme::ExplicitRk(tableau) => self.drive(
-                    integrand.explicit_rk(tableau).map_err(setup)?,
-                    (&mut observe, within),
-                )?,
+                Scheme::ExplicitRk(tableau) => {
+                    let solver = Diffsol::new(integrand.explicit_rk(tableau).map_err(setup)?);
+                    self.drive(solver, (&mut observe, within))?
+                }
+                Scheme::Pair(pair) => self.drive(integrand.erk(pair)?, (&mut observe, within))?,
             };
             let Some(e) = self.end_leg(&mut stats, leg, &mut observe)? else {
                 break;
@@ -239,29 +249,25 @@ impl<'c, M: OdeModel> Legs<'c, M> {
     /// goes to `within` with its dense output, ending at the event when
     /// it located one. Outputs after an event are not served by this leg
     /// (its law is extended past the breakpoint there).
-    fn drive<'a, Eqn, S>(
+    fn drive(
         &mut self,
-        mut solver: S,
+        mut solver: impl Stepper,
         (observe, within): (
             &mut impl FnMut(f64, &[f64], &[f64]) -> Result<()>,
             &mut StepWatch<'_>,
         ),
-    ) -> Result<(Stats, Option<Event<M::Crossing>>)>
-    where
-        Eqn: diffsol::OdeEquations<T = f64, V = diffsol::FaerVec<f64>> + 'a,
-        S: OdeSolverMethod<'a, Eqn>,
-    {
+    ) -> Result<(Stats, Option<Event<M::Crossing>>)> {
         let opts = self.opts;
         let times = &opts.times;
         let nsens = self.nsens;
         let t_end = times[times.len() - 1];
         solver
             .set_stop_time(t_end)
-            .map_err(|e| Error::numerical("integrate: stop time", e.to_string()))?;
+            .map_err(|e| Error::numerical("integrate: stop time", e))?;
         // Output times at the start (first leg only: later legs start
         // after the outputs already served).
         while self.next < times.len() && times[self.next] <= opts.t0 {
-            let (y, mut s0) = self.split(solver.state().y.clone_as_vec());
+            let (y, mut s0) = self.split(solver.state());
             if self.fused.is_none() {
                 // Initial sensitivities are zero (the initial state is given).
                 s0 = vec![0.0; y.len() * nsens];
@@ -271,37 +277,27 @@ impl<'c, M: OdeModel> Legs<'c, M> {
         }
         let mut event = None;
         loop {
-            let t_before = solver.state().t;
+            let t_before = solver.time();
             let reason = solver.step().map_err(|e| {
                 Error::numerical_at(
                     format!("integrate: {} step", opts.method.name()),
                     t_before,
-                    e.to_string(),
+                    e,
                 )
             })?;
-            let mut t = solver.state().t;
+            let mut t = solver.time();
             if let OdeSolverStopReason::RootFound(tr, idx) = reason {
                 let (yr, s_fused) = self.split(
                     solver
                         .interpolate(tr)
-                        .map_err(|e| {
-                            Error::numerical_at("integrate: event state", tr, e.to_string())
-                        })?
-                        .clone_as_vec(),
+                        .map_err(|e| Error::numerical_at("integrate: event state", tr, e))?,
                 );
                 let crossing = self.model.classify(&self.events.borrow(), idx, tr, &yr);
                 if let Some(crossing) = crossing {
                     let s = if nsens > 0 {
-                        solver
-                            .interpolate_sens(tr)
-                            .map_err(|e| {
-                                Error::numerical_at(
-                                    "integrate: event sensitivities",
-                                    tr,
-                                    e.to_string(),
-                                )
-                            })?
-                            .clone_as_vec()
+                        solver.interpolate_sens(tr).map_err(|e| {
+                            Error::numerical_at("integrate: event sensitivities", tr, e)
+                        })?
                     } else {
                         s_fused
                     };
@@ -339,41 +335,28 @@ impl<'c, M: OdeModel> Legs<'c, M> {
                 break;
             }
         }
-        let st = solver.get_statistics();
-        let stats = Stats {
-            steps: st.number_of_steps,
-            jacobians: st.number_of_linear_solver_setups,
-            error_test_failures: st.number_of_error_test_failures,
-            nonlinear_iterations: st.number_of_nonlinear_solver_iterations,
-            nonlinear_failures: st.number_of_nonlinear_solver_fails,
-            ..Stats::default()
-        };
-        Ok((stats, event))
+        Ok((solver.stats(), event))
     }
 
     /// The state and the sensitivities (lane-major) at `tq` in the last
     /// accepted step of `solver`, from its dense output (its state at the
     /// step's end).
-    fn dense<'a, Eqn, S>(&self, solver: &S, tq: f64) -> Result<DenseState>
-    where
-        Eqn: diffsol::OdeEquations<T = f64, V = diffsol::FaerVec<f64>> + 'a,
-        S: OdeSolverMethod<'a, Eqn>,
-    {
-        let y = if tq == solver.state().t {
-            solver.state().y.clone()
+    fn dense(&self, solver: &impl Stepper, tq: f64) -> Result<DenseState> {
+        let y = if tq == solver.time() {
+            solver.state()
         } else {
             solver
                 .interpolate(tq)
-                .map_err(|e| Error::numerical_at("integrate: dense output", tq, e.to_string()))?
+                .map_err(|e| Error::numerical_at("integrate: dense output", tq, e))?
         };
-        let (y, s_fused) = self.split(y.clone_as_vec());
+        let (y, s_fused) = self.split(y);
         if self.nsens == 0 {
             return Ok((y, s_fused));
         }
         let sens = solver
             .interpolate_sens(tq)
-            .map_err(|e| Error::numerical_at("integrate: sensitivity output", tq, e.to_string()))?;
-        Ok((y, sens.clone_as_vec()))
+            .map_err(|e| Error::numerical_at("integrate: sensitivity output", tq, e))?;
+        Ok((y, sens))
     }
 
     /// The end of a leg: count it; at an event, end the integration with

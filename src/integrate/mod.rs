@@ -6,7 +6,9 @@
 //! multistep method; diffsol's variable-order BDF ([`Method::Bdf`], the
 //! default) is that family. The explicit Tsitouras 5(4) pair
 //! ([`Method::Tsit45`]) and the ESDIRK 3(4) method ([`Method::Esdirk34`])
-//! are selectable for comparison. Implicit methods need Jacobian-vector
+//! are selectable for comparison, and Verner's explicit 6(5) pair
+//! ([`Method::Vern65`]), which has more stages than diffsol's explicit
+//! solver holds, is stepped by this module's own driver (`erk`). Implicit methods need Jacobian-vector
 //! products `J v`; they are exact, from one evaluation of the generic
 //! right-hand side on `num_dual::Dual64` numbers `y + ε v`.
 //!
@@ -36,13 +38,20 @@
 //! (`g_p = 0`), and `g_y v` is [`OdeModel::crossing_dir`].
 
 mod block_lu;
+mod erk;
+#[cfg(test)]
+mod erk_tests;
 mod fused;
 mod legs;
 mod ode;
 mod options;
+mod pair;
+#[cfg(test)]
+mod pair_tests;
 mod plain;
 mod sens;
 mod step;
+mod stepper;
 #[cfg(test)]
 mod tests;
 

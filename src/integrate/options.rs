@@ -1,6 +1,7 @@
 //! Integration settings ([`Options`], [`Method`]) and statistics
 //! ([`Stats`]).
 
+use super::pair::Pair;
 use crate::error::{Error, Result};
 use diffsol::Tableau;
 
@@ -14,6 +15,11 @@ pub enum Method {
     Tsit45,
     /// Explicit-first-stage SDIRK, order 3(4).
     Esdirk34,
+    /// Verner's explicit 6(5) pair (9 stages, FSAL) with its order-5
+    /// continuous extension (one more stage per step whose dense output
+    /// is read), stepped here (`super::erk`); sensitivities in the fused
+    /// form only.
+    Vern65,
 }
 
 impl Method {
@@ -23,6 +29,7 @@ impl Method {
             Method::Bdf => "bdf",
             Method::Tsit45 => "tsit45",
             Method::Esdirk34 => "esdirk34",
+            Method::Vern65 => "vern65",
         }
     }
 
@@ -34,6 +41,7 @@ impl Method {
             Method::Bdf => Scheme::Bdf,
             Method::Tsit45 => Scheme::ExplicitRk(Tableau::tsit45()),
             Method::Esdirk34 => Scheme::Sdirk(Tableau::esdirk34()),
+            Method::Vern65 => Scheme::Pair(Pair::vern65()),
         }
     }
 }
@@ -47,6 +55,9 @@ pub(super) enum Scheme {
     Sdirk(Tableau<f64>),
     /// An explicit Runge–Kutta method with this tableau.
     ExplicitRk(Tableau<f64>),
+    /// An explicit Runge–Kutta pair with more stages than diffsol's
+    /// tableaus hold, stepped here (`super::erk`).
+    Pair(Pair),
 }
 
 /// How forward sensitivities are integrated.
@@ -69,7 +80,9 @@ impl SensitivityForm {
     /// single-lane ones per lane for the staggered form; the same steps).
     pub fn default_for(method: Method) -> SensitivityForm {
         match method {
-            Method::Tsit45 | Method::Bdf | Method::Esdirk34 => SensitivityForm::Fused,
+            Method::Tsit45 | Method::Bdf | Method::Esdirk34 | Method::Vern65 => {
+                SensitivityForm::Fused
+            }
         }
     }
 

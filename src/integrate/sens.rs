@@ -188,6 +188,14 @@ where
         self.problem.explicit_rk_solver_sens(state, tableau)
     }
 
+    fn erk(&self, _pair: super::pair::Pair) -> Result<super::erk::Erk<'_, Eqn>> {
+        Err(Error::input(
+            "integrator.sensitivity",
+            "staggered",
+            "the fused form with an explicit pair stepped here (vern65)",
+        ))
+    }
+
     fn restart(&mut self, t: f64, y: Vec<f64>, s: Vec<f64>) {
         self.problem.t0 = t;
         *self.start.0.borrow_mut() = y;

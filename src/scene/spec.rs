@@ -583,7 +583,8 @@ impl ForceSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSpec {
-    /// Integration method ([`Method`]): `bdf` (default), `tsit45` or `esdirk34`.
+    /// Integration method ([`Method`]): `bdf` (default), `tsit45`, `esdirk34`
+    /// or `vern65`.
     #[serde(default = "default_method")]
     pub method: Method,
     /// Relative tolerance of the error control (default 1e-6).
