@@ -53,7 +53,7 @@
 //!   `front_design.svg` (two variables): the same designs in design space.
 
 use super::gradient::{gradient_front, subproblem_noise, GradientSettings};
-use super::grid::{evaluate_grid, grid_size, MAX_GRID_DESIGNS};
+use super::grid::{evaluate_grid, grid_size, GridFront, MAX_GRID_DESIGNS};
 use super::outputs::write_outputs;
 pub use super::outputs::{FrontReport, MethodFront};
 use crate::error::{Error, Result};
@@ -343,31 +343,29 @@ fn since(problem: &dyn MultiProblem, before: Option<usize>) -> Option<usize> {
     Some(problem.simulations()? - before?)
 }
 
-/// Run `[front]`: both methods (and the grid), the indicators, the tables
-/// and the plots in `dir`.
-pub fn run_front(ctx: &Context) -> Result<FrontReport> {
-    let (study, threads, quiet) = (ctx.study, ctx.threads, ctx.quiet);
-    let dir = &ctx.dir()?;
-    let section = check(study)?;
-    let built = multi_problem(study, &section)?;
-    let scope: Vec<&str> = section.objectives.iter().map(|o| o.name.as_str()).collect();
-    let journal = ctx.journal("front", &scope.join(","))?;
-    let inner = JournaledMulti::new(built.as_ref(), &journal)?;
-    let problem = oriented(&inner, &section).map_err(study.locate("front"))?;
-    let m = section.objectives.len();
+/// The gradient side's settings: the study's local method and
+/// tolerances, and the objectives' noise measured at the start (for the
+/// subproblems' stop tests).
+fn gradient_settings(
+    study: &Study,
+    section: &FrontSection,
+    problem: &Oriented,
+    threads: usize,
+    quiet: bool,
+) -> Result<GradientSettings> {
     let tol = section.feasibility_tolerance.unwrap_or(1e-6);
     let tolerances = KktTolerances {
         feasibility: tol,
         ..KktTolerances::default()
     };
     let (noise, noise_g, noise_calls) =
-        subproblem_noise(&problem, study.meta.seed).map_err(study.locate("front"))?;
+        subproblem_noise(problem, study.meta.seed).map_err(study.locate("front"))?;
     if !quiet {
         println!(
             "  noise of the objectives at the start: allowance {noise:.2e} ({noise_calls} function calls)"
         );
     }
-    let settings = GradientSettings {
+    Ok(GradientSettings {
         subproblems: section.subproblems,
         threads,
         solver: Arc::from(local(
@@ -386,7 +384,56 @@ pub fn run_front(ctx: &Context) -> Result<FrontReport> {
         },
         anchor_starts: section.anchor_starts,
         seed: study.meta.seed,
+    })
+}
+
+/// The `n`-per-variable grid's front as a method row, with the grid
+/// (a warning names the designs that failed to evaluate).
+fn grid_front(
+    problem: &Oriented,
+    n: usize,
+    threads: usize,
+    quiet: bool,
+    tol: f64,
+) -> Result<(MethodFront, GridFront)> {
+    let sims = problem.simulations();
+    let g = evaluate_grid(problem, n, threads, quiet, tol)?;
+    let row = MethodFront {
+        method: "grid".into(),
+        points: g.front.clone(),
+        function_calls: g.points.len(),
+        gradient_calls: 0,
+        simulations: since(problem, sims),
+        wall_seconds: g.wall_seconds,
+        certified: None,
+        hypervolume: 0.0,
+        igd_union: None,
+        igd_analytic: None,
     };
+    if g.failures() > 0 && !quiet {
+        eprintln!(
+            "warning: {} of {} grid designs failed to evaluate (grid.csv, column error)",
+            g.failures(),
+            g.points.len()
+        );
+    }
+    Ok((row, g))
+}
+
+/// Run `[front]`: both methods (and the grid), the indicators, the tables
+/// and the plots in `dir`.
+pub fn run_front(ctx: &Context) -> Result<FrontReport> {
+    let (study, threads, quiet) = (ctx.study, ctx.threads, ctx.quiet);
+    let dir = &ctx.dir()?;
+    let section = check(study)?;
+    let built = multi_problem(study, &section)?;
+    let scope: Vec<&str> = section.objectives.iter().map(|o| o.name.as_str()).collect();
+    let journal = ctx.journal("front", &scope.join(","))?;
+    let inner = JournaledMulti::new(built.as_ref(), &journal)?;
+    let problem = oriented(&inner, &section).map_err(study.locate("front"))?;
+    let m = section.objectives.len();
+    let tol = section.feasibility_tolerance.unwrap_or(1e-6);
+    let settings = gradient_settings(study, &section, &problem, threads, quiet)?;
     let sims = problem.simulations();
     journal.watch(Some(Progress::counter(
         "front (gradient)",
@@ -449,27 +496,8 @@ pub fn run_front(ctx: &Context) -> Result<FrontReport> {
     ];
     let grid = match section.grid {
         Some(n) => {
-            let sims = problem.simulations();
-            let g = evaluate_grid(&problem, n, threads, quiet, tol)?;
-            methods.push(MethodFront {
-                method: "grid".into(),
-                points: g.front.clone(),
-                function_calls: g.points.len(),
-                gradient_calls: 0,
-                simulations: since(&problem, sims),
-                wall_seconds: g.wall_seconds,
-                certified: None,
-                hypervolume: 0.0,
-                igd_union: None,
-                igd_analytic: None,
-            });
-            if g.failures() > 0 && !quiet {
-                eprintln!(
-                    "warning: {} of {} grid designs failed to evaluate (grid.csv, column error)",
-                    g.failures(),
-                    g.points.len()
-                );
-            }
+            let (row, g) = grid_front(&problem, n, threads, quiet, tol)?;
+            methods.push(row);
             Some(g)
         }
         None => None,
