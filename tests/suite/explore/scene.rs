@@ -444,3 +444,66 @@ fn gradient_check_section_compares_fixed_and_updated_modes() {
     );
     assert!(fixed > 10.0 * updated, "fixed {fixed} vs updated {updated}");
 }
+
+/// `studies/sar_sweep64.toml` makes panel 2 a rigid body because in this
+/// phase 1 it carries no load (R1 and R2 locked: it hangs between grounded
+/// bodies). Its problem must then be sar_explore's, whose panel 2 is
+/// flexible, to the integration tolerance: the same f, the same two
+/// critical-point constraints and the same gradients (panel 2's lanes are
+/// zero). Both coarse (8 divisions, 4 modes, the whole 0–3 s, rtol
+/// 1e-10). Measured at 40°/−25°: f agrees to 7e-12 of itself, g to 8e-11,
+/// ∇f to 9e-11 and ∇g to 1.6e-8 of each gradient's largest component.
+#[test]
+fn a_panel_that_carries_no_load_can_be_rigid() {
+    // The whole 3 s, so that U3 has two local maxima in time.
+    let flexible = replace(
+        &coarse_sar(include_str!("../../../studies/sar_explore.toml"), 8, 4),
+        "t_end = 0.5",
+        "t_end = 3.0",
+        1,
+    );
+    let mut rigid = include_str!("../../../studies/sar_sweep64.toml").to_string();
+    for (from, to) in [
+        ("divisions = 32", "divisions = 8"),
+        ("modes = 14", "modes = 4"),
+        ("dt_out = 0.01", "dt_out = 0.005"),
+        ("rtol = 1e-6", "rtol = 1e-10"),
+        ("atol = 1e-8", "atol = 1e-12"),
+        ("rtol = \"auto\"\n", ""),
+    ] {
+        rigid = replace(&rigid, from, to, 1);
+    }
+    let parse =
+        |name: &str, text: &str| explore::problem(&Study::parse(name, text).unwrap()).unwrap();
+    let (a, b) = (
+        parse("sar_sweep64.toml", &rigid),
+        parse("sar_explore.toml", &flexible),
+    );
+    assert_eq!(a.n_constraints(), 2);
+    assert_eq!(b.n_constraints(), 2);
+    let x = [40.0, -25.0];
+    let (ea, eb) = (a.evaluate(&x, true).unwrap(), b.evaluate(&x, true).unwrap());
+    println!("rigid panel 2: {ea:?}\nflexible panel 2: {eb:?}");
+    assert!(
+        (ea.f - eb.f).abs() < 1e-9 * eb.f.abs(),
+        "f {} vs {}",
+        ea.f,
+        eb.f
+    );
+    for j in 0..2 {
+        assert!(
+            (ea.g[j] - eb.g[j]).abs() < 1e-9,
+            "g{j} {} vs {}",
+            ea.g[j],
+            eb.g[j]
+        );
+    }
+    let mut pairs = vec![(ea.grad_f.unwrap(), eb.grad_f.unwrap())];
+    pairs.extend(ea.grad_g.unwrap().into_iter().zip(eb.grad_g.unwrap()));
+    for (ga, gb) in pairs {
+        let scale = gb.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (u, v) in ga.iter().zip(&gb) {
+            assert!((u - v).abs() < 1e-7 * scale, "gradient {u:e} vs {v:e}");
+        }
+    }
+}
