@@ -507,3 +507,56 @@ fn a_panel_that_carries_no_load_can_be_rigid() {
         }
     }
 }
+
+/// `[eval_bench] rtols` runs each case at those tolerances, and
+/// `reference_rtol` gives every row its distance from an evaluation at
+/// that tolerance: on the coarse problem at 40°/−25° the errors of f, g and
+/// the gradients fall as rtol tightens from 1e-5 to 1e-8 (against 1e-11),
+/// an f row has no gradient error, and a tolerance out of range is an
+/// error naming its key.
+#[test]
+fn eval_bench_runs_at_each_tolerance_against_a_reference() {
+    let tmp = temp_dir("eval-bench-rtols");
+    let dir = tmp.path().to_path_buf();
+    std::fs::write(dir.join("coarse.toml"), coarse()).unwrap();
+    let bench = |rtols: &str| {
+        format!(
+            "[eval_bench]\nproblems = [\"coarse.toml\"]\nrepeats = 1\ndesigns = [[40.0, -25.0]]\n\
+             rtols = {rtols}\nreference_rtol = 1e-11\n"
+        )
+    };
+    let path = dir.join("bench.toml");
+    let run = |text: String| {
+        std::fs::write(&path, text).unwrap();
+        let study = Study::load(&path).unwrap();
+        let spec: plyscape::sections::eval_bench::EvalBenchSpec =
+            study.require_section("eval_bench", "").unwrap();
+        plyscape::sections::eval_bench::run_eval_bench(&study, &spec, |_| {})
+    };
+    let rows = run(bench("[1e-5, 1e-8]")).unwrap();
+    let h = plyscape::sections::eval_bench::HEADERS;
+    let col = |r: &Vec<String>, name: &str| r[h.iter().position(|c| *c == name).unwrap()].clone();
+    let num = |r: &Vec<String>, name: &str| col(r, name).parse::<f64>().unwrap();
+    assert_eq!(rows.len(), 4);
+    let (f5, fg5, f8, fg8) = (&rows[0], &rows[1], &rows[2], &rows[3]);
+    assert_eq!([col(f5, "rtol"), col(f8, "rtol")], ["1e-5", "1e-8"]);
+    assert_eq!([col(f5, "mode"), col(fg5, "mode")], ["f", "f+g"]);
+    assert_eq!(col(f5, "gradient_rel_error"), "");
+    for name in ["f_rel_error", "g_max_error"] {
+        println!(
+            "{name}: {} at 1e-5, {} at 1e-8",
+            col(f5, name),
+            col(f8, name)
+        );
+        assert!(num(f8, name) < num(f5, name), "{name}");
+    }
+    let (g5, g8) = (
+        num(fg5, "gradient_rel_error"),
+        num(fg8, "gradient_rel_error"),
+    );
+    println!("gradient_rel_error: {g5:e} at 1e-5, {g8:e} at 1e-8");
+    assert!(g8 < g5 && g8 < 1e-4, "{g8:e} vs {g5:e}");
+    assert!(num(fg8, "steps") > num(fg5, "steps"));
+    let e = run(bench("[1e-6, 0.5]")).unwrap_err().to_string();
+    assert!(e.contains("eval_bench.rtols[1]"), "{e}");
+}
