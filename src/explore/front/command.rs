@@ -358,7 +358,7 @@ fn gradient_settings(
         feasibility: tol,
         ..KktTolerances::default()
     };
-    let (noise, noise_g, noise_calls) =
+    let (noise, noise_g, objective_sigma, noise_calls) =
         subproblem_noise(problem, study.meta.seed).map_err(study.locate("front"))?;
     if !quiet {
         println!(
@@ -384,6 +384,7 @@ fn gradient_settings(
         },
         anchor_starts: section.anchor_starts,
         seed: study.meta.seed,
+        objective_sigma,
     })
 }
 

@@ -37,7 +37,7 @@
 //! certified or not, with its calls.
 
 use super::gradient::{certified, non_dominated_ends, objectives, subproblem};
-use super::gradient::{GradientSettings, SubproblemEnd};
+use super::gradient::{GradientSettings, Merge, SubproblemEnd};
 use crate::error::Result;
 use crate::explore::persist::tables::RunRecord;
 use crate::optimize::multiobjective::{dominates, MultiProblem};
@@ -68,7 +68,7 @@ fn normalized(f: &[f64], (ideal, scale): (&[f64], &[f64])) -> [f64; 2] {
 /// The certified non-dominated points of `ends`, normalized by `norm`
 /// and sorted by `u_1`.
 fn front(n: usize, ends: &[SubproblemEnd], norm: (&[f64], &[f64])) -> Vec<Found> {
-    let mut pts: Vec<Found> = non_dominated_ends(n, ends)
+    let mut pts: Vec<Found> = non_dominated_ends(n, Merge::Objectives, ends)
         .into_iter()
         .map(|(x, f)| Found {
             u: normalized(&f, norm),
@@ -193,7 +193,6 @@ pub fn refine(
     x0: &[f64],
     ends: &mut Vec<SubproblemEnd>,
 ) -> Result<usize> {
-    let n = problem.variables().len();
     let mut r = Refiner {
         problem,
         s,
@@ -205,7 +204,7 @@ pub fn refine(
     };
     let mut closed: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
     while r.used(ends) < s.refine {
-        let pts = front(n, ends, norm);
+        let pts = front(problem.variables().len(), ends, norm);
         let gaps = open_gaps(&pts, &closed, ROUND.min(s.refine - r.used(ends)));
         if gaps.is_empty() {
             break;

@@ -40,13 +40,14 @@
 use crate::error::{Error, Result};
 use crate::explore::local::settle::EndPolicy;
 use crate::explore::local::solvers::LocalSolver;
+use crate::explore::multistart::cluster::scaled_distance;
 use crate::explore::multistart::driver::one_run;
 use crate::explore::persist::tables::{class_name, RunRecord};
 use crate::optimize::kkt::EndClass;
 use crate::optimize::mo_testproblems::simplex_lattice;
 use crate::optimize::multiobjective::{dominates, EpsilonConstraint, MultiProblem, Tchebycheff};
 use crate::optimize::noise::{estimate, NoiseOptions};
-use crate::optimize::{NoObserver, Problem};
+use crate::optimize::{NoObserver, Problem, Variable};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -78,6 +79,31 @@ pub struct GradientSettings {
     pub anchor_starts: usize,
     /// Seed of those random starts.
     pub seed: u64,
+    /// The noise σ of each objective at the start (absolute, in its own
+    /// units; 0 where ECNoise found it smooth): the Tchebycheff
+    /// subproblems' allowance is taken from it once the ranges are known
+    /// ([`tchebycheff_settings`]).
+    pub objective_sigma: Vec<f64>,
+}
+
+/// The settings of the Tchebycheff subproblems: their constraints
+/// `u_i − r_i − t <= 0` with `u_i = (f_i − z_i)/s_i` carry each
+/// objective's noise divided by its range, `3σ_i/s_i`, and so does their
+/// objective `t + ρ Σ u_i`; the end policy's allowances (of f, relative to
+/// `max(|t|, 1)`, and of g) are raised to the largest of these. On the
+/// deployable panel's front the ranges are 0.06 J·s and 0.017 s, so the
+/// allowance taken from the objectives themselves was 17–60× too small.
+pub fn tchebycheff_settings(s: &GradientSettings, scale: &[f64]) -> GradientSettings {
+    let a = s
+        .objective_sigma
+        .iter()
+        .zip(scale)
+        .map(|(sigma, range)| 3.0 * sigma / range)
+        .fold(0.0, f64::max);
+    let mut sub = s.clone();
+    sub.end.noise = sub.end.noise.max(a);
+    sub.end.noise_g = sub.end.noise_g.max(a);
+    sub
 }
 
 /// One settled end of the gradient side.
@@ -208,13 +234,18 @@ pub(super) fn objectives(
 /// smooth at every step tried, as a closed form is); the constraints'
 /// allowance (absolute, [`crate::optimize::noise::Measured::allowance_g`])
 /// over the problem's constraints and the objectives themselves, which
-/// the ε-constraint subproblems bound; and the function calls it took. A
-/// scalarization weighs the objectives, so its noise relative to its own
-/// value is at most about the largest of theirs.
-pub fn subproblem_noise(problem: &dyn MultiProblem, seed: u64) -> Result<(f64, f64, usize)> {
+/// the ε-constraint subproblems bound; each objective's σ (absolute, for
+/// [`tchebycheff_settings`]); and the function calls it took. A weighted
+/// sum of the objectives has a noise relative to its own value of at most
+/// about the largest of theirs.
+pub fn subproblem_noise(
+    problem: &dyn MultiProblem,
+    seed: u64,
+) -> Result<(f64, f64, Vec<f64>, usize)> {
     let x0 = problem.start();
     let m = problem.objective_names().len();
     let (mut allowance, mut allowance_g): (f64, f64) = (0.0, 0.0);
+    let mut sigmas = Vec::new();
     let mut calls = 0;
     for i in 0..m {
         let mut w = vec![0.0; m];
@@ -224,9 +255,10 @@ pub fn subproblem_noise(problem: &dyn MultiProblem, seed: u64) -> Result<(f64, f
         allowance = allowance.max(measured.allowance());
         let sigma_f = measured.noise_f.sigma().unwrap_or(0.0);
         allowance_g = allowance_g.max(measured.allowance_g()).max(3.0 * sigma_f);
+        sigmas.push(sigma_f);
         calls += measured.evaluations;
     }
-    Ok((allowance, allowance_g, calls))
+    Ok((allowance, allowance_g, sigmas, calls))
 }
 
 /// Build the front's gradient side (see the module doc).
@@ -311,6 +343,7 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
         ));
     }
     let (ideal, nadir, scale) = ideal_and_nadir(&anchor_f, m);
+    let s = &tchebycheff_settings(s, &scale);
     // 2. The subproblems.
     let refs = reference_points(m, s.subproblems);
     let runs: Vec<Result<(RunRecord, usize)>> = pool.install(|| {
@@ -339,7 +372,8 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
         extra_calls += super::gaps::refine(problem, s, &pool, norm, &x0, &mut ends)?;
     }
     // 3. The non-dominated certified ends.
-    let points = non_dominated_ends(problem.variables().len(), &ends);
+    let vars = problem.variables();
+    let points = non_dominated_ends(vars.len(), Merge::Designs(vars), &ends);
     // Extra calls: the subproblems' start evaluations and the final
     // objective evaluations.
     let function_calls = ends.iter().map(|e| e.run.function_calls).sum::<usize>() + extra_calls;
@@ -504,7 +538,8 @@ pub enum FrontRole {
     Point,
     /// Dominated by the end with this label.
     DominatedBy(String),
-    /// The same objectives as the earlier end with this label.
+    /// The same objectives as the earlier end with this label, or the same
+    /// design (every coordinate within [`SAME_DESIGN`] of its range).
     EqualTo(String),
     /// Not certified; its class.
     NotCertified(&'static str),
@@ -528,11 +563,42 @@ impl std::fmt::Display for FrontRole {
     }
 }
 
+/// Which ends [`front_roles`] takes as one point.
+#[derive(Debug, Clone, Copy)]
+pub enum Merge<'a> {
+    /// Equal objectives, or the same design ([`SAME_DESIGN`]) with nearly
+    /// equal objectives, over these variables (the first coordinates of
+    /// each end's design): the front's points.
+    Designs(&'a [Variable]),
+    /// Equal objectives only: the gap search ([`super::gaps`]) keeps an end
+    /// that reached a point again, so that the gap beside it, whose ends
+    /// are compared by their objectives, is tried again from that end's
+    /// design (the refinement as it was before the front's points were
+    /// merged by design).
+    Objectives,
+}
+
+/// Two certified ends whose designs agree to this fraction of every
+/// variable's range (1.8e-3° on a 180° ply angle) and whose objectives
+/// agree to [`SAME_OBJECTIVES`] are one point of the front. Two
+/// subproblems that converge to the same Pareto point end there to their
+/// stop tests, about 1e-7 of the range apart on the deployable panel's
+/// front, with objectives that differ by the evaluation's noise (4e-9 of
+/// max(|f|, 1)), so that neither dominates.
+pub const SAME_DESIGN: f64 = 1e-5;
+/// The objectives' agreement for [`SAME_DESIGN`]: `|Δf_i| <= 1e-6 ·
+/// max(|f_i|, 1)`. Designs that close can still be distinct points where
+/// an objective is steep: ZDT3's `f2` moves by `√Δx1` near `x1 = 0`.
+pub const SAME_OBJECTIVES: f64 = 1e-6;
+
 /// What became of each end: dominated by any other end with objectives,
-/// equal to an earlier one, or a point of the front (the non-dominated
-/// filter of [`crate::optimize::multiobjective::non_dominated`], equal
-/// points once).
-pub fn front_roles(ends: &[SubproblemEnd]) -> Vec<FrontRole> {
+/// equal to an earlier one (the same objectives, or the same design and
+/// nearly the same objectives, [`SAME_DESIGN`]), or a point of the front (the non-dominated filter of
+/// [`crate::optimize::multiobjective::non_dominated`], equal points once).
+/// `merge`: whether ends at one design are merged (the front's points) or
+/// only ends with equal objectives (the gap search's view, [`Merge`]).
+pub fn front_roles(merge: Merge<'_>, ends: &[SubproblemEnd]) -> Vec<FrontRole> {
+    let point = representatives(merge, ends);
     ends.iter()
         .enumerate()
         .map(|(i, e)| {
@@ -545,27 +611,82 @@ pub fn front_roles(ends: &[SubproblemEnd]) -> Vec<FrontRole> {
                     FrontRole::NotFinite
                 };
             };
-            let others = ends.iter().enumerate().filter(|(j, _)| *j != i);
-            let with_f = others.filter_map(|(j, o)| o.f.as_ref().map(|g| (j, o, g)));
-            let mut equal = None;
-            for (j, o, g) in with_f {
-                if dominates(g, f) {
-                    return FrontRole::DominatedBy(o.label.clone());
-                }
-                if j < i && g == f && equal.is_none() {
-                    equal = Some(o.label.clone());
-                }
+            let by = ends
+                .iter()
+                .enumerate()
+                .find(|(j, o)| *j != i && o.f.as_ref().is_some_and(|g| dominates(g, f)));
+            match by {
+                Some((_, o)) => FrontRole::DominatedBy(o.label.clone()),
+                None if point[i] != i => FrontRole::EqualTo(ends[point[i]].label.clone()),
+                None => FrontRole::Point,
             }
-            equal.map_or(FrontRole::Point, FrontRole::EqualTo)
         })
         .collect()
 }
 
+/// Are the ends `a` and `b` (both with objectives) one point by `merge`?
+fn one_point(merge: Merge<'_>, a: &SubproblemEnd, b: &SubproblemEnd) -> bool {
+    let (Some(fa), Some(fb)) = (&a.f, &b.f) else {
+        return false;
+    };
+    if fa == fb {
+        return true;
+    }
+    let Merge::Designs(vars) = merge else {
+        return false;
+    };
+    let near = fa
+        .iter()
+        .zip(fb)
+        .all(|(u, v)| (u - v).abs() <= SAME_OBJECTIVES * v.abs().max(1.0));
+    let n = vars.len();
+    match (&a.run.result, &b.run.result) {
+        (Some(ra), Some(rb)) => {
+            near && scaled_distance(vars, &ra.x[..n], &rb.x[..n]) <= SAME_DESIGN
+        }
+        _ => false,
+    }
+}
+
+/// For each end with objectives, the end that stands for its point of the
+/// front (itself when it does; ends without objectives: themselves). Ends
+/// that are one point with an earlier cluster's first member join that
+/// cluster; the cluster's point is its first member that no other member
+/// dominates, so that a cluster whose members differ by noise keeps one
+/// point and never none.
+fn representatives(merge: Merge<'_>, ends: &[SubproblemEnd]) -> Vec<usize> {
+    let n = ends.len();
+    let mut cluster: Vec<usize> = (0..n).collect();
+    for i in 0..n {
+        if let Some(c) = (0..i).find(|&c| cluster[c] == c && one_point(merge, &ends[c], &ends[i])) {
+            cluster[i] = c;
+        }
+    }
+    let mut point = cluster.clone();
+    for c in (0..n).filter(|&c| cluster[c] == c) {
+        let members: Vec<usize> = (c..n).filter(|&i| cluster[i] == c).collect();
+        let objectives = |i: usize| ends[i].f.as_deref().unwrap_or(&[]);
+        let first = members.iter().copied().find(|&i| {
+            !members
+                .iter()
+                .any(|&j| dominates(objectives(j), objectives(i)))
+        });
+        for &i in &members {
+            point[i] = first.unwrap_or(c);
+        }
+    }
+    point
+}
+
 /// The non-dominated certified ends (the [`FrontRole::Point`]s):
 /// (design, objectives), the first `n` coordinates of each design.
-pub(super) fn non_dominated_ends(n: usize, ends: &[SubproblemEnd]) -> Vec<(Vec<f64>, Vec<f64>)> {
+pub(super) fn non_dominated_ends(
+    n: usize,
+    merge: Merge<'_>,
+    ends: &[SubproblemEnd],
+) -> Vec<(Vec<f64>, Vec<f64>)> {
     ends.iter()
-        .zip(front_roles(ends))
+        .zip(front_roles(merge, ends))
         .filter(|(_, role)| *role == FrontRole::Point)
         .filter_map(|(e, _)| Some((e.run.result.as_ref()?.x[..n].to_vec(), e.f.clone()?)))
         .collect()
@@ -586,5 +707,109 @@ mod tests {
         assert!(r
             .iter()
             .all(|p| (p.iter().sum::<f64>() - 2.0).abs() < 1e-12));
+    }
+
+    /// The Tchebycheff subproblems' allowance is 3σ_i/s_i at its largest
+    /// (here 3 · 2e-6 / 0.01 = 6e-4), raised from the objectives' own;
+    /// an allowance already larger stays.
+    #[test]
+    fn the_subproblems_allowance_is_the_noise_over_the_range() {
+        use crate::explore::local::solvers::{local, LocalMethod, MmfdPreset};
+        let mut s = GradientSettings {
+            subproblems: 1,
+            threads: 1,
+            solver: Arc::from(
+                local(
+                    LocalMethod::Sqp,
+                    &Default::default(),
+                    MmfdPreset::Standard,
+                    1e-6,
+                )
+                .unwrap(),
+            ),
+            refine: 0,
+            end: EndPolicy {
+                tolerances: Default::default(),
+                polish: true,
+                rescue: true,
+                noise: 1e-6,
+                noise_g: 2e-6,
+            },
+            anchor_starts: 1,
+            seed: 0,
+            objective_sigma: vec![1e-6, 2e-6],
+        };
+        let sub = tchebycheff_settings(&s, &[0.1, 0.01]);
+        assert!((sub.end.noise - 6e-4).abs() < 1e-15 && (sub.end.noise_g - 6e-4).abs() < 1e-15);
+        s.end.noise = 1e-3;
+        assert_eq!(tchebycheff_settings(&s, &[0.1, 0.01]).end.noise, 1e-3);
+    }
+
+    /// A certified end at `x` (with `t` appended, as a subproblem's design
+    /// is) with objectives `f`.
+    fn end(label: &str, x: &[f64], f: [f64; 2]) -> SubproblemEnd {
+        let mut design = x.to_vec();
+        design.push(0.0);
+        SubproblemEnd {
+            label: label.into(),
+            run: RunRecord {
+                start: 0,
+                x0: design.clone(),
+                result: Some(crate::explore::persist::tables::RunResult {
+                    x: design,
+                    f: 0.0,
+                    g: vec![],
+                }),
+                exit: String::new(),
+                iterations: 1,
+                function_calls: 1,
+                gradient_calls: 1,
+                wall_seconds: 0.0,
+                optimum: None,
+                certificate: None,
+                polish: String::new(),
+            },
+            certified: true,
+            f: Some(f.to_vec()),
+        }
+    }
+
+    /// Two ends at one design (1e-7 of the range apart, the periodic
+    /// variable across its seam) whose objectives differ by noise so that
+    /// neither dominates are one point of the front; a design 1e-4 of the
+    /// range away is another point, and so is one 1e-6 away whose
+    /// objectives differ by 0.1 (a steep objective). Where a later end at a
+    /// design dominates an earlier one by noise, the later one is the
+    /// point (the cluster keeps one point, never none).
+    #[test]
+    fn one_design_reached_twice_is_one_point() {
+        let vars = [
+            Variable::periodic("a", -90.0, 180.0).unwrap(),
+            Variable::bounded("b", 0.0, 1.0).unwrap(),
+        ];
+        let ends = [
+            end("subproblem-0", &[89.99999, 0.5], [1.0, 2.0]),
+            end("subproblem-1", &[-89.99999, 0.5], [1.0 + 1e-9, 2.0 - 1e-9]),
+            end("subproblem-2", &[89.99999, 0.5001], [0.9, 2.1]),
+            end("subproblem-3", &[89.99999, 0.500001], [1.1, 1.9]),
+            end(
+                "subproblem-4",
+                &[89.99999, 0.5001],
+                [0.9 - 1e-9, 2.1 - 1e-9],
+            ),
+        ];
+        let roles = front_roles(Merge::Designs(&vars), &ends);
+        assert_eq!(
+            roles,
+            [
+                FrontRole::Point,
+                FrontRole::EqualTo("subproblem-0".into()),
+                FrontRole::DominatedBy("subproblem-4".into()),
+                FrontRole::Point,
+                FrontRole::Point
+            ]
+        );
+        assert_eq!(non_dominated_ends(2, Merge::Designs(&vars), &ends).len(), 3);
+        assert_eq!(non_dominated_ends(2, Merge::Objectives, &ends).len(), 4);
     }
 }

@@ -179,7 +179,7 @@ fn write_ends(
     .to_vec();
     header.extend(vars.iter().map(|v| format!("x_{}", v.name)));
     header.extend(columns.iter().cloned());
-    let roles = super::gradient::front_roles(ends);
+    let roles = super::gradient::front_roles(super::gradient::Merge::Designs(vars), ends);
     let rows: Vec<Vec<String>> = ends
         .iter()
         .zip(roles)
