@@ -54,13 +54,14 @@
 
 use super::gradient::{gradient_front, subproblem_noise, GradientSettings};
 use super::grid::{evaluate_grid, grid_size, GridFront, MAX_GRID_DESIGNS};
+use super::hybrid::{hybrid_front, HybridFront};
 use super::outputs::write_outputs;
 pub use super::outputs::{FrontReport, MethodFront};
 use crate::error::{Error, Result};
 use crate::explore::context::Context;
 use crate::explore::local::settle::EndPolicy;
 use crate::explore::local::solvers::{local, LocalMethod, MmfdPreset, MmfdSettings};
-use crate::explore::persist::journal::JournaledMulti;
+use crate::explore::persist::journal::{Journal, JournaledMulti};
 use crate::explore::problem::problems::ProblemSpec;
 use crate::explore::problem::scene_front::SceneFrontProblem;
 use crate::optimize::indicators::{hypervolume, igd};
@@ -144,6 +145,10 @@ pub struct FrontSection {
     /// Feasible: `max g <= feasibility_tolerance` (default 1e-6), for the
     /// certificate, MMFD's CTMIN and NSGA-II's constraint-domination.
     pub feasibility_tolerance: Option<f64>,
+    /// Also run the hybrid ([`super::hybrid`]): NSGA-II on this fraction
+    /// of NSGA-II's budget (0 < φ < 1), then gradient subproblems seeded
+    /// at its points and in the gaps of their front (row `hybrid`).
+    pub hybrid: Option<f64>,
 }
 
 fn default_subproblems() -> usize {
@@ -248,6 +253,13 @@ pub fn check(study: &Study) -> Result<FrontSection> {
     if let Some(t) = s.feasibility_tolerance {
         crate::error::require_positive("feasibility_tolerance", t)
             .map_err(study.locate("front"))?;
+    }
+    if let Some(h) = s.hybrid.filter(|h| !(*h > 0.0 && *h < 1.0)) {
+        return Err(study.error(
+            "front.hybrid",
+            h,
+            "a fraction of NSGA-II's budget, 0 < hybrid < 1",
+        ));
     }
     let spec: ProblemSpec = study.require_section("problem", "the problem to solve")?;
     let names: Vec<String> = s.objectives.iter().map(|o| o.name.clone()).collect();
@@ -385,6 +397,7 @@ fn gradient_settings(
         anchor_starts: section.anchor_starts,
         seed: study.meta.seed,
         objective_sigma,
+        seeds: vec![],
     })
 }
 
@@ -495,6 +508,14 @@ pub fn run_front(ctx: &Context) -> Result<FrontReport> {
             igd_analytic: None,
         },
     ];
+    let hybrid = match section.hybrid {
+        Some(_) => {
+            let h = hybrid_row(&problem, (&section, &options), &settings, &journal, quiet)?;
+            methods.push(h.0);
+            Some(h.1)
+        }
+        None => None,
+    };
     let grid = match section.grid {
         Some(n) => {
             let (row, g) = grid_front(&problem, n, threads, quiet, tol)?;
@@ -518,7 +539,10 @@ pub fn run_front(ctx: &Context) -> Result<FrontReport> {
         &signs,
         analytic.as_deref(),
         grid.as_ref(),
-        &grad.ends,
+        (
+            &grad.ends,
+            hybrid.as_ref().map(|h| h.gradient.ends.as_slice()),
+        ),
         dir,
     )?;
     if !quiet {
@@ -526,6 +550,45 @@ pub fn run_front(ctx: &Context) -> Result<FrontReport> {
     }
     journal.report("front", quiet);
     Ok(report)
+}
+
+/// The hybrid ([`super::hybrid`]) on `⌈φ·B⌉` NSGA-II evaluations (`B`:
+/// `options`' budget, at least one population) as a method row, with its
+/// subproblems' ends.
+fn hybrid_row(
+    problem: &Oriented,
+    (section, options): (&FrontSection, &Nsga2Options),
+    settings: &GradientSettings,
+    journal: &Journal,
+    quiet: bool,
+) -> Result<(MethodFront, HybridFront)> {
+    let phi = section.hybrid.unwrap_or(1.0);
+    let budget = ((phi * options.max_evaluations as f64).ceil() as usize).max(options.population);
+    let opts = Nsga2Options {
+        max_evaluations: budget,
+        ..options.clone()
+    };
+    journal.watch(Some(Progress::counter(
+        "front (hybrid)",
+        "evaluations",
+        quiet,
+    )));
+    let sims = problem.simulations();
+    let h = hybrid_front(problem, &opts, settings)?;
+    journal.watch(None);
+    let row = MethodFront {
+        method: format!("hybrid-nsga2-{}", settings.solver.name()),
+        points: h.points.clone(),
+        function_calls: h.function_calls,
+        gradient_calls: h.gradient.gradient_calls,
+        simulations: since(problem, sims),
+        wall_seconds: h.wall_seconds,
+        certified: Some((h.gradient.certified(), h.gradient.ends.len())),
+        hypervolume: 0.0,
+        igd_union: None,
+        igd_analytic: None,
+    };
+    Ok((row, h))
 }
 
 /// The indicators of every method's front: the hypervolume to the

@@ -84,6 +84,14 @@ pub struct GradientSettings {
     /// subproblems' allowance is taken from it once the ranges are known
     /// ([`tchebycheff_settings`]).
     pub objective_sigma: Vec<f64>,
+    /// Designs with their objectives found by another method (the hybrid's
+    /// NSGA-II, [`super::hybrid`]); empty for the pure gradient side. With
+    /// seeds, the anchors start from the start design and the seeds best
+    /// in their objective (instead of random designs; at least one), and
+    /// each lattice
+    /// subproblem from the seed nearest its ray (instead of the anchors'
+    /// blend).
+    pub seeds: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
 /// The settings of the Tchebycheff subproblems: their constraints
@@ -196,6 +204,29 @@ fn between_anchors(
     )
 }
 
+/// The design of the seed nearest the ray `r + t·1` in the objectives
+/// normalized by `(ideal, scale)`: the seed whose `u − r` is closest to a
+/// multiple of `1` (smallest `max_i − min_i` of `u_i − r_i`), or `None`
+/// without seeds.
+fn nearest_seed(
+    seeds: &[(Vec<f64>, Vec<f64>)],
+    r: &[f64],
+    (ideal, scale): (&[f64], &[f64]),
+) -> Option<Vec<f64>> {
+    let off = |f: &[f64]| {
+        let d: Vec<f64> = (0..r.len())
+            .map(|i| (f[i] - ideal[i]) / scale[i] - r[i])
+            .collect();
+        let hi = d.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let lo = d.iter().copied().fold(f64::INFINITY, f64::min);
+        hi - lo
+    };
+    seeds
+        .iter()
+        .min_by(|a, b| off(&a.1).total_cmp(&off(&b.1)))
+        .map(|p| p.0.clone())
+}
+
 /// One settled run of `p` from `x0` by the settings' solver.
 pub(super) fn solve(p: &dyn Problem, s: &GradientSettings, index: usize, x0: &[f64]) -> RunRecord {
     one_run(p, s.solver.as_ref(), &s.end, index, x0, &mut NoObserver)
@@ -278,10 +309,9 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
     let names = problem.objective_names();
     // 1. Anchors from every start, the best of each objective, and its
     // lexicographic refinement.
-    let starts = anchor_starts(problem, s, &x0);
-    let pairs: Vec<(usize, usize)> = (0..m)
-        .flat_map(|i| (0..starts.len()).map(move |k| (i, k)))
-        .collect();
+    let starts: Vec<Vec<Vec<f64>>> = (0..m).map(|i| anchor_starts(problem, s, &x0, i)).collect();
+    let per = starts[0].len();
+    let pairs: Vec<(usize, usize)> = (0..m).flat_map(|i| (0..per).map(move |k| (i, k))).collect();
     let firsts: Vec<RunRecord> = pool.install(|| {
         pairs
             .par_iter()
@@ -292,13 +322,13 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
                     &EpsilonConstraint::new(problem, w, vec![]),
                     s,
                     i,
-                    &starts[k],
+                    &starts[i][k],
                 )
             })
             .collect()
     });
     let best: Vec<RunRecord> = (0..m)
-        .map(|i| best_first(&firsts[i * starts.len()..(i + 1) * starts.len()], tol))
+        .map(|i| best_first(&firsts[i * per..(i + 1) * per], tol))
         .collect();
     let anchors: Vec<RunRecord> = pool.install(|| {
         (0..m)
@@ -350,7 +380,10 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
         refs.par_iter()
             .enumerate()
             .map(|(k, r)| {
-                let start = between_anchors(problem, &anchor_x, r).unwrap_or_else(|| x0.clone());
+                let start = match nearest_seed(&s.seeds, r, (&ideal, &scale)) {
+                    Some(x) => x,
+                    None => between_anchors(problem, &anchor_x, r).unwrap_or_else(|| x0.clone()),
+                };
                 subproblem(problem, s, (k, r), (&ideal, &scale), &start, &x0)
             })
             .collect()
@@ -391,8 +424,20 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
 
 /// The anchors' starts: the problem's start design `x0`, then
 /// `anchor_starts − 1` seeded uniform random designs.
-fn anchor_starts(problem: &dyn MultiProblem, s: &GradientSettings, x0: &[f64]) -> Vec<Vec<f64>> {
+fn anchor_starts(
+    problem: &dyn MultiProblem,
+    s: &GradientSettings,
+    x0: &[f64],
+    i: usize,
+) -> Vec<Vec<f64>> {
     let mut starts = vec![x0.to_vec()];
+    if !s.seeds.is_empty() {
+        let mut order: Vec<&(Vec<f64>, Vec<f64>)> = s.seeds.iter().collect();
+        order.sort_by(|a, b| a.1[i].total_cmp(&b.1[i]));
+        let best = order.iter().map(|p| p.0.clone());
+        starts.extend(best.cycle().take(s.anchor_starts.max(2) - 1));
+        return starts;
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(s.seed);
     for _ in 1..s.anchor_starts.max(1) {
         starts.push(
@@ -738,6 +783,7 @@ mod tests {
             anchor_starts: 1,
             seed: 0,
             objective_sigma: vec![1e-6, 2e-6],
+            seeds: vec![],
         };
         let sub = tchebycheff_settings(&s, &[0.1, 0.01]);
         assert!((sub.end.noise - 6e-4).abs() < 1e-15 && (sub.end.noise_g - 6e-4).abs() < 1e-15);

@@ -18,4 +18,5 @@ pub mod command;
 pub mod gaps;
 pub mod gradient;
 pub mod grid;
+pub mod hybrid;
 pub mod outputs;

@@ -88,14 +88,14 @@ fn field(v: Option<f64>) -> String {
 }
 
 /// Every output of `[front]` in `dir`; `ends` are the gradient side's
-/// runs.
+/// runs and, with `[front] hybrid`, the hybrid's subproblems.
 pub fn write_outputs(
     problem: &dyn MultiProblem,
     report: &FrontReport,
     signs: &[f64],
     analytic: Option<&[Vec<f64>]>,
     grid: Option<&GridFront>,
-    ends: &[SubproblemEnd],
+    (ends, hybrid): (&[SubproblemEnd], Option<&[SubproblemEnd]>),
     dir: &Path,
 ) -> Result<()> {
     let units = Units::new(problem, signs);
@@ -118,7 +118,16 @@ pub fn write_outputs(
     }
     write_table(&dir.join("front.csv"), &header, &rows)?;
     write_summary(report, &units, dir)?;
-    write_ends(problem, ends, &columns, &units, dir)?;
+    write_ends(problem, ends, &columns, &units, &dir.join("front_ends.csv"))?;
+    if let Some(hybrid) = hybrid {
+        write_ends(
+            problem,
+            hybrid,
+            &columns,
+            &units,
+            &dir.join("hybrid_ends.csv"),
+        )?;
+    }
     if let Some(grid) = grid {
         let mut header: Vec<String> = xcols.collect();
         header.extend(columns.iter().cloned());
@@ -157,13 +166,14 @@ pub fn write_outputs(
 /// ([`super::gradient::front_roles`]: `point`, `dominated by <run>`, `equal
 /// to <run>`, `not certified (<class>)`, `anchor start`), the end design
 /// (without the subproblem's `t`) and, for the certified ends, the
-/// objectives in their units.
+/// objectives in their units. `hybrid_ends.csv`: the same for the
+/// hybrid's subproblems.
 fn write_ends(
     problem: &dyn MultiProblem,
     ends: &[SubproblemEnd],
     columns: &[String],
     units: &Units,
-    dir: &Path,
+    path: &Path,
 ) -> Result<()> {
     let vars = problem.variables();
     let mut header: Vec<String> = [
@@ -204,7 +214,7 @@ fn write_ends(
             r
         })
         .collect();
-    write_table(&dir.join("front_ends.csv"), &header, &rows)
+    write_table(path, &header, &rows)
 }
 
 /// `front_summary.csv`: one row per method.

@@ -150,6 +150,11 @@ fn front_input_errors_name_the_key() {
         "[problem]\nname = \"dtlz2\"\n[front]\nobjectives = [{ name = \"f1\" }, { name = \"f2\" }, { name = \"f3\" }]\nrefine = 4\n",
     );
     assert!(e.contains("front.refine") && e.contains("two"), "{e}");
+    let e = err(&format!("{base}{two}hybrid = 1.5\n"));
+    assert!(
+        e.contains("front.hybrid") && e.contains("0 < hybrid < 1"),
+        "{e}"
+    );
     let e = err("[problem]\nname = \"hs22\"\n[front]\nobjectives = [{ name = \"f1\" }, { name = \"f2\" }]\n");
     assert!(e.contains("zdt1, zdt2, zdt3, dtlz2"), "{e}");
     // A multi-objective problem where one objective is expected.
@@ -174,4 +179,44 @@ fn a_maximized_objective_is_written_in_its_own_sign() {
     }
     let summary = table_without(&tmp.path().join("zmax/front_summary.csv"), &[]);
     assert_eq!(column(&summary, "igd_analytic"), vec!["", ""]);
+}
+
+/// `[front] hybrid`: on ZDT1 (4 subproblems, NSGA-II on 2000 calls, the
+/// hybrid's NSGA-II on a quarter of them, 500) the `hybrid-nsga2-mmfd` row
+/// counts NSGA-II's 500 calls and its gradient side's in its function
+/// calls, its gradient side's ends are in `hybrid_ends.csv`, all certified,
+/// and its front is at least the pure gradient side's in hypervolume
+/// (its points are NSGA-II's and the seeded gradient side's, whose
+/// anchors start from the start design as the pure side's do).
+#[test]
+fn the_hybrid_seeds_the_gradient_side_with_nsga2_points() {
+    let tmp = temp_dir("front-hybrid");
+    let text = "[problem]\nname = \"zdt1\"\n[front]\nobjectives = [{ name = \"f1\" }, { name = \"f2\" }]\n\
+                subproblems = 4\nevaluations = 2000\nhybrid = 0.25\n";
+    let s = study("zhyb", text);
+    run(&s, tmp.path(), 2);
+    let summary = table_without(&tmp.path().join("zhyb/front_summary.csv"), &[]);
+    let methods = column(&summary, "method");
+    assert_eq!(
+        methods,
+        vec!["mmfd-tchebycheff", "nsga2", "hybrid-nsga2-mmfd"]
+    );
+    let num = |name: &str, k: usize| column(&summary, name)[k].parse::<f64>().unwrap();
+    let ends = table_without(&tmp.path().join("zhyb/hybrid_ends.csv"), &[]);
+    let end_calls: f64 = column(&ends, "function_calls")
+        .iter()
+        .map(|c| c.parse::<f64>().unwrap())
+        .sum();
+    println!(
+        "hybrid: {} function calls ({end_calls} in its runs), hypervolume {} against {}",
+        num("function_calls", 2),
+        num("hypervolume", 2),
+        num("hypervolume", 0)
+    );
+    assert!(num("function_calls", 2) >= 500.0 + end_calls);
+    assert!(
+        column(&ends, "class").iter().all(|c| c == "converged"),
+        "{ends:?}"
+    );
+    assert!(num("hypervolume", 2) >= num("hypervolume", 0) - 1e-9);
 }
