@@ -22,25 +22,29 @@ fn run(study: &Study, out: &std::path::Path, threads: usize) {
 /// (sampled as in `optimize::mo_testproblems`) at most 1e-2 on ZDT1 and
 /// ZDT2 (Zitzler, Deb & Thiele 2000) and 5e-2 on DTLZ2 (Deb et al. 2002),
 /// at the studies' budgets; issue 41's on the disconnected ZDT3: 1e-2
-/// (SQP subproblems with the gaps refined).
+/// (SQP subproblems with the gaps refined, and the hybrid).
 #[test]
 fn the_shipped_fronts_reach_the_analytic_fronts() {
     let tmp = temp_dir("fronts");
-    for (file, bar, objectives, gradient) in [
-        ("studies/zdt1.toml", 1e-2, 2, "mmfd-tchebycheff"),
-        ("studies/zdt2.toml", 1e-2, 2, "mmfd-tchebycheff"),
-        ("studies/zdt3.toml", 1e-2, 2, "sqp-tchebycheff"),
-        ("studies/dtlz2.toml", 5e-2, 3, "mmfd-tchebycheff"),
+    for (file, bar, objectives, gradient, hybrid) in [
+        ("studies/zdt1.toml", 1e-2, 2, "mmfd-tchebycheff", None),
+        ("studies/zdt2.toml", 1e-2, 2, "mmfd-tchebycheff", None),
+        (
+            "studies/zdt3.toml",
+            1e-2,
+            2,
+            "sqp-tchebycheff",
+            Some("hybrid-nsga2-sqp"),
+        ),
+        ("studies/dtlz2.toml", 5e-2, 3, "mmfd-tchebycheff", None),
     ] {
         let s = Study::load(file).unwrap();
         run(&s, tmp.path(), 2);
         let dir = tmp.path().join(s.name());
         let summary = table_without(&dir.join("front_summary.csv"), &["wall_seconds"]);
-        assert_eq!(
-            column(&summary, "method"),
-            vec![gradient, "nsga2"],
-            "{file}"
-        );
+        let mut methods = vec![gradient, "nsga2"];
+        methods.extend(hybrid);
+        assert_eq!(column(&summary, "method"), methods, "{file}");
         for (m, igd) in column(&summary, "igd_analytic").iter().enumerate() {
             let igd: f64 = igd.parse().unwrap();
             assert!(igd <= bar, "{file} method {m}: IGD {igd} > {bar}");
