@@ -122,6 +122,16 @@ pub fn non_dominated(points: &[Vec<f64>]) -> Vec<usize> {
         .collect()
 }
 
+/// The non-dominated `(design, objectives)` pairs of `points`, in their
+/// order ([`non_dominated`] on the objectives).
+pub fn non_dominated_pairs(points: &[(Vec<f64>, Vec<f64>)]) -> Vec<(Vec<f64>, Vec<f64>)> {
+    let f: Vec<Vec<f64>> = points.iter().map(|p| p.1.clone()).collect();
+    non_dominated(&f)
+        .into_iter()
+        .map(|i| points[i].clone())
+        .collect()
+}
+
 /// One objective of a study: which of the problem's, and its direction.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pick {

@@ -12,7 +12,7 @@
 //! message and left out of the front.
 
 use crate::error::{Error, Result};
-use crate::optimize::multiobjective::{non_dominated, MultiEvaluation, MultiProblem};
+use crate::optimize::multiobjective::{non_dominated_pairs, MultiEvaluation, MultiProblem};
 use crate::optimize::Variable;
 use crate::report::Progress;
 use rayon::prelude::*;
@@ -133,11 +133,7 @@ pub fn evaluate_grid(
             (e.max_g() <= tol).then(|| (p.x.clone(), e.f.clone()))
         })
         .collect();
-    let fs: Vec<Vec<f64>> = feasible.iter().map(|p| p.1.clone()).collect();
-    let front = non_dominated(&fs)
-        .into_iter()
-        .map(|i| feasible[i].clone())
-        .collect();
+    let front = non_dominated_pairs(&feasible);
     Ok(GridFront {
         points,
         front,

@@ -19,7 +19,7 @@
 
 use super::gradient::{gradient_front, GradientFront, GradientSettings};
 use crate::error::{Error, Result};
-use crate::optimize::multiobjective::{non_dominated, MultiProblem};
+use crate::optimize::multiobjective::{non_dominated_pairs, MultiProblem};
 use crate::optimize::nsga2::{self, Nsga2Options};
 use std::time::Instant;
 
@@ -71,11 +71,7 @@ pub fn hybrid_front(
     let gradient = gradient_front(problem, &seeded)?;
     let mut all = seeds;
     all.extend(gradient.points.iter().cloned());
-    let objectives: Vec<Vec<f64>> = all.iter().map(|p| p.1.clone()).collect();
-    let points = non_dominated(&objectives)
-        .into_iter()
-        .map(|i| all[i].clone())
-        .collect();
+    let points = non_dominated_pairs(&all);
     Ok(HybridFront {
         points,
         nsga2_calls: evo.evaluations,
