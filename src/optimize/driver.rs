@@ -176,5 +176,6 @@ pub fn local_outcome(
         active_constraints,
         active_side_constraints,
         termination: termination.unwrap_or(Termination::MaxIterations),
+        curvature: None,
     }
 }

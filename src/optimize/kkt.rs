@@ -46,6 +46,24 @@
 //! leads from it towards the feasible set (a local minimum of the
 //! violation, as the peak-strain constraint of the SAR problem has many).
 //!
+//! **At the noise.** An evaluation that integrates a motion with adaptive
+//! steps has noise (about 2e-8 of f on the SAR problem at rtol 1e-7,
+//! [`super::noise`]), and near an optimum the decrease a step could still
+//! make falls below it before the residual falls below `stationarity`.
+//! When the solver hands over its curvature model `H` of the Lagrangian
+//! (scaled, [`AtNoise`]), the certificate also computes the decrease left
+//! along the residual's direction `S` (the least-norm solution above,
+//! `S = −(∇f + Σ λ_j ∇g_j + Σ μ_i n_i)`) on that model,
+//!
+//! ```text
+//!   decrease_left = (∇fᵀS)² / (2 SᵀHS),
+//! ```
+//!
+//! and a feasible end whose `decrease_left` is at most the noise
+//! allowance of f (3σ of the measured noise, absolute) is **converged at
+//! the noise** ([`Certificate::at_noise`]): no step the model can see
+//! would show a decrease the evaluation resolves.
+//!
 //! Tolerances ([`KktTolerances`]) are stated by the study
 //! (`[multistart] feasibility_tolerance`, `active_tolerance`,
 //! `kt_tolerance`); the defaults are `1e-6`, `1e-4` and `1e-4`.
@@ -132,6 +150,41 @@ pub struct Certificate {
     /// Infeasible designs: is the design a stationary point of the
     /// violation? (`None` for feasible designs.)
     pub violation_stationary: Option<bool>,
+    /// Feasible designs certified with a curvature model ([`AtNoise`]):
+    /// the decrease of f left along the residual's direction on it.
+    pub decrease_left: Option<f64>,
+    /// Converged by the test at the noise while `kt_residual` is above
+    /// `stationarity`: the allowance `decrease_left` met (`None`
+    /// otherwise).
+    pub at_noise: Option<f64>,
+}
+
+/// The test at the noise of the module doc: the solver's curvature model
+/// of the Lagrangian and the noise allowance of f.
+#[derive(Debug, Clone, Copy)]
+pub struct AtNoise<'a> {
+    /// `H`, in the range-scaled variables, `n × n`, row-major.
+    pub hessian: &'a [f64],
+    /// The noise allowance of f, absolute (`> 0`; 3σ of the measured
+    /// noise).
+    pub allowance: f64,
+}
+
+/// The decrease of f the quadratic model `f + αgᵀs + ½α²sᵀHs` predicts
+/// along `s` at its minimum, `(gᵀs)²/(2sᵀHs)`, for a descent direction
+/// (`gᵀs < 0`) with positive curvature on the row-major `n × n` `hessian`;
+/// `None` otherwise.
+pub fn decrease_left(hessian: &[f64], g: &[f64], s: &[f64]) -> Option<f64> {
+    let n = s.len();
+    if hessian.len() != n * n || g.len() != n {
+        return None;
+    }
+    let d0: f64 = g.iter().zip(s).map(|(a, b)| a * b).sum();
+    let shs: f64 = (0..n)
+        .map(|i| s[i] * (0..n).map(|j| hessian[i * n + j] * s[j]).sum::<f64>())
+        .sum();
+    let left = d0 * d0 / (2.0 * shs);
+    (d0 < 0.0 && shs > 0.0 && left.is_finite()).then_some(left)
 }
 
 fn ranges(vars: &[Variable]) -> Vec<f64> {
@@ -173,6 +226,17 @@ pub fn certify(
     ev: &Evaluation,
     tol: &KktTolerances,
 ) -> Result<Certificate> {
+    certify_with(vars, x, ev, tol, None)
+}
+
+/// [`certify`] with the test at the noise when `at_noise` is given.
+pub fn certify_with(
+    vars: &[Variable],
+    x: &[f64],
+    ev: &Evaluation,
+    tol: &KktTolerances,
+    at_noise: Option<AtNoise<'_>>,
+) -> Result<Certificate> {
     let missing = || Error::numerical("optimize::kkt", "the evaluation has no gradients");
     let r = ranges(vars);
     let scale = |g: &[f64]| -> Vec<f64> { g.iter().zip(&r).map(|(a, b)| a * b).collect() };
@@ -201,8 +265,13 @@ pub fn certify(
         for (k, &j) in active.iter().enumerate() {
             multipliers[j] = Some(sol.lambda[k]);
         }
+        let left = at_noise.and_then(|a| decrease_left(a.hessian, &gf, &sol.s));
+        let stationary = residual <= tol.stationarity;
+        let at_noise = at_noise
+            .map(|a| a.allowance)
+            .filter(|&a| !stationary && a > 0.0 && left.is_some_and(|d| d <= a));
         return Ok(Certificate {
-            class: if residual <= tol.stationarity {
+            class: if stationary || at_noise.is_some() {
                 EndClass::Converged
             } else {
                 EndClass::Stopped
@@ -212,6 +281,8 @@ pub fn certify(
             multipliers,
             violation_residual: None,
             violation_stationary: None,
+            decrease_left: left,
+            at_noise,
         });
     }
     // Infeasible: the gradient of the violation, per unit of violation.
@@ -238,6 +309,8 @@ pub fn certify(
         multipliers: vec![None; m],
         violation_residual: Some(residual),
         violation_stationary: Some(residual <= tol.stationarity),
+        decrease_left: None,
+        at_noise: None,
     })
 }
 
@@ -250,11 +323,21 @@ pub fn certify_at(
     x: &[f64],
     tol: &KktTolerances,
 ) -> Result<(Evaluation, Certificate)> {
+    certify_at_with(problem, x, tol, None)
+}
+
+/// [`certify_at`] with the test at the noise when `at_noise` is given.
+pub fn certify_at_with(
+    problem: &dyn Problem,
+    x: &[f64],
+    tol: &KktTolerances,
+    at_noise: Option<AtNoise<'_>>,
+) -> Result<(Evaluation, Certificate)> {
     let ev = match problem.last_gradient() {
         Some((at, ev)) if at == x => ev,
         _ => problem.evaluate(x, true)?,
     };
-    let c = certify(problem.variables(), x, &ev, tol)?;
+    let c = certify_with(problem.variables(), x, &ev, tol, at_noise)?;
     Ok((ev, c))
 }
 
@@ -414,6 +497,45 @@ mod tests {
         // With a margin (a noise of g of 1e-6): inside by about the margin.
         let (_, en) = nudge_inside(&p, &x, &ev, 1e-6).unwrap().unwrap();
         assert!((-1.1e-6..=-0.9e-6).contains(&en.max_g()), "{}", en.max_g());
+    }
+
+    /// The test at the noise on the disc problem, on the circle at the
+    /// angle δ = 1e-3 from x*: the residual is about sin δ = 1e-3 (not
+    /// stationary at 1e-4), and the decrease left along the circle is
+    /// √2(1 − cos δ) = 7.07e-7 (closed form). With the Lagrangian's exact
+    /// Hessian λ∇²g = √2·I (λ = 1/√2), in the scaled variables `r² √2·I`
+    /// (r = 4, the range), the model's decrease left matches it to 1e-3;
+    /// an allowance of 1e-6 certifies the design at the noise, one of
+    /// 5e-7 does not, nor does a missing model.
+    #[test]
+    fn the_test_at_the_noise_uses_the_decrease_left() {
+        let p = testproblems::disc();
+        let (delta, r) = (1e-3_f64, 4.0);
+        let a = 1.25 * std::f64::consts::PI + delta;
+        let x = [a.cos(), a.sin()];
+        let k = r * r * std::f64::consts::SQRT_2;
+        let h = [k, 0.0, 0.0, k];
+        let exact = std::f64::consts::SQRT_2 * (1.0 - delta.cos());
+        let with = |allowance: f64| {
+            let noisy = Some(AtNoise {
+                hessian: &h,
+                allowance,
+            });
+            certify_at_with(&p, &x, &tol(), noisy).unwrap().1
+        };
+        let c = with(1e-6);
+        assert_eq!(c.class, EndClass::Converged, "{c:?}");
+        assert_eq!(c.at_noise, Some(1e-6));
+        assert!((c.kt_residual.unwrap() - delta).abs() < 1e-6, "{c:?}");
+        let left = c.decrease_left.unwrap();
+        assert!((left / exact - 1.0).abs() < 1e-3, "{left} vs {exact}");
+        let c = with(5e-7);
+        assert_eq!((c.class, c.at_noise), (EndClass::Stopped, None), "{c:?}");
+        let (_, c) = certify_at(&p, &x, &tol()).unwrap();
+        assert_eq!((c.class, c.decrease_left), (EndClass::Stopped, None));
+        // No descent along the direction, or no positive curvature: none.
+        assert_eq!(decrease_left(&h, &[1.0, 0.0], &[1.0, 0.0]), None);
+        assert_eq!(decrease_left(&[0.0; 4], &[1.0, 0.0], &[-1.0, 0.0]), None);
     }
 
     /// A lower bound as a constraint: f = x on [0, 1] at x = 0 is a

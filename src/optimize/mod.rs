@@ -378,6 +378,10 @@ pub enum Termination {
     RelativeChange,
     /// The Kuhn–Tucker conditions hold to tolerance.
     KuhnTucker,
+    /// The decrease a step could still make, on the solver's curvature
+    /// model, is within the noise allowance of f (MMFD with a measured
+    /// noise; [`kkt`]'s test at the noise).
+    AtNoise,
     /// No usable-feasible direction exists.
     NoFeasibleDirection,
     /// Iteration limit reached.
@@ -401,6 +405,7 @@ impl std::fmt::Display for Termination {
             Termination::AbsoluteChange => "absolute_change",
             Termination::RelativeChange => "relative_change",
             Termination::KuhnTucker => "kuhn_tucker",
+            Termination::AtNoise => "at_noise",
             Termination::NoFeasibleDirection => "no_feasible_direction",
             Termination::MaxIterations => "max_iterations",
             Termination::MaxEvaluations => "max_evaluations",
@@ -434,6 +439,11 @@ pub struct LocalOutcome {
     pub active_side_constraints: usize,
     /// Why it stopped.
     pub termination: Termination,
+    /// The solver's curvature model of the Lagrangian at `x`, in the
+    /// range-scaled variables of [`kkt`] (`n × n`, row-major), when it
+    /// keeps one (MMFD's damped BFGS model): the certificate's test at the
+    /// noise reads it ([`kkt::AtNoise`]).
+    pub curvature: Option<Vec<f64>>,
 }
 
 /// The end of a global (evolutionary) run.

@@ -222,7 +222,7 @@ fn optimize_rows(name: &str, p: &mut SceneProblem) -> Result<Vec<Vec<String>>> {
         crate::explore::local::solvers::LocalMethod::Mmfd,
         &Default::default(),
         crate::explore::local::solvers::MmfdPreset::Dot,
-        crate::optimize::mmfd::MmfdOptions::dot().ctmin,
+        (crate::optimize::mmfd::MmfdOptions::dot().ctmin, 0.0),
     )?;
     let start = p.start().to_vec();
     let mut rows = Vec::new();

@@ -278,7 +278,7 @@ fn measure_at(
             spec.method,
             &MmfdSettings::default(),
             MmfdPreset::default(),
-            spec.feasibility_tolerance,
+            (spec.feasibility_tolerance, measured[0].allowance()),
         )?;
         let end = EndPolicy {
             tolerances: KktTolerances {

@@ -384,7 +384,7 @@ fn gradient_settings(
             section.method,
             &MmfdSettings::default(),
             MmfdPreset::Standard,
-            tol,
+            (tol, 0.0),
         )?),
         refine: section.refine,
         end: EndPolicy {

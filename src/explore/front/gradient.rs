@@ -768,7 +768,7 @@ mod tests {
                     LocalMethod::Sqp,
                     &Default::default(),
                     MmfdPreset::Standard,
-                    1e-6,
+                    (1e-6, 0.0),
                 )
                 .unwrap(),
             ),

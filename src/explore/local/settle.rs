@@ -7,7 +7,10 @@
 //!
 //! 1. The Kuhn–Tucker certificate at the end ([`kkt::certify_at`], one
 //!    evaluation with gradients): `converged`, `stopped` or `infeasible`
-//!    (see [`crate::optimize::kkt`] for the formulas and tolerances).
+//!    (see [`crate::optimize::kkt`] for the formulas and tolerances). When
+//!    the solver hands over its curvature model (MMFD's) it also tests at
+//!    the noise allowance [`EndPolicy::noise`]: converged when the
+//!    decrease a step could still make on that model is within it.
 //! 2. When the end is not converged and the polish is on: MMFD continued
 //!    from the end with [`MmfdOptions::polish_for`] (the active set from the
 //!    first iteration, CTMIN = the feasibility tolerance, change exits at
@@ -115,9 +118,17 @@ pub struct Left {
 
 impl Settled {
     /// The `polish` column of `runs.csv`: the polish's text, then the
-    /// rescue's and step 4's after `; ` (empty when none ran).
+    /// certificate's test at the noise when it decided the class
+    /// ([`kkt::AtNoise`]), the rescue's and step 4's after `; ` (empty
+    /// when none ran).
     pub fn note(&self) -> String {
         let mut parts = vec![self.polish.text()];
+        parts.extend(self.certificate.as_ref().and_then(|c| {
+            let (left, allowance) = (c.decrease_left?, c.at_noise?);
+            Some(format!(
+                "converged at the noise: decrease left {left:.2e} <= allowance {allowance:.2e}"
+            ))
+        }));
         parts.extend(self.rescue.as_ref().map(Rescue::text));
         parts.extend(self.returned.map(|l| {
             format!(
@@ -218,10 +229,13 @@ pub fn return_to_best(
         x: b.x.clone(),
         f: b.f,
         g: b.g.clone(),
+        // The solver's model is of its end, not of this design.
+        curvature: None,
         ..o.clone()
     };
     let at = (o.function_calls, o.gradient_calls);
-    let Ok((c, calls)) = certify_recorded(&counted, &there, at, &policy.tolerances, observer)
+    let noisy = (at, policy.noise);
+    let Ok((c, calls)) = certify_recorded(&counted, &there, noisy, &policy.tolerances, observer)
     else {
         let spent = (counted.function_calls(), counted.gradient_calls());
         return stay(settled, (at.0 + spent.0, at.1 + spent.1), observer);
@@ -392,17 +406,23 @@ fn no_worse(b: &LocalOutcome, a: &LocalOutcome, tol: f64, noise: f64) -> bool {
 /// The certificate at `o`'s design, recorded to `observer` as a check of
 /// the run's last iteration (one evaluation with gradients through
 /// `counted`, whose calls are added to `calls`; its active set
-/// `g_j >= −active` as the record's CT). Returns the certificate and the
-/// calls after it.
+/// `g_j >= −active` as the record's CT). With the solver's curvature
+/// model (`o.curvature`) and a noise allowance (`noise`, relative to
+/// `max(|f|, 1)`) the certificate also tests at the noise
+/// ([`kkt::AtNoise`]). Returns the certificate and the calls after it.
 fn certify_recorded(
     counted: &Counted<'_>,
     o: &LocalOutcome,
-    calls: (usize, usize),
+    (calls, noise): ((usize, usize), f64),
     tol: &KktTolerances,
     observer: &mut dyn Observer,
 ) -> Result<(Certificate, (usize, usize))> {
     let before = (counted.function_calls(), counted.gradient_calls());
-    let (ev, c) = kkt::certify_at(counted, &o.x, tol)?;
+    let at_noise = o.curvature.as_deref().map(|hessian| kkt::AtNoise {
+        hessian,
+        allowance: noise * o.f.abs().max(1.0),
+    });
+    let (ev, c) = kkt::certify_at_with(counted, &o.x, tol, at_noise)?;
     let calls = (
         calls.0 + counted.function_calls() - before.0,
         calls.1 + counted.gradient_calls() - before.1,
@@ -493,6 +513,7 @@ fn rescue(
         active_constraints: 0,
         active_side_constraints: 0,
         termination: o.termination.clone(),
+        curvature: None,
     };
     let again = settle_end(problem, reached, policy, observer);
     Settled {
@@ -519,18 +540,19 @@ fn settle_end(
     // the caller's counter counts it.
     let counted = Counted::new(problem);
     let calls = (outcome.function_calls, outcome.gradient_calls);
-    let (first, calls) = match certify_recorded(&counted, &outcome, calls, tol, observer) {
-        Ok(c) => c,
-        Err(e) => {
-            return Settled {
-                outcome,
-                certificate: None,
-                polish: PolishEnd::CertificateFailed(e.to_string()),
-                rescue: None,
-                returned: None,
+    let (first, calls) =
+        match certify_recorded(&counted, &outcome, (calls, policy.noise), tol, observer) {
+            Ok(c) => c,
+            Err(e) => {
+                return Settled {
+                    outcome,
+                    certificate: None,
+                    polish: PolishEnd::CertificateFailed(e.to_string()),
+                    rescue: None,
+                    returned: None,
+                }
             }
-        }
-    };
+        };
     // No polish from an infeasible end where descent on the violation
     // cannot go on: a stationary point of the violation, or an end where
     // the solver's own moves toward the feasible set found no decrease
@@ -572,7 +594,7 @@ fn settle_end(
             ..p.clone()
         };
         let at = (o.function_calls, o.gradient_calls);
-        let (c, after) = certify_recorded(&counted, &o, at, tol, observer)?;
+        let (c, after) = certify_recorded(&counted, &o, (at, policy.noise), tol, observer)?;
         Ok((p.termination, o, c, after))
     });
     let (polish, c) = match polished {
@@ -644,6 +666,7 @@ pub fn strictly_feasible(
         active_constraints: 0,
         active_side_constraints: 0,
         termination: crate::optimize::Termination::MaxIterations,
+        curvature: None,
     };
     let s = settle_end(problem, outcome, policy, &mut NoObserver);
     let end = s.outcome;

@@ -18,6 +18,7 @@ fn end(p: &dyn Problem, x: f64) -> LocalOutcome {
         active_constraints: 0,
         active_side_constraints: 0,
         termination: Termination::RelativeChange,
+        curvature: None,
     }
 }
 

@@ -137,18 +137,19 @@ impl MmfdSettings {
 }
 
 /// The local solver `method` (MMFD with `mmfd`'s settings over `preset`,
-/// CTMIN = `feasibility`; SQP with its defaults and that feasibility
-/// tolerance). This match is the one place a study's method name becomes
-/// a solver.
+/// CTMIN = `feasibility` and the exit at the noise allowance `noise` of
+/// f, relative to `max(|f|, 1)`, 0 for none ([`MmfdOptions::with_noise`]);
+/// SQP with its defaults and that feasibility tolerance). This match is
+/// the one place a study's method name becomes a solver.
 pub fn local(
     method: LocalMethod,
     mmfd: &MmfdSettings,
     preset: MmfdPreset,
-    feasibility: f64,
+    (feasibility, noise): (f64, f64),
 ) -> Result<Box<dyn LocalSolver>> {
     Ok(match method {
         LocalMethod::Steepest => Box::new(Steepest),
-        LocalMethod::Mmfd => Box::new(mmfd.options(preset, feasibility)),
+        LocalMethod::Mmfd => Box::new(mmfd.options(preset, feasibility).with_noise(noise)),
         LocalMethod::Sqp => Box::new(SqpOptions::default().with_feasibility(feasibility)),
     })
 }
@@ -293,6 +294,7 @@ pub fn steepest(
             .count(),
         x,
         termination,
+        curvature: None,
     })
 }
 

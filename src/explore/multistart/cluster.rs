@@ -169,6 +169,8 @@ mod tests {
             multipliers: vec![],
             violation_residual: None,
             violation_stationary: None,
+            decrease_left: None,
+            at_noise: None,
         });
         RunRecord {
             certificate,

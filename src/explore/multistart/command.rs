@@ -45,13 +45,13 @@ pub fn multistart_with(
     };
     ctx.manifest(&dir, "multistart", started)?;
     let section = &plan.section;
+    let noise = noise_allowance(ctx, problem, plan)?;
     let solver = solvers::local(
         section.method,
         &section.mmfd,
         section.preset,
-        section.feasibility_tolerance,
+        (section.feasibility_tolerance, noise.0 .0),
     )?;
-    let noise = noise_allowance(ctx, problem, plan)?;
     let report_plan = optimum_report::prepare(ctx, problem, plan)?;
     let settings = driver::Settings {
         threads: ctx.threads,

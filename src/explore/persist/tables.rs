@@ -283,6 +283,8 @@ impl RunRecord {
                         format!("field {} = \"{s}\" is not true/false", at + 4 + m)
                     })?),
                 },
+                decrease_left: None,
+                at_noise: None,
             }),
             _ if ["failed", "uncertified"].contains(&f(at)) => None,
             _ => {
@@ -443,6 +445,8 @@ mod tests {
                 multipliers: vec![None],
                 violation_residual: Some(1.0 / 3.0),
                 violation_stationary: Some(false),
+                decrease_left: None,
+                at_noise: None,
             }),
             polish: if ok {
                 "relative_change".into()

@@ -117,6 +117,11 @@ impl Bfgs {
         }
     }
 
+    /// The model `H` (`n × n`, row-major), once it exists.
+    pub(super) fn matrix(&self) -> Option<&[f64]> {
+        (!self.h.is_empty()).then_some(self.h.as_slice())
+    }
+
     /// The curvature `SᵀHS/|S|²` along `s`, when the model exists and it
     /// is positive.
     pub(super) fn along(&self, s: &[f64]) -> Option<f64> {

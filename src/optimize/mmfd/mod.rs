@@ -96,7 +96,13 @@
 //!    consecutive feasible iterations, or the Kuhn–Tucker test
 //!    `|S| <= kt_tolerance · max(|f|, 1)` (or `max(|∇f|, 1)` with the
 //!    scaled gradient, option `kt_scale`) with the binding constraints
-//!    within CTMIN of their limits.
+//!    within CTMIN of their limits, or, with a noise allowance (option
+//!    `noise`), the same test at the noise as the certificate's
+//!    ([`super::kkt`]): a feasible design, binding constraints within
+//!    CTMIN, and the decrease the curvature model predicts along `S` (along
+//!    `−∇f` when nothing is active), `(∇fᵀS)²/(2SᵀHS)`, within the
+//!    allowance `noise · max(|f|, 1)` (exit `at_noise`). The outcome hands
+//!    the model to the certificate ([`LocalOutcome::curvature`]).
 //!
 //! Counting follows DOT (and the paper's Table 5) and scipy, see
 //! [`Counted`]: an evaluation with gradients counts one gradient call,
@@ -104,7 +110,7 @@
 //! (the accepted point of a line search).
 
 use super::driver::{self, OptState, Recorded};
-use super::{Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination};
+use super::{kkt, Counted, Evaluation, IterRecord, LocalOutcome, Observer, Problem, Termination};
 use crate::error::{Error, Result};
 use argmin::core::{
     Problem as ArgminProblem, Solver, State, TerminationReason, TerminationStatus, KV,
@@ -359,7 +365,8 @@ impl Mmfd {
             .collect();
         let sides = SideConstraints::at(&vars, &base.x, &self.range);
         // Steps 3–4: direction.
-        let dir = if active.is_empty() && sides.rows.is_empty() {
+        let unconstrained = active.is_empty() && sides.rows.is_empty();
+        let dir = if unconstrained {
             self.conjugate_direction(&gf)
         } else {
             self.fr_prev = None;
@@ -372,6 +379,10 @@ impl Mmfd {
         // Kuhn–Tucker test.
         if self.kuhn_tucker(&base, &gf, &dir) {
             self.stop(problem, &base, Termination::KuhnTucker);
+            return Ok(());
+        }
+        if self.at_noise(&base, &gf, &dir, unconstrained) {
+            self.stop(problem, &base, Termination::AtNoise);
             return Ok(());
         }
         self.search_and_move(problem, &base, (&gf, &gg), &dir, curvature)
@@ -449,6 +460,32 @@ impl Mmfd {
             KtScale::Gradient => norm(gf).max(1.0),
         };
         norm(&dir.s) <= o.kt_tolerance * kt_scale && on_limits
+    }
+
+    /// The exit at the noise of step 6: with a noise allowance (option
+    /// `noise`), a feasible design whose binding constraints are on their
+    /// limits and from which the curvature model predicts a decrease
+    /// ([`kkt::decrease_left`]) within the allowance `noise · max(|f|, 1)`
+    /// along the direction the certificate tests: `S`, or `−∇f` when
+    /// nothing is active (`S` is then conjugated).
+    fn at_noise(&self, base: &Point, gf: &[f64], dir: &Direction, unconstrained: bool) -> bool {
+        let o = &self.options;
+        let Some(h) = self.curvature.matrix() else {
+            return false;
+        };
+        if o.noise <= 0.0 || base.max_g() > o.ctmin {
+            return false;
+        }
+        let on_limits = dir.binding.iter().all(|&j| base.g[j].abs() <= o.ctmin);
+        let steepest: Vec<f64>;
+        let s = if unconstrained {
+            steepest = gf.iter().map(|v| -v).collect();
+            &steepest
+        } else {
+            &dir.s
+        };
+        let allowance = o.noise * base.f.abs().max(1.0);
+        on_limits && kkt::decrease_left(h, gf, s).is_some_and(|d| d <= allowance)
     }
 
     /// Steps 5–5b: the line search along `dir` (then, if enabled and it
@@ -641,11 +678,14 @@ pub fn minimize(
         .current
         .clone()
         .ok_or_else(|| Error::numerical("optimize::mmfd", "no iteration was run"))?;
-    Ok(driver::local_outcome(
-        &ap,
-        (p.x, p.f, p.g),
-        solver.ct_now,
-        solver.iteration,
-        solver.termination,
-    ))
+    Ok(LocalOutcome {
+        curvature: solver.curvature.matrix().map(<[f64]>::to_vec),
+        ..driver::local_outcome(
+            &ap,
+            (p.x, p.f, p.g),
+            solver.ct_now,
+            solver.iteration,
+            solver.termination,
+        )
+    })
 }

@@ -84,10 +84,11 @@ pub struct MmfdOptions {
     /// [`super`], step 5b): off in DOT's settings, on in the polish, where
     /// the decreases left near an optimum fall below the evaluation's noise.
     pub slope_search: bool,
-    /// The relative noise of f that the slope search tolerates as a rise
-    /// (of `max(|f|, 1)`): 0 for a function exact to rounding (DOT's
-    /// settings and the polish's own); the drivers give the noise they
-    /// measured (ECNoise, `crate::optimize::noise`) with
+    /// The relative noise of f (of `max(|f|, 1)`) that the slope search
+    /// tolerates as a rise and below which a predicted decrease ends the
+    /// run (exit `at_noise`, step 6 of [`super`]): 0 for a function exact
+    /// to rounding (DOT's settings and the polish's own); the drivers give
+    /// the noise they measured (ECNoise, `crate::optimize::noise`) with
     /// [`MmfdOptions::with_noise`].
     pub noise: f64,
 }
@@ -170,7 +171,8 @@ impl MmfdOptions {
         .with_feasibility(tol.feasibility)
     }
 
-    /// The slope search tolerating a rise of f of `noise · max(|f|, 1)`:
+    /// The slope search tolerating a rise of f of `noise · max(|f|, 1)`,
+    /// and the exit at that noise:
     /// the evaluation's measured noise (3σ of f relative,
     /// `crate::optimize::noise::Measured::allowance`).
     pub fn with_noise(mut self, noise: f64) -> MmfdOptions {
