@@ -177,3 +177,68 @@ fn measured_noise_is_reported_at_the_optima_and_keeps_every_end() {
         "{header}"
     );
 }
+
+/// Issue 38's comparison with scipy's SLSQP: HS 21/35/43/76/100/22, one
+/// `[multistart] method = "sqp"` run each from the starts 2,−1 /
+/// 0.5,0.5,0.5 / 0,0,0,0 / 0.5,0.5,0.5,0.5 / 1,2,0,4,0,1,1 / 2,2, the
+/// noise measured, every end certified: every run converged within 1e-6
+/// of the published f* (Hock & Schittkowski 1981; HS 22's f* = 1), and
+/// all six at most 1.3× the calls (f + g) scipy 1.17.1's SLSQP at ftol
+/// 1e-12 takes from the same starts (`results/sqp_peers/slsqp.csv`,
+/// written by `scripts/peers/slsqp_hs.py`). Measured: 58 f + 53 g against
+/// SLSQP's 114 f + 53 g, 0.66×.
+#[test]
+fn six_hock_schittkowski_runs_cost_less_than_slsqp() {
+    use plyscape::optimize::testproblems as tp;
+    let tmp = temp_dir("cert-hs-six");
+    let dir = tmp.path().to_path_buf();
+    let cases = [
+        ("hs21", "2.0, -1.0", tp::hs21().f_opt),
+        ("hs35", "0.5, 0.5, 0.5", tp::hs35().f_opt),
+        ("hs43", "0.0, 0.0, 0.0, 0.0", tp::hs43().f_opt),
+        ("hs76", "0.5, 0.5, 0.5, 0.5", tp::hs76().f_opt),
+        (
+            "hs100",
+            "1.0, 2.0, 0.0, 4.0, 0.0, 1.0, 1.0",
+            tp::hs100().f_opt,
+        ),
+        ("hs22", "2.0, 2.0", 1.0),
+    ];
+    let mut ours = 0;
+    for (name, x0, f_opt) in cases {
+        let text = format!(
+            "[study]\nname = \"{name}\"\nseed = 1\n[problem]\nname = \"{name}\"\n\
+             [multistart]\npoints = [[{x0}]]\nstarts = 0\nmethod = \"sqp\"\nnoise = \"measured\"\n"
+        );
+        let s = study(name, &text);
+        let r = explore::run_multistart(&ctx(&s, &dir, 1, DriveFlags::default())).unwrap();
+        assert_eq!(r.classes.converged, 1, "{name}: {:?}", r.classes);
+        let runs = table_without(&dir.join(name).join("runs.csv"), &[]);
+        let f: f64 = column(&runs, "f")[0].parse().unwrap();
+        assert!(
+            (f - f_opt).abs() <= 1e-6 * f_opt.abs().max(1.0),
+            "{name}: f = {f}"
+        );
+        for c in ["function_calls", "gradient_calls"] {
+            ours += column(&runs, c)[0].parse::<usize>().unwrap();
+        }
+    }
+    let peer = std::fs::read_to_string("results/sqp_peers/slsqp.csv").unwrap();
+    let mut rows = peer.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<&str> = rows.next().unwrap().split(',').collect();
+    let at = |k: &str| header.iter().position(|h| *h == k).unwrap();
+    let (fc, gc) = (at("function_calls"), at("gradient_calls"));
+    let slsqp: usize = rows
+        .map(|l| {
+            let v: Vec<&str> = l.split(',').collect();
+            v[fc].parse::<usize>().unwrap() + v[gc].parse::<usize>().unwrap()
+        })
+        .sum();
+    eprintln!("six HS runs: {ours} calls, SLSQP {slsqp}");
+    assert_eq!(slsqp, 167, "results/sqp_peers/slsqp.csv changed");
+    assert!(ours as f64 <= 1.3 * slsqp as f64, "{ours} against {slsqp}");
+    assert!(
+        ours <= 111,
+        "{ours} calls: a rise past the measured 111 is a regression"
+    );
+}
