@@ -80,12 +80,11 @@ impl MultiProblem for MoAnalytic {
             ));
         }
         let (f, gf) = (self.kernel)(x);
-        Ok(MultiEvaluation {
-            f,
-            g: vec![],
-            grad_f: gradients.then_some(gf),
-            grad_g: gradients.then(Vec::new),
-        })
+        Ok(MultiEvaluation::smooth(
+            (f, vec![]),
+            gradients.then_some(gf),
+            gradients.then(Vec::new),
+        ))
     }
     fn name(&self) -> &str {
         &self.name

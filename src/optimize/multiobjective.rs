@@ -26,6 +26,18 @@
 //!   for `ρ > 0` (Miettinen, *Nonlinear Multiobjective Optimization*,
 //!   Kluwer 1999, Thm 3.4.6); reference points spread evenly over a simplex
 //!   give points spread along the front, convex or not.
+//!
+//! **Objectives that are maxima.** An objective may be the largest of a
+//! few smooth pieces, `f_i = max_k p_ik` (a peak over time: the response
+//! at each of its critical time points, [`MultiProblem::objective_pieces`]);
+//! where two pieces are equal `f_i` has a kink and its gradient jumps, so
+//! a scalarization that uses `f_i` as one smooth function stalls there.
+//! The scalarizations take such an objective piece by piece, as the
+//! epigraph of the maximum: [`Tchebycheff`]'s constraint becomes one
+//! `(p_ik − z_i)/s_i − r_i − t <= 0` per piece, and a cap one
+//! `(p_ik − ε_i)/s_i <= 0` per piece; minimizing such an objective alone
+//! is the Tchebycheff problem of that objective alone
+//! ([`Tchebycheff::only`]: minimize `t` with every piece at most `t`).
 
 use super::{Evaluation, Problem, Variable};
 use crate::error::{Error, Result};
@@ -41,13 +53,56 @@ pub struct MultiEvaluation {
     pub grad_f: Option<Vec<Vec<f64>>>,
     /// Gradients of each `g[j]` (m rows of length n) when asked for.
     pub grad_g: Option<Vec<Vec<f64>>>,
+    /// The further pieces of the objectives that are maxima
+    /// ([`MultiProblem::objective_pieces`] `K_i > 1`): for each such
+    /// objective in order, its pieces 2 to `K_i` (the largest is `f_i`
+    /// itself); empty when every objective is smooth.
+    pub pieces: Vec<f64>,
+    /// Their gradients (rows of length n), with the objectives'.
+    pub grad_pieces: Option<Vec<Vec<f64>>>,
 }
 
 impl MultiEvaluation {
+    /// An evaluation whose objectives are all smooth (no pieces).
+    pub fn smooth(
+        (f, g): (Vec<f64>, Vec<f64>),
+        grad_f: Option<Vec<Vec<f64>>>,
+        grad_g: Option<Vec<Vec<f64>>>,
+    ) -> MultiEvaluation {
+        MultiEvaluation {
+            f,
+            g,
+            grad_f,
+            grad_g,
+            pieces: vec![],
+            grad_pieces: None,
+        }
+    }
+
     /// Largest constraint value (`-inf` without constraints).
     pub fn max_g(&self) -> f64 {
         self.g.iter().copied().fold(f64::NEG_INFINITY, f64::max)
     }
+
+    /// The pieces of objective `i` with their gradients (when evaluated
+    /// with them), `f_i` first, for the piece counts `counts`
+    /// ([`MultiProblem::objective_pieces`] of every objective).
+    pub fn pieces_of(&self, counts: &[usize], i: usize) -> Vec<(f64, Option<&[f64]>)> {
+        let from: usize = counts[..i].iter().map(|k| k - 1).sum();
+        let mut out = vec![(self.f[i], self.grad_f.as_ref().map(|g| g[i].as_slice()))];
+        for k in from..from + counts[i] - 1 {
+            let grad = self.grad_pieces.as_ref().map(|g| g[k].as_slice());
+            out.push((self.pieces[k], grad));
+        }
+        out
+    }
+}
+
+/// Every objective's piece count (`K_i >= 1`) of `problem`.
+pub fn piece_counts(problem: &dyn MultiProblem) -> Vec<usize> {
+    (0..problem.objective_names().len())
+        .map(|i| problem.objective_pieces(i).max(1))
+        .collect()
 }
 
 /// A problem with several objectives, all minimized, subject to
@@ -63,6 +118,12 @@ pub trait MultiProblem: Sync {
     /// Evaluate at `x`; with `gradients` also every objective's and
     /// constraint's gradient.
     fn evaluate(&self, x: &[f64], gradients: bool) -> Result<MultiEvaluation>;
+    /// The smooth pieces objective `i` is the largest of (module doc;
+    /// default 1: a smooth objective); the evaluation carries pieces 2 to
+    /// `K_i` in [`MultiEvaluation::pieces`].
+    fn objective_pieces(&self, _i: usize) -> usize {
+        1
+    }
     /// Short name for reports.
     fn name(&self) -> &str;
     /// Objective `i` with its unit, for plot axes (default: its name, a
@@ -199,6 +260,19 @@ impl MultiProblem for Oriented<'_> {
     fn evaluate(&self, x: &[f64], gradients: bool) -> Result<MultiEvaluation> {
         let e = self.inner.evaluate(x, gradients)?;
         let s: Vec<f64> = (0..self.picks.len()).map(|k| self.sign(k)).collect();
+        // The further pieces of the minimized picks, in the picks' order.
+        let counts = piece_counts(self.inner);
+        let (mut pieces, mut grad_pieces) = (vec![], e.grad_f.as_ref().map(|_| vec![]));
+        for (k, p) in self.picks.iter().enumerate() {
+            if self.objective_pieces(k) > 1 {
+                for (v, g) in e.pieces_of(&counts, p.index).into_iter().skip(1) {
+                    pieces.push(v);
+                    if let (Some(rows), Some(g)) = (grad_pieces.as_mut(), g) {
+                        rows.push(g.to_vec());
+                    }
+                }
+            }
+        }
         Ok(MultiEvaluation {
             f: self
                 .picks
@@ -215,7 +289,17 @@ impl MultiProblem for Oriented<'_> {
             }),
             g: e.g,
             grad_g: e.grad_g,
+            pieces,
+            grad_pieces,
         })
+    }
+    /// The inner objective's pieces when it is minimized (a maximized
+    /// maximum is no epigraph: its pieces are dropped).
+    fn objective_pieces(&self, k: usize) -> usize {
+        match &self.picks[k] {
+            p if p.maximize => 1,
+            p => self.inner.objective_pieces(p.index),
+        }
     }
     fn name(&self) -> &str {
         self.inner.name()
@@ -261,7 +345,8 @@ impl MultiProblem for Oriented<'_> {
 }
 
 /// Minimize `Σ_i w_i f_i` subject to `(f_j − ε_j)/s_j <= 0` for every
-/// capped objective `j` and the problem's own constraints (first). Only
+/// capped objective `j` (one per piece of an objective that is a maximum,
+/// module doc) and the problem's own constraints (first). Only
 /// the objectives with `w_i != 0` or a cap enter, so an objective whose
 /// gradient is unbounded somewhere (ZDT's `f2` at `x1 = 0`) does not
 /// spoil a problem that does not use it.
@@ -269,6 +354,7 @@ pub struct EpsilonConstraint<'a> {
     inner: &'a dyn MultiProblem,
     weights: Vec<f64>,
     caps: Vec<(usize, f64, f64)>,
+    counts: Vec<usize>,
     name: String,
 }
 
@@ -285,6 +371,7 @@ impl<'a> EpsilonConstraint<'a> {
             inner,
             weights,
             caps,
+            counts: piece_counts(inner),
             name,
         }
     }
@@ -295,10 +382,12 @@ impl Problem for EpsilonConstraint<'_> {
         self.inner.variables()
     }
     fn n_constraints(&self) -> usize {
-        self.inner.n_constraints() + self.caps.len()
+        let capped: usize = self.caps.iter().map(|c| self.counts[c.0]).sum();
+        self.inner.n_constraints() + capped
     }
     fn evaluate(&self, x: &[f64], gradients: bool) -> Result<Evaluation> {
-        let e = self.inner.evaluate(x, gradients)?;
+        let mut e = self.inner.evaluate(x, gradients)?;
+        let gg_in = e.grad_g.take();
         let n = x.len();
         let used = |i: usize| self.weights[i] != 0.0;
         let f = (0..e.f.len())
@@ -306,8 +395,14 @@ impl Problem for EpsilonConstraint<'_> {
             .map(|i| self.weights[i] * e.f[i])
             .sum();
         let mut g = e.g.clone();
-        g.extend(self.caps.iter().map(|&(j, eps, s)| (e.f[j] - eps) / s));
-        let (grad_f, grad_g) = match (e.grad_f, e.grad_g) {
+        let mut dcap = Vec::new();
+        for &(j, eps, s) in &self.caps {
+            for (p, dp) in e.pieces_of(&self.counts, j) {
+                g.push((p - eps) / s);
+                dcap.extend(dp.map(|d| d.iter().map(|v| v / s).collect::<Vec<f64>>()));
+            }
+        }
+        let (grad_f, grad_g) = match (&e.grad_f, gg_in) {
             (Some(gf), Some(gg)) => {
                 let mut df = vec![0.0; n];
                 for (i, row) in gf.iter().enumerate().filter(|(i, _)| used(*i)) {
@@ -316,11 +411,7 @@ impl Problem for EpsilonConstraint<'_> {
                     }
                 }
                 let mut dg = gg;
-                dg.extend(
-                    self.caps
-                        .iter()
-                        .map(|&(j, _, s)| gf[j].iter().map(|v| v / s).collect()),
-                );
+                dg.extend(dcap);
                 (Some(df), Some(dg))
             }
             _ => (None, None),
@@ -339,7 +430,8 @@ impl Problem for EpsilonConstraint<'_> {
 
 /// The augmented reference-point Tchebycheff problem of the module doc
 /// over `(x, t)`: the problem's constraints first, then one
-/// `u_i − r_i − t <= 0` per objective.
+/// `u_i − r_i − t <= 0` per objective (per piece of an objective that is
+/// a maximum), then the caps ([`Tchebycheff::capped`]).
 pub struct Tchebycheff<'a> {
     inner: &'a dyn MultiProblem,
     ideal: Vec<f64>,
@@ -347,6 +439,11 @@ pub struct Tchebycheff<'a> {
     reference: Vec<f64>,
     rho: f64,
     vars: Vec<Variable>,
+    /// The objectives in the maximum (all unless [`Tchebycheff::only`]).
+    used: Vec<usize>,
+    /// `(j, ε_j, s_j)`: `(p_jk − ε_j)/s_j <= 0` for every piece of `f_j`.
+    caps: Vec<(usize, f64, f64)>,
+    counts: Vec<usize>,
     name: String,
 }
 
@@ -364,15 +461,34 @@ impl<'a> Tchebycheff<'a> {
         let mut vars = inner.variables().to_vec();
         vars.push(Variable::bounded("t", t_lower, t_upper)?);
         let name = format!("{}-tchebycheff", inner.name());
+        let counts = piece_counts(inner);
         Ok(Tchebycheff {
             inner,
+            used: (0..counts.len()).collect(),
             ideal,
             scale,
             reference,
             rho,
             vars,
+            caps: vec![],
+            counts,
             name,
         })
+    }
+
+    /// Only objective `i` in the maximum: with ideal 0, range 1 and
+    /// reference 0, minimizing `t + ρ f_i` with every piece of `f_i` at
+    /// most `t` is minimizing `f_i` (the epigraph of a maximum, module
+    /// doc).
+    pub fn only(mut self, i: usize) -> Self {
+        self.used = vec![i];
+        self
+    }
+
+    /// With caps `(j, ε_j, s_j)`, `s_j > 0`, as [`EpsilonConstraint`]'s.
+    pub fn capped(mut self, caps: Vec<(usize, f64, f64)>) -> Self {
+        self.caps = caps;
+        self
     }
 
     /// Normalized objectives `u_i = (f_i − z_i)/s_i`.
@@ -383,15 +499,14 @@ impl<'a> Tchebycheff<'a> {
             .collect()
     }
 
-    /// The start `(x0, t0)` with `t0 = max_i (u_i(x0) − r_i)` (every added
-    /// constraint satisfied, the largest active), clamped to `t`'s bounds.
+    /// The start `(x0, t0)` with `t0 = max_i (u_i(x0) − r_i)` over the
+    /// objectives in the maximum (every added constraint satisfied, the
+    /// largest active), clamped to `t`'s bounds.
     pub fn start(&self, x0: &[f64]) -> Result<Vec<f64>> {
         let e = self.inner.evaluate(x0, false)?;
         let u = self.normalized(&e.f);
-        let t0 = u
-            .iter()
-            .zip(&self.reference)
-            .map(|(u, r)| u - r)
+        let t0 = (self.used.iter())
+            .map(|&i| u[i] - self.reference[i])
             .fold(f64::NEG_INFINITY, f64::max);
         let mut x = x0.to_vec();
         x.push(self.vars[x0.len()].wrap(t0));
@@ -404,7 +519,9 @@ impl Problem for Tchebycheff<'_> {
         &self.vars
     }
     fn n_constraints(&self) -> usize {
-        self.inner.n_constraints() + self.ideal.len()
+        let pieces: usize = self.used.iter().map(|&i| self.counts[i]).sum();
+        let capped: usize = self.caps.iter().map(|c| self.counts[c.0]).sum();
+        self.inner.n_constraints() + pieces + capped
     }
     fn evaluate(&self, xt: &[f64], gradients: bool) -> Result<Evaluation> {
         let n = self.vars.len() - 1;
@@ -416,15 +533,34 @@ impl Problem for Tchebycheff<'_> {
             ));
         }
         let (x, t) = (&xt[..n], xt[n]);
-        let e = self.inner.evaluate(x, gradients)?;
+        let mut e = self.inner.evaluate(x, gradients)?;
+        let gg_in = e.grad_g.take();
         let u = self.normalized(&e.f);
-        let f = t + self.rho * u.iter().sum::<f64>();
+        let f = t + self.rho * self.used.iter().map(|&i| u[i]).sum::<f64>();
         let mut g = e.g.clone();
-        g.extend(u.iter().zip(&self.reference).map(|(u, r)| u - r - t));
-        let (grad_f, grad_g) = match (e.grad_f, e.grad_g) {
+        // The added rows: (value, gradient in x, coefficient of t).
+        let mut rows: Vec<(f64, Option<&[f64]>, f64, f64)> = Vec::new();
+        for &i in &self.used {
+            let (z, s, r) = (self.ideal[i], self.scale[i], self.reference[i]);
+            for (p, dp) in e.pieces_of(&self.counts, i) {
+                rows.push(((p - z) / s - r - t, dp, s, -1.0));
+            }
+        }
+        for &(j, eps, s) in &self.caps {
+            for (p, dp) in e.pieces_of(&self.counts, j) {
+                rows.push(((p - eps) / s, dp, s, 0.0));
+            }
+        }
+        g.extend(rows.iter().map(|r| r.0));
+        let (grad_f, grad_g) = match (&e.grad_f, gg_in) {
             (Some(gf), Some(gg)) => {
                 let mut df = vec![0.0; n + 1];
                 df[n] = 1.0;
+                for &i in &self.used {
+                    for (d, v) in df.iter_mut().zip(&gf[i]) {
+                        *d += self.rho * v / self.scale[i];
+                    }
+                }
                 let mut dg: Vec<Vec<f64>> = gg
                     .into_iter()
                     .map(|mut row| {
@@ -432,12 +568,9 @@ impl Problem for Tchebycheff<'_> {
                         row
                     })
                     .collect();
-                for (row, s) in gf.iter().zip(&self.scale) {
-                    let mut du: Vec<f64> = row.iter().map(|v| v / s).collect();
-                    for (d, v) in df.iter_mut().zip(&du) {
-                        *d += self.rho * v;
-                    }
-                    du.push(-1.0);
+                for (_, dp, s, dt) in &rows {
+                    let mut du: Vec<f64> = dp.unwrap_or_default().iter().map(|v| v / s).collect();
+                    du.push(*dt);
                     dg.push(du);
                 }
                 (Some(df), Some(dg))

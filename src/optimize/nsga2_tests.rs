@@ -109,12 +109,11 @@ impl MultiProblem for Segment {
         1
     }
     fn evaluate(&self, x: &[f64], _gradients: bool) -> crate::error::Result<MultiEvaluation> {
-        Ok(MultiEvaluation {
-            f: x.to_vec(),
-            g: vec![1.0 - x[0] - x[1]],
-            grad_f: None,
-            grad_g: None,
-        })
+        Ok(MultiEvaluation::smooth(
+            (x.to_vec(), vec![1.0 - x[0] - x[1]]),
+            None,
+            None,
+        ))
     }
     fn name(&self) -> &str {
         "segment"

@@ -97,6 +97,12 @@ pub struct ObjectiveSpec {
     /// `minimize` (default) or `maximize`.
     #[serde(default)]
     pub goal: Goal,
+    /// For a minimized scene `peak` response (a maximum over time): how
+    /// many of its critical time points, largest first, the gradient side
+    /// takes as the smooth pieces of the objective (default 1, the peak
+    /// alone; `optimize::multiobjective`'s module doc). NSGA-II and the
+    /// grid read the peak.
+    pub critical_points: Option<usize>,
 }
 
 /// The `[front]` section.
@@ -174,7 +180,12 @@ pub fn multi_problem(study: &Study, section: &FrontSection) -> Result<Box<dyn Mu
     let spec: ProblemSpec = study.require_section("problem", "the problem to solve")?;
     if spec.name == "scene" {
         let names: Vec<String> = section.objectives.iter().map(|o| o.name.clone()).collect();
-        return Ok(Box::new(SceneFrontProblem::from_study(study, &names)?));
+        let points: Vec<usize> = (section.objectives.iter())
+            .map(|o| o.critical_points.unwrap_or(1))
+            .collect();
+        return Ok(Box::new(
+            SceneFrontProblem::from_study(study, &names)?.with_points(points),
+        ));
     }
     spec.build_multi().map_err(study.locate("problem"))
 }
@@ -265,10 +276,25 @@ pub fn check(study: &Study) -> Result<FrontSection> {
     let names: Vec<String> = s.objectives.iter().map(|o| o.name.clone()).collect();
     let variables = if spec.name == "scene" {
         SceneFrontProblem::check(study, &names)?;
+        let points: Vec<(Option<usize>, bool)> = (s.objectives.iter())
+            .map(|o| (o.critical_points, o.goal == Goal::Maximize))
+            .collect();
+        SceneFrontProblem::check_points(study, &names, &points)?;
         let sp: crate::explore::problem::scene_problem::SceneProblemSpec =
             study.require_section("scene_problem", "the scene problem")?;
         sp.variables.len()
     } else {
+        if let Some(k) = s
+            .objectives
+            .iter()
+            .position(|o| o.critical_points.is_some())
+        {
+            return Err(study.error(
+                format!("front.objectives[{k}].critical_points"),
+                s.objectives[k].critical_points.unwrap_or(0),
+                "a scene problem's peak response (`[problem] name = \"scene\"`)",
+            ));
+        }
         let problem = spec.build_multi().map_err(study.locate("problem"))?;
         oriented(problem.as_ref(), &s).map_err(study.locate("front"))?;
         problem.variables().len()

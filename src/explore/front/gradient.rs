@@ -315,18 +315,9 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
     let firsts: Vec<RunRecord> = pool.install(|| {
         pairs
             .par_iter()
-            .map(|&(i, k)| {
-                let mut w = vec![0.0; m];
-                w[i] = 1.0;
-                solve(
-                    &EpsilonConstraint::new(problem, w, vec![]),
-                    s,
-                    i,
-                    &starts[i][k],
-                )
-            })
-            .collect()
-    });
+            .map(|&(i, k)| minimize_one(problem, s, (i, vec![]), i, &starts[i][k]))
+            .collect::<Result<_>>()
+    })?;
     let best: Vec<RunRecord> = (0..m)
         .map(|i| best_first(&firsts[i * per..(i + 1) * per], tol))
         .collect();
@@ -334,8 +325,8 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
         (0..m)
             .into_par_iter()
             .map(|i| lexicographic(problem, s, i, &best[i], &x0))
-            .collect()
-    });
+            .collect::<Result<_>>()
+    })?;
     let mut extra_calls = 0;
     let mut ends = Vec::new();
     for ((i, k), first) in pairs.iter().zip(firsts) {
@@ -350,7 +341,7 @@ pub fn gradient_front(problem: &dyn MultiProblem, s: &GradientSettings) -> Resul
     for (i, second) in anchors.into_iter().enumerate() {
         let f = objectives(problem, &second, tol, &mut extra_calls)?;
         if f.is_some() {
-            anchor_x[i] = second.result.as_ref().map(|r| r.x.clone());
+            anchor_x[i] = design(&second, x0.len());
         }
         ends.push(SubproblemEnd {
             label: format!("lexicographic-{}", names[i]),
@@ -468,38 +459,97 @@ fn best_first(runs: &[RunRecord], tol: f64) -> RunRecord {
         .clone()
 }
 
+/// The design of a run's end: the first `n` values of its result (a
+/// scalarization over `(x, t)` appends `t`).
+fn design(run: &RunRecord, n: usize) -> Option<Vec<f64>> {
+    run.result.as_ref().map(|r| r.x[..n].to_vec())
+}
+
+/// One settled run minimizing objective `i` subject to `caps` (as
+/// [`EpsilonConstraint`]'s) from the design `x0`: the ε-constraint
+/// problem, or, when `f_i` is a maximum of pieces, its epigraph
+/// ([`Tchebycheff::only`] with ideal 0, range 1, reference 0 and no
+/// augmentation: minimize `t` with every piece at most `t`, so that the
+/// end's f is `f_i`), whose start evaluation is counted with the run.
+fn minimize_one(
+    problem: &dyn MultiProblem,
+    s: &GradientSettings,
+    (i, caps): (usize, Vec<(usize, f64, f64)>),
+    index: usize,
+    x0: &[f64],
+) -> Result<RunRecord> {
+    let m = problem.objective_names().len();
+    if problem.objective_pieces(i) <= 1 {
+        let mut w = vec![0.0; m];
+        w[i] = 1.0;
+        return Ok(solve(
+            &EpsilonConstraint::new(problem, w, caps),
+            s,
+            index,
+            x0,
+        ));
+    }
+    let f0 = problem.evaluate(x0, false)?.f[i];
+    let span = f0.abs().max(1.0);
+    let t_bounds = (f0.min(0.0) - 2.0 * span, f0 + span);
+    let p = Tchebycheff::new(
+        problem,
+        (vec![0.0; m], vec![1.0; m]),
+        vec![0.0; m],
+        0.0,
+        t_bounds,
+    )?
+    .only(i)
+    .capped(caps);
+    let mut run = solve(&p, s, index, &p.start(x0)?);
+    run.function_calls += 1;
+    Ok(run)
+}
+
 /// The lexicographic anchor of objective `i`: the sum of the other
-/// objectives subject to `f_i <= f_i* + τ·max(1, |f_i*|)`, from the end of
-/// `first`, and once more from `x0` (calls counted together) when that
-/// run is not certified; `first` itself when it has no finite `f_i*`.
+/// objectives subject to `f_i <= f_i* + τ·max(1, |f_i*|)` (with two
+/// objectives, the other one by [`minimize_one`], so that an objective
+/// that is a maximum of pieces is minimized as its epigraph), from the
+/// end of `first`, and once more from `x0` (calls counted together) when
+/// that run is not certified; `first` itself when it has no finite `f_i*`.
 fn lexicographic(
     problem: &dyn MultiProblem,
     s: &GradientSettings,
     i: usize,
     first: &RunRecord,
     x0: &[f64],
-) -> RunRecord {
+) -> Result<RunRecord> {
     let tol = s.end.tolerances.feasibility;
     let m = problem.objective_names().len();
     let fi = first.result.as_ref().map(|r| r.f);
-    match (fi, &first.result) {
-        (Some(fi), Some(end)) if fi.is_finite() => {
-            let scale = fi.abs().max(1.0);
-            let w = (0..m).map(|j| if j == i { 0.0 } else { 1.0 }).collect();
-            let cap = vec![(i, fi + ANCHOR_CAP * scale, scale)];
-            let p = EpsilonConstraint::new(problem, w, cap);
-            let from_end = solve(&p, s, i, &end.x);
-            if certified(&from_end, tol) {
-                from_end
-            } else {
-                let mut again = solve(&p, s, i, x0);
-                again.function_calls += from_end.function_calls;
-                again.gradient_calls += from_end.gradient_calls;
-                again
-            }
-        }
-        _ => first.clone(),
+    let (Some(fi), Some(end)) = (fi, design(first, x0.len())) else {
+        return Ok(first.clone());
+    };
+    if !fi.is_finite() {
+        return Ok(first.clone());
     }
+    let scale = fi.abs().max(1.0);
+    let cap = vec![(i, fi + ANCHOR_CAP * scale, scale)];
+    let run = |from: &[f64]| -> Result<RunRecord> {
+        if m == 2 {
+            return minimize_one(problem, s, (1 - i, cap.clone()), i, from);
+        }
+        let w = (0..m).map(|j| if j == i { 0.0 } else { 1.0 }).collect();
+        Ok(solve(
+            &EpsilonConstraint::new(problem, w, cap.clone()),
+            s,
+            i,
+            from,
+        ))
+    };
+    let from_end = run(&end)?;
+    if certified(&from_end, tol) {
+        return Ok(from_end);
+    }
+    let mut again = run(x0)?;
+    again.function_calls += from_end.function_calls;
+    again.gradient_calls += from_end.gradient_calls;
+    Ok(again)
 }
 
 /// The ideal point `z_j = min_i f_j(a_i)`, the payoff-table nadir

@@ -37,7 +37,7 @@
 
 use super::fingerprint::{self, Fingerprint};
 use crate::error::{Error, Result};
-use crate::optimize::multiobjective::{MultiEvaluation, MultiProblem};
+use crate::optimize::multiobjective::{piece_counts, MultiEvaluation, MultiProblem};
 use crate::optimize::{Evaluation, Problem, Variable};
 use crate::report::Progress;
 use crate::study::Study;
@@ -356,25 +356,35 @@ impl Values for Evaluation {
     }
 }
 
+/// The further pieces of objectives that are maxima are kept as more
+/// objectives after `f` (`k` counts them); [`with_pieces`] moves them
+/// back.
 impl Values for MultiEvaluation {
     fn values(&self) -> Vec<f64> {
-        join(
-            &self.f,
-            &self.g,
-            self.grad_f.as_deref(),
-            self.grad_g.as_deref(),
-        )
+        let f: Vec<f64> = self.f.iter().chain(&self.pieces).copied().collect();
+        let gf = self.grad_f.as_ref().map(|gf| {
+            let mut rows = gf.clone();
+            rows.extend(self.grad_pieces.iter().flatten().cloned());
+            rows
+        });
+        join(&f, &self.g, gf.as_deref(), self.grad_g.as_deref())
     }
     fn from_values(v: &[f64], gradients: bool, n: usize, km: (usize, usize)) -> Option<Self> {
         let (f, g, grads) = split(v, gradients, n, km)?;
         let (grad_f, grad_g) = grads.map_or((None, None), |(a, b)| (Some(a), Some(b)));
-        Some(MultiEvaluation {
-            f,
-            g,
-            grad_f,
-            grad_g,
-        })
+        Some(MultiEvaluation::smooth((f, g), grad_f, grad_g))
     }
+}
+
+/// `e` with its objectives after the first `k` moved to its pieces (an
+/// evaluation read back from the journal; one with `k` objectives is
+/// returned as it is).
+fn with_pieces(mut e: MultiEvaluation, k: usize) -> MultiEvaluation {
+    if e.f.len() > k {
+        e.pieces = e.f.split_off(k);
+        e.grad_pieces = e.grad_f.as_mut().map(|rows| rows.split_off(k));
+    }
+    e
 }
 
 /// Serve `x` from the journal or evaluate it with `evaluate` and record it.
@@ -457,14 +467,22 @@ pub struct JournaledMulti<'a> {
     journal: &'a Journal,
     /// Objectives and constraints.
     km: (usize, usize),
+    /// The objectives' further pieces (journaled after the objectives).
+    pieces: usize,
 }
 
 impl<'a> JournaledMulti<'a> {
     /// Wrap `inner`; on resume the journal's spot check runs first.
     pub fn new(inner: &'a dyn MultiProblem, journal: &'a Journal) -> Result<Self> {
         journal.spot_check(|x, g| Ok(inner.evaluate(x, g)?.values()))?;
+        let pieces: usize = piece_counts(inner).iter().map(|k| k - 1).sum();
         let km = (inner.objective_names().len(), inner.n_constraints());
-        Ok(JournaledMulti { inner, journal, km })
+        Ok(JournaledMulti {
+            inner,
+            journal,
+            km,
+            pieces,
+        })
     }
 }
 
@@ -479,9 +497,17 @@ impl MultiProblem for JournaledMulti<'_> {
         self.inner.n_constraints()
     }
     fn evaluate(&self, x: &[f64], gradients: bool) -> Result<MultiEvaluation> {
-        through(self.journal, (x, gradients), (x.len(), self.km), || {
-            self.inner.evaluate(x, gradients)
-        })
+        let (k, m) = self.km;
+        let e = through(
+            self.journal,
+            (x, gradients),
+            (x.len(), (k + self.pieces, m)),
+            || self.inner.evaluate(x, gradients),
+        )?;
+        Ok(with_pieces(e, k))
+    }
+    fn objective_pieces(&self, i: usize) -> usize {
+        self.inner.objective_pieces(i)
     }
     fn name(&self) -> &str {
         self.inner.name()
@@ -542,12 +568,7 @@ mod tests {
         assert_eq!(back.f.to_bits(), e.f.to_bits());
         assert_eq!(back.g[0].to_bits(), (-0.0f64).to_bits());
         assert_eq!(back, e);
-        let m = MultiEvaluation {
-            f: vec![1.5, 2.5],
-            g: vec![],
-            grad_f: None,
-            grad_g: None,
-        };
+        let m = MultiEvaluation::smooth((vec![1.5, 2.5], vec![]), None, None);
         assert_eq!(
             MultiEvaluation::from_values(&m.values(), false, 3, (2, 0)),
             Some(m)

@@ -522,6 +522,9 @@ impl MultiProblem for CostlyMulti {
     fn evaluate(&self, x: &[f64], gradients: bool) -> Result<MultiEvaluation> {
         self.cost.around(|| self.inner.evaluate(x, gradients))
     }
+    fn objective_pieces(&self, i: usize) -> usize {
+        self.inner.objective_pieces(i)
+    }
     fn name(&self) -> &str {
         self.inner.name()
     }

@@ -27,9 +27,21 @@
 //! one without, they agree to about the integrator's tolerance). The
 //! methods' function calls are counted as the optimizers ask for them;
 //! [`MultiProblem::simulations`] counts the simulations actually run.
+//!
+//! **Peaks as pieces.** A minimized `peak` response (a maximum over time)
+//! whose `[[front.objectives]]` entry names `critical_points = K` is the
+//! largest of `K` smooth pieces, the response at its `K` largest local
+//! maxima in time (the peak where it has fewer): the evaluation carries
+//! pieces 2 to `K` ([`MultiEvaluation::pieces`], normalised as the
+//! objective), and the gradient side's scalarizations take the objective
+//! piece by piece (`optimize::multiobjective`'s module doc), as the
+//! constraints of `[[scene_problem.constraints]]` take a peak's critical
+//! points (`scene_bounds`).
 
-use super::scene_problem::{SceneProblem, SceneProblemSpec};
+use super::scene_bounds::MAX_CRITICAL_POINTS;
+use super::scene_problem::{peak_sense, SceneProblem, SceneProblemSpec};
 use crate::error::{Error, Result};
+use crate::mbs::responses::Sense;
 use crate::optimize::multiobjective::{MultiEvaluation, MultiProblem};
 use crate::optimize::Variable;
 use crate::study::Study;
@@ -50,6 +62,8 @@ pub struct SceneFrontProblem {
     cache: Mutex<HashMap<Vec<u64>, MultiEvaluation>>,
     /// Simulations run (cache misses).
     simulations: AtomicUsize,
+    /// Each objective's pieces `K_i` (1: the response alone).
+    points: Vec<usize>,
 }
 
 /// `[scene_problem]` as parsed (for `normalize_at`).
@@ -111,7 +125,45 @@ impl SceneFrontProblem {
             scales: extra.values.iter().map(|v| v.abs()).collect(),
             cache: Mutex::new(HashMap::new()),
             simulations: AtomicUsize::new(0),
+            points: vec![1; names.len()],
         })
+    }
+
+    /// Objective `i` as the largest of `points[i]` pieces (module doc;
+    /// checked by [`SceneFrontProblem::check_points`]).
+    pub fn with_points(mut self, points: Vec<usize>) -> SceneFrontProblem {
+        self.points = points;
+        self
+    }
+
+    /// Each objective's `critical_points` (`points[k]`: the count given,
+    /// and whether the objective is maximized) is 1 to
+    /// [`MAX_CRITICAL_POINTS`] on a minimized `peak` response of sense
+    /// `max` (key `front.objectives[k].critical_points`).
+    pub fn check_points(
+        study: &Study,
+        names: &[String],
+        points: &[(Option<usize>, bool)],
+    ) -> Result<()> {
+        let plan = crate::scene::ScenePlan::new(study)?;
+        for (k, (name, &(count, maximize))) in names.iter().zip(points).enumerate() {
+            let Some(count) = count else { continue };
+            let expected = if !(1..=MAX_CRITICAL_POINTS).contains(&count) {
+                format!("a count from 1 to {MAX_CRITICAL_POINTS}")
+            } else if peak_sense(plan.spec(), name) != Some(Sense::Max) {
+                format!("a `peak` response of sense `max` (\"{name}\" is not)")
+            } else if maximize {
+                "a minimized objective (a maximized peak is no maximum of pieces)".into()
+            } else {
+                continue;
+            };
+            return Err(study.error(
+                format!("front.objectives[{k}].critical_points"),
+                count,
+                expected,
+            ));
+        }
+        Ok(())
     }
 
     /// `|R_i(x_n)|`, the divisors of the objectives (response units).
@@ -121,16 +173,26 @@ impl SceneFrontProblem {
 
     fn simulate(&self, x: &[f64], gradients: bool) -> Result<MultiEvaluation> {
         self.simulations.fetch_add(1, Ordering::Relaxed);
-        let (e, extra, _) = self.inner.evaluate_with(x, gradients, &self.names)?;
-        let f = (extra.values.iter().zip(&self.scales))
+        // The objectives, then each one's further pieces, with its scale.
+        let mut at: Vec<(String, usize)> = self.names.iter().map(|n| (n.clone(), 0)).collect();
+        let mut scales = self.scales.clone();
+        for (i, &k) in self.points.iter().enumerate() {
+            at.extend((1..k).map(|p| (self.names[i].clone(), p)));
+            scales.extend((1..k).map(|_| self.scales[i]));
+        }
+        let (e, extra, _) = self.inner.evaluate_at_points(x, gradients, &at)?;
+        let mut f: Vec<f64> = (extra.values.iter().zip(&scales))
             .map(|(v, s)| v / s)
             .collect();
-        let grad_f = extra.gradients.map(|rows| {
-            (rows.iter().zip(&self.scales))
+        let mut grad_f: Option<Vec<Vec<f64>>> = extra.gradients.map(|rows| {
+            (rows.iter().zip(&scales))
                 .map(|(row, s)| row.iter().map(|v| v / s).collect())
                 .collect()
         });
+        let m = self.names.len();
         Ok(MultiEvaluation {
+            pieces: f.split_off(m),
+            grad_pieces: grad_f.as_mut().map(|rows| rows.split_off(m)),
             f,
             g: e.g,
             grad_f,
@@ -170,6 +232,9 @@ impl MultiProblem for SceneFrontProblem {
         let e = self.simulate(x, gradients)?;
         cache()?.insert(key, e.clone());
         Ok(e)
+    }
+    fn objective_pieces(&self, i: usize) -> usize {
+        self.points[i]
     }
     fn name(&self) -> &str {
         crate::optimize::Problem::name(&self.inner)

@@ -551,6 +551,19 @@ impl SceneProblem {
         gradients: bool,
         extra: &[String],
     ) -> Result<(Evaluation, ExtraResponses, EvalProfile)> {
+        let at: Vec<(String, usize)> = extra.iter().map(|n| (n.clone(), 0)).collect();
+        self.evaluate_at_points(x, gradients, &at)
+    }
+
+    /// [`SceneProblem::evaluate_with`] with each extra response at a
+    /// critical point, `(name, point)` (0: the response itself; `k`: a
+    /// peak's `k+1`-th critical time point, the peak where it has fewer).
+    pub fn evaluate_at_points(
+        &self,
+        x: &[f64],
+        gradients: bool,
+        extra: &[(String, usize)],
+    ) -> Result<(Evaluation, ExtraResponses, EvalProfile)> {
         if x.len() != self.vars.len() || x.iter().any(|v| !v.is_finite()) {
             return Err(Error::input(
                 "scene_problem.x",
@@ -565,7 +578,7 @@ impl SceneProblem {
                 .map(|c| (c.response.clone(), c.point)),
         );
         let own = names.len();
-        names.extend(extra.iter().map(|n| (n.clone(), 0)));
+        names.extend(extra.iter().cloned());
         let raw = self.raw(x, &names, gradients)?;
         let extra = ExtraResponses {
             values: raw.values[own..].to_vec(),
@@ -670,7 +683,7 @@ fn at_point(r: &ResponseValue, point: usize) -> (f64, &[f64]) {
 }
 
 /// The sense of response `name` of `scene` when it is a `peak`.
-fn peak_sense(scene: &crate::scene::SceneSpec, name: &str) -> Option<Sense> {
+pub(crate) fn peak_sense(scene: &crate::scene::SceneSpec, name: &str) -> Option<Sense> {
     let r = scene.responses.iter().find(|r| r.name == name)?;
     (r.kind == ResponseKindName::Peak).then(|| r.sense.unwrap_or_default())
 }

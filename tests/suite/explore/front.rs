@@ -154,6 +154,13 @@ fn front_input_errors_name_the_key() {
         "[problem]\nname = \"dtlz2\"\n[front]\nobjectives = [{ name = \"f1\" }, { name = \"f2\" }, { name = \"f3\" }]\nrefine = 4\n",
     );
     assert!(e.contains("front.refine") && e.contains("two"), "{e}");
+    let e = err(&format!(
+        "{base}objectives = [{{ name = \"f1\" }}, {{ name = \"f2\", critical_points = 2 }}]\n"
+    ));
+    assert!(
+        e.contains("front.objectives[1].critical_points") && e.contains("scene"),
+        "{e}"
+    );
     let e = err(&format!("{base}{two}hybrid = 1.5\n"));
     assert!(
         e.contains("front.hybrid") && e.contains("0 < hybrid < 1"),

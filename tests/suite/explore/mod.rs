@@ -5,6 +5,7 @@ mod critical_points;
 mod design_vars;
 mod discrete;
 mod front;
+mod front_pieces;
 mod kill;
 mod multistart;
 mod optimum_report;

@@ -176,4 +176,36 @@ fn scene_front_input_errors_name_the_key() {
         e.contains("front.reference_relative") && e.contains("positive factors"),
         "{e}"
     );
+    // critical_points: on a peak of sense max, minimized, 1 to 16.
+    let pieces = |a: &str, b: &str| {
+        let objectives = format!("[{{ name = \"psi0\"{a} }}, {{ name = \"u3_peak\"{b} }}]");
+        err(&replace(
+            &text,
+            "[{ name = \"psi0\" }, { name = \"u3_peak\" }]",
+            &objectives,
+            1,
+        ))
+    };
+    let e = pieces(", critical_points = 2", "");
+    assert!(
+        e.contains("front.objectives[0].critical_points") && e.contains("`peak` response"),
+        "{e}"
+    );
+    let e = pieces("", ", critical_points = 0");
+    assert!(
+        e.contains("front.objectives[1].critical_points") && e.contains("1 to 16"),
+        "{e}"
+    );
+    let e = pieces("", ", critical_points = 2, goal = \"maximize\"");
+    assert!(
+        e.contains("front.objectives[1].critical_points") && e.contains("minimized"),
+        "{e}"
+    );
+    let ok = replace(
+        &text,
+        "{ name = \"u3_peak\" }",
+        "{ name = \"u3_peak\", critical_points = 2 }",
+        1,
+    );
+    plyscape::explore::front::command::check(&study("ok", &ok)).unwrap();
 }
