@@ -511,7 +511,9 @@ fn minimize_one(
 /// objectives, the other one by [`minimize_one`], so that an objective
 /// that is a maximum of pieces is minimized as its epigraph), from the
 /// end of `first`, and once more from `x0` (calls counted together) when
-/// that run is not certified; `first` itself when it has no finite `f_i*`.
+/// that run is not certified, the better of the two kept (certified
+/// first, then feasible, then lower f); `first` itself when it has no
+/// finite `f_i*`.
 fn lexicographic(
     problem: &dyn MultiProblem,
     s: &GradientSettings,
@@ -546,10 +548,28 @@ fn lexicographic(
     if certified(&from_end, tol) {
         return Ok(from_end);
     }
-    let mut again = run(x0)?;
-    again.function_calls += from_end.function_calls;
-    again.gradient_calls += from_end.gradient_calls;
-    Ok(again)
+    let again = run(x0)?;
+    let calls = (
+        from_end.function_calls + again.function_calls,
+        from_end.gradient_calls + again.gradient_calls,
+    );
+    let key = |r: &RunRecord| {
+        let feasible = r.result.as_ref().is_some_and(|e| e.max_g() <= tol);
+        let f = r.result.as_ref().map_or(f64::INFINITY, |e| e.f);
+        (
+            !certified(r, tol),
+            !feasible,
+            if f.is_nan() { f64::INFINITY } else { f },
+        )
+    };
+    let (ka, kb) = (key(&from_end), key(&again));
+    let better = (ka.0, ka.1)
+        .cmp(&(kb.0, kb.1))
+        .then(ka.2.total_cmp(&kb.2))
+        .is_le();
+    let mut kept = if better { from_end } else { again };
+    (kept.function_calls, kept.gradient_calls) = calls;
+    Ok(kept)
 }
 
 /// The ideal point `z_j = min_i f_j(a_i)`, the payoff-table nadir
