@@ -14,6 +14,7 @@
 //!   tables and plots in [`outputs`] (`front.csv`, `front_summary.csv`,
 //!   `front.svg`, ...), with the hypervolume and IGD of each method.
 
+mod anchors;
 pub mod command;
 pub mod gaps;
 pub mod gradient;
