@@ -93,6 +93,25 @@ pub struct GradientSettings {
     pub seeds: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
+impl GradientSettings {
+    /// One subproblem on one thread by `solver`'s runs settled by `end`:
+    /// no gap subproblems, one anchor start, seed 0, no noise, no seeds
+    /// (the fields to change are then set by name).
+    pub fn new(solver: Arc<dyn LocalSolver>, end: EndPolicy) -> GradientSettings {
+        GradientSettings {
+            subproblems: 1,
+            threads: 1,
+            solver,
+            refine: 0,
+            end,
+            anchor_starts: 1,
+            seed: 0,
+            objective_sigma: vec![],
+            seeds: vec![],
+        }
+    }
+}
+
 /// The settings of the Tchebycheff subproblems: their constraints
 /// `u_i − r_i − t <= 0` with `u_i = (f_i − z_i)/s_i` carry each
 /// objective's noise divided by its range, `3σ_i/s_i`, and so does their
@@ -670,30 +689,20 @@ mod tests {
     #[test]
     fn the_subproblems_allowance_is_the_noise_over_the_range() {
         use crate::explore::local::solvers::{local, LocalMethod, MmfdPreset};
+        let solver = local(
+            LocalMethod::Sqp,
+            &Default::default(),
+            MmfdPreset::Standard,
+            (1e-6, 0.0),
+        );
+        let end = EndPolicy {
+            noise: 1e-6,
+            noise_g: 2e-6,
+            ..EndPolicy::default()
+        };
         let mut s = GradientSettings {
-            subproblems: 1,
-            threads: 1,
-            solver: Arc::from(
-                local(
-                    LocalMethod::Sqp,
-                    &Default::default(),
-                    MmfdPreset::Standard,
-                    (1e-6, 0.0),
-                )
-                .unwrap(),
-            ),
-            refine: 0,
-            end: EndPolicy {
-                tolerances: Default::default(),
-                polish: true,
-                rescue: true,
-                noise: 1e-6,
-                noise_g: 2e-6,
-            },
-            anchor_starts: 1,
-            seed: 0,
             objective_sigma: vec![1e-6, 2e-6],
-            seeds: vec![],
+            ..GradientSettings::new(Arc::from(solver.unwrap()), end)
         };
         let sub = tchebycheff_settings(&s, &[0.1, 0.01]);
         assert!((sub.end.noise - 6e-4).abs() < 1e-15 && (sub.end.noise_g - 6e-4).abs() < 1e-15);

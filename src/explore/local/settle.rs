@@ -89,6 +89,20 @@ pub struct EndPolicy {
     pub noise_g: f64,
 }
 
+/// The defaults of `[multistart]`: the certificate's default tolerances,
+/// the polish and the rescue on, no noise allowance.
+impl Default for EndPolicy {
+    fn default() -> Self {
+        EndPolicy {
+            tolerances: KktTolerances::default(),
+            polish: true,
+            rescue: true,
+            noise: 0.0,
+            noise_g: 0.0,
+        }
+    }
+}
+
 /// A settled run end.
 #[derive(Debug, Clone)]
 pub struct Settled {

@@ -5,8 +5,8 @@
 
 use plyscape::explore::front::gradient::{gradient_front, GradientSettings};
 use plyscape::explore::local::settle::EndPolicy;
-use plyscape::explore::local::solvers::{local, LocalMethod, MmfdPreset};
 use plyscape::optimize::multiobjective::{MultiEvaluation, MultiProblem};
+use plyscape::optimize::sqp::SqpOptions;
 use plyscape::optimize::Variable;
 use std::sync::Arc;
 
@@ -72,30 +72,13 @@ impl MultiProblem for Kinked {
 }
 
 fn settings() -> GradientSettings {
+    // SQP at feasibility 1e-6, the ends settled as a multistart's.
+    let sqp = SqpOptions::default().with_feasibility(1e-6);
     GradientSettings {
         subproblems: 6,
-        threads: 1,
-        solver: Arc::from(
-            local(
-                LocalMethod::Sqp,
-                &Default::default(),
-                MmfdPreset::Standard,
-                (1e-6, 0.0),
-            )
-            .unwrap(),
-        ),
-        refine: 0,
-        end: EndPolicy {
-            tolerances: Default::default(),
-            polish: true,
-            rescue: true,
-            noise: 0.0,
-            noise_g: 0.0,
-        },
-        anchor_starts: 1,
         seed: 1,
         objective_sigma: vec![0.0, 0.0],
-        seeds: vec![],
+        ..GradientSettings::new(Arc::new(sqp), EndPolicy::default())
     }
 }
 
