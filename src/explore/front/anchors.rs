@@ -38,21 +38,24 @@ pub(super) fn anchor_starts(
     starts
 }
 
-/// The best of one objective's first anchor runs: certified first, then
-/// lowest f.
-pub(super) fn best_first(runs: &[RunRecord], tol: f64) -> RunRecord {
+/// The order of runs of one scalarization, better first: certified, then
+/// feasible to `tol`, then lower f (a run without a result or with a NaN
+/// f last).
+fn better(a: &RunRecord, b: &RunRecord, tol: f64) -> std::cmp::Ordering {
     let key = |r: &RunRecord| {
-        let f = r.result.as_ref().map_or(f64::INFINITY, |x| x.f);
-        (
-            !certified(r, tol),
-            if f.is_nan() { f64::INFINITY } else { f },
-        )
+        let feasible = r.result.as_ref().is_some_and(|e| e.max_g() <= tol);
+        let f = r.result.as_ref().map_or(f64::INFINITY, |e| e.f);
+        let f = if f.is_nan() { f64::INFINITY } else { f };
+        ((!certified(r, tol), !feasible), f)
     };
+    let (ka, kb) = (key(a), key(b));
+    ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+}
+
+/// The best of one objective's first anchor runs ([`better`]).
+pub(super) fn best_first(runs: &[RunRecord], tol: f64) -> RunRecord {
     runs.iter()
-        .min_by(|a, b| {
-            let (ka, kb) = (key(a), key(b));
-            ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
-        })
+        .min_by(|a, b| better(a, b, tol))
         .expect("at least one start")
         .clone()
 }
@@ -68,7 +71,8 @@ pub(super) fn design(run: &RunRecord, n: usize) -> Option<Vec<f64>> {
 /// problem, or, when `f_i` is a maximum of pieces, its epigraph
 /// ([`Tchebycheff::only`] with ideal 0, range 1, reference 0 and no
 /// augmentation: minimize `t` with every piece at most `t`, so that the
-/// end's f is `f_i`), whose start evaluation is counted with the run.
+/// end's f is `f_i`), started at `(x0, f_i(x0))`, whose one evaluation
+/// is counted with the run.
 pub(super) fn minimize_one(
     problem: &dyn MultiProblem,
     s: &GradientSettings,
@@ -87,6 +91,7 @@ pub(super) fn minimize_one(
             x0,
         ));
     }
+    // t0 = f_i(x0), the largest piece: every epigraph row met, one active.
     let f0 = problem.evaluate(x0, false)?.f[i];
     let span = f0.abs().max(1.0);
     let t_bounds = (f0.min(0.0) - 2.0 * span, f0 + span);
@@ -99,7 +104,8 @@ pub(super) fn minimize_one(
     )?
     .only(i)
     .capped(caps);
-    let mut run = solve(&p, s, index, &p.start(x0)?);
+    let start: Vec<f64> = x0.iter().copied().chain([f0]).collect();
+    let mut run = solve(&p, s, index, &start);
     run.function_calls += 1;
     Ok(run)
 }
@@ -109,9 +115,8 @@ pub(super) fn minimize_one(
 /// objectives, the other one by [`minimize_one`], so that an objective
 /// that is a maximum of pieces is minimized as its epigraph), from the
 /// end of `first`, and once more from `x0` (calls counted together) when
-/// that run is not certified, the better of the two kept (certified
-/// first, then feasible, then lower f); `first` itself when it has no
-/// finite `f_i*`.
+/// that run is not certified, the [`better`] of the two kept; `first`
+/// itself when it has no finite `f_i*`.
 pub(super) fn lexicographic(
     problem: &dyn MultiProblem,
     s: &GradientSettings,
@@ -151,21 +156,11 @@ pub(super) fn lexicographic(
         from_end.function_calls + again.function_calls,
         from_end.gradient_calls + again.gradient_calls,
     );
-    let key = |r: &RunRecord| {
-        let feasible = r.result.as_ref().is_some_and(|e| e.max_g() <= tol);
-        let f = r.result.as_ref().map_or(f64::INFINITY, |e| e.f);
-        (
-            !certified(r, tol),
-            !feasible,
-            if f.is_nan() { f64::INFINITY } else { f },
-        )
+    let mut kept = if better(&from_end, &again, tol).is_le() {
+        from_end
+    } else {
+        again
     };
-    let (ka, kb) = (key(&from_end), key(&again));
-    let better = (ka.0, ka.1)
-        .cmp(&(kb.0, kb.1))
-        .then(ka.2.total_cmp(&kb.2))
-        .is_le();
-    let mut kept = if better { from_end } else { again };
     (kept.function_calls, kept.gradient_calls) = calls;
     Ok(kept)
 }

@@ -90,8 +90,11 @@ fn sar_from_55_minus_55_in_16_function_and_5_gradient_calls() {
 /// decrease the MMFD's curvature model sees left is within the allowance
 /// (3σ of the measured noise). Its f is within that allowance of the best
 /// design known at the same tolerance, 0.9089406489896893: start 3 of
-/// results/sar_optimize/runs.csv, certified with a Kuhn–Tucker residual of
-/// 4.8e-8. About 4 s in release.
+/// results/sar_optimize/runs.csv as committed before the test at the
+/// noise (commit 0c5fd26; `git show 0c5fd26:results/sar_optimize/runs.csv`),
+/// certified there with a Kuhn–Tucker residual of 4.8e-8 (the same run's
+/// start 0 then ended at 0.9089406489742763, residual 5.0e-6). About 4 s
+/// in release.
 #[test]
 fn sar_first_run_is_certified_at_the_noise_in_16_f_and_5_g() {
     use plyscape::explore::local::settle::{settle, EndPolicy};
