@@ -29,8 +29,9 @@ use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use nalgebra::{DMatrix, Dyn, SymmetricEigen};
 
+use super::blocks::ShiftInvert;
 use super::modes::ModalOptions;
-use super::sparse::{Factor, Pencil};
+use super::sparse::Pencil;
 use crate::error::{Error, Result};
 
 /// Result of the Lanczos iteration (before sign normalisation).
@@ -59,7 +60,7 @@ fn start_value(i: usize, c: usize) -> f64 {
 }
 
 /// `W ← Op W = (K − σM)⁻¹ M W`.
-fn apply_op(factor: &mut Factor<'_>, mass: &[f64], mut w: MatMut<'_, f64>) {
+fn apply_op(factor: &mut ShiftInvert<'_>, mass: &[f64], mut w: MatMut<'_, f64>) {
     for c in 0..w.ncols() {
         let col = w
             .rb_mut()
@@ -179,7 +180,7 @@ fn fresh_block(
     mass: &[f64],
     p: usize,
     salt: usize,
-    factor: &mut Factor<'_>,
+    factor: &mut ShiftInvert<'_>,
     solves: &mut usize,
 ) -> Mat<f64> {
     let n = mass.len();
@@ -208,7 +209,7 @@ fn fresh_block(
 /// Lowest `want` eigenpairs of `K x = λ M x` above the shift.
 pub(crate) fn block_lanczos(
     pencil: &Pencil,
-    factor: &mut Factor<'_>,
+    factor: &mut ShiftInvert<'_>,
     opts: &ModalOptions,
     want: usize,
 ) -> Result<LanczosOut> {
@@ -254,7 +255,7 @@ pub(crate) fn block_lanczos(
 /// `H` and the counts reported in [`LanczosOut`].
 struct Lanczos<'a, 'f, 'p> {
     mass: &'a [f64],
-    factor: &'f mut Factor<'p>,
+    factor: &'f mut ShiftInvert<'p>,
     opts: &'a ModalOptions,
     want: usize,
     n: usize,
@@ -322,7 +323,7 @@ impl Ritz {
 impl<'a, 'f, 'p> Lanczos<'a, 'f, 'p> {
     fn new(
         pencil: &'a Pencil,
-        factor: &'f mut Factor<'p>,
+        factor: &'f mut ShiftInvert<'p>,
         opts: &'a ModalOptions,
         want: usize,
     ) -> Self {

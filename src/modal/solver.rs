@@ -3,7 +3,7 @@
 //! ([`super::lanczos`]) and their design derivatives
 //! ([`super::derivatives`]).
 
-use super::blocks::Blocks;
+use super::blocks::{Blocks, ShiftInvert};
 use super::derivatives::{
     self, DerivativeOptions, DesignDerivative, ModeUpdate, VariableDerivatives,
 };
@@ -21,9 +21,12 @@ use faer::Mat;
 /// its ply thicknesses moved the mass, its `M` ([`ModalSolver::set_mass`]).
 pub struct ModalSolver {
     pencil: Pencil,
-    /// The independent blocks of the last design with derivatives
-    /// ([`super::blocks`]).
+    /// The independent blocks of `K` ([`super::blocks`]): the
+    /// eigen-solver's shift-invert solves ([`ShiftInvert`]) and the
+    /// derivative systems go block by block.
     blocks: Option<Blocks>,
+    /// `K` or `M` changed since the blocks were found.
+    stale: bool,
 }
 
 impl ModalSolver {
@@ -33,6 +36,7 @@ impl ModalSolver {
         Ok(ModalSolver {
             pencil: Pencil::new(k, mass)?,
             blocks: None,
+            stale: true,
         })
     }
 
@@ -49,16 +53,29 @@ impl ModalSolver {
             // The blocks map entries of the old pattern.
             self.blocks = None;
         }
+        self.stale = true;
         Ok(())
     }
 
     /// Replace the lumped mass (length `n`, every entry finite and > 0):
     /// a new design whose ply thicknesses moved it. `M` is diagonal, so
-    /// the pattern and the symbolic factorization are kept; the blocks of
-    /// the derivatives take it at their next refresh. Errors: as
-    /// [`ModalSolver::new`]'s `mass`; on error the solver is unchanged.
+    /// the pattern and the symbolic factorization are kept; the blocks
+    /// take it at their next refresh. Errors: as [`ModalSolver::new`]'s
+    /// `mass`; on error the solver is unchanged.
     pub fn set_mass(&mut self, mass: &[f64]) -> Result<()> {
-        self.pencil.set_mass(mass)
+        self.pencil.set_mass(mass)?;
+        self.stale = true;
+        Ok(())
+    }
+
+    /// The blocks of the current `K` and `M`, found again only after a
+    /// change.
+    fn fresh_blocks(&mut self) -> Result<()> {
+        if self.stale {
+            Blocks::refresh(&mut self.blocks, &self.pencil)?;
+            self.stale = false;
+        }
+        Ok(())
     }
 
     /// The lumped mass the modes are computed with (length `n`).
@@ -69,7 +86,7 @@ impl ModalSolver {
     /// The `opts.n_modes` lowest modes. Errors: `n_modes` = 0 or > n →
     /// [`Error::Input`]; `K − σM` not positive definite, or no convergence →
     /// [`Error::Numerical`].
-    pub fn solve(&self, opts: &ModalOptions) -> Result<Modes> {
+    pub fn solve(&mut self, opts: &ModalOptions) -> Result<Modes> {
         let n = self.pencil.n();
         let k = opts.n_modes;
         if k == 0 || k > n {
@@ -85,7 +102,8 @@ impl ModalSolver {
             return Err(Error::input("block_size", 0, "at least 1"));
         }
         let t0 = std::time::Instant::now();
-        let mut factor = self.pencil.factor_llt(opts.shift)?;
+        self.fresh_blocks()?;
+        let mut factor = ShiftInvert::new(&self.pencil, self.blocks.as_ref(), opts.shift)?;
         let t1 = std::time::Instant::now();
         let want = (k + 1).min(n);
         let out = lanczos::block_lanczos(&self.pencil, &mut factor, opts, want)?;
@@ -138,7 +156,9 @@ impl ModalSolver {
                 solves: out.solves,
                 restarts: out.restarts,
                 basis: out.basis,
-                factor_nnz: self.pencil.factor_nnz(),
+                factor_nnz: self.blocks.as_ref().map_or(self.pencil.factor_nnz(), |b| {
+                    b.parts.iter().map(|p| p.pencil.factor_nnz()).sum()
+                }),
                 factor_seconds,
                 lanczos_seconds,
             },
@@ -229,9 +249,10 @@ impl ModalSolver {
 
     /// Eigenvalue (and, in the updated-mode approach, eigenvector)
     /// derivatives of `modes` for each design variable; see [`derivatives`].
-    /// Where `K` and the `K'ᵥ` split into independent blocks (e.g. the
-    /// membrane and bending DOFs of a symmetric laminate's flat shell),
-    /// each mode's systems are solved on its block.
+    /// Where `K` splits into independent blocks (e.g. the membrane and
+    /// bending DOFs of a symmetric laminate's flat shell), each mode's
+    /// systems are solved on its block and on the blocks the `K'ᵥ` couple
+    /// to it.
     pub fn derivatives(
         &mut self,
         modes: &Modes,
@@ -239,8 +260,11 @@ impl ModalSolver {
         opts: &DerivativeOptions,
     ) -> Result<Vec<VariableDerivatives>> {
         let blocks = if opts.update == ModeUpdate::Updated {
+            self.fresh_blocks()?;
             let dk: Vec<_> = vars.iter().map(|d| d.dk).collect();
-            Blocks::refresh(&mut self.blocks, &self.pencil, &dk)?;
+            if let Some(b) = self.blocks.as_mut() {
+                b.couple(&dk);
+            }
             self.blocks.as_ref()
         } else {
             None

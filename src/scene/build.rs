@@ -65,9 +65,10 @@ impl SceneSpec {
             geometric_stiffening: self.has(Effect::GeometricStiffening),
             ..Model::default()
         };
-        self.add_bodies(&mut model, panels)?;
+        let (skip, ground) = self.grounded();
+        self.add_bodies(&mut model, panels, &ground)?;
         self.add_markers(&mut model)?;
-        self.add_joints(&mut model)?;
+        self.add_joints(&mut model, &skip)?;
         let force_index = self.add_forces(&mut model)?;
         let options = self.options()?;
         let flex_names: Vec<&str> = self
@@ -134,8 +135,9 @@ impl SceneSpec {
     }
 
     /// Rigid bodies, and flexible ones (with `flexibility`) whose bases
-    /// come from `panels` or the closed-form beam.
-    fn add_bodies(&self, model: &mut Model, panels: PanelBases) -> Result<()> {
+    /// come from `panels` or the closed-form beam; those marked in
+    /// `ground` fixed (`ground` module).
+    fn add_bodies(&self, model: &mut Model, panels: PanelBases, ground: &[bool]) -> Result<()> {
         for (k, b) in self.bodies.iter().enumerate() {
             let key = format!("bodies[{k}]");
             if model.body(&b.name).is_some() || b.name == "ground" {
@@ -189,7 +191,7 @@ impl SceneSpec {
                     Body::new(&key, &b.name, mass, inertia, (com, [1.0, 0.0, 0.0, 0.0]))?
                 }
             };
-            body.fixed = b.fixed;
+            body.fixed = b.fixed || ground[k];
             body.v0 = finite3(format!("{key}.velocity"), b.velocity)?;
             body.w0 = body.orientation().transpose()
                 * finite3(format!("{key}.angular_velocity"), b.angular_velocity)?;
@@ -216,8 +218,9 @@ impl SceneSpec {
         Ok(())
     }
 
-    /// Joints with their two markers each.
-    fn add_joints(&self, model: &mut Model) -> Result<()> {
+    /// Joints with their two markers each, but those marked in `skip`
+    /// (checked, not built: `ground` module).
+    fn add_joints(&self, model: &mut Model, skip: &[bool]) -> Result<()> {
         for (k, j) in self.joints.iter().enumerate() {
             let key = format!("joints[{k}]");
             let bi = find_body(format!("{key}.body_i"), &j.body_i, model)?;
@@ -247,12 +250,15 @@ impl SceneSpec {
             let mj = make_marker(model, &pk, (&format!("{}.j", j.name), bj), point, fj)?;
             model.markers.push(mi);
             model.markers.push(mj);
-            if model.joint(&j.name).is_some() {
+            if self.joints[..k].iter().any(|o| o.name == j.name) {
                 return Err(Error::input(
                     format!("{key}.name"),
                     &j.name,
                     "a unique joint name",
                 ));
+            }
+            if skip[k] {
+                continue;
             }
             model.joints.push(Joint {
                 name: j.name.clone(),

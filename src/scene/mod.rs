@@ -115,6 +115,7 @@
 
 pub mod build;
 pub mod forces;
+mod ground;
 pub mod load;
 pub mod parts;
 pub mod quantity;

@@ -447,7 +447,24 @@ pub(crate) fn compute(
             .map(|s| Adjacent::new(&modes.modes, s, ci, (first, r)))
             .collect();
         let f = right_hand_sides(pencil.mass(), &setups, &adjacent, (first, r));
-        let vsol = on.scatter(sys.solve(&on.gather(f.as_ref(), 0..f.ncols()))?, n);
+        let mut vsol = on.scatter(sys.solve(&on.gather(f.as_ref(), 0..f.ncols()))?, n);
+        if let (Some(b), Some(p)) = (blocks, slot.checked_sub(1)) {
+            for (q, part) in b.parts.iter().enumerate() {
+                if q == p || !b.coupled(p, q) {
+                    continue;
+                }
+                let fq =
+                    Mat::<f64>::from_fn(part.dofs.len(), f.ncols(), |i, j| f[(part.dofs[i], j)]);
+                let (vq, factor) =
+                    system::plain_solve(&part.pencil, sys.lambda_bar, &fq, spares[q + 1].take())?;
+                for j in 0..f.ncols() {
+                    for (i, &d) in part.dofs.iter().enumerate() {
+                        vsol[(d, j)] = vq[(i, j)];
+                    }
+                }
+                spares[q + 1] = Some(factor);
+            }
+        }
         for (v, d) in vars.iter().enumerate() {
             let adj = &adjacent[v];
             let sol = vsol.as_ref().subcols(v * r, r);

@@ -143,6 +143,23 @@ fn refined_solve(
     Ok(x)
 }
 
+/// Solve `(K − λ̄M) X = B` on a pencil of which `λ̄` is not an eigenvalue
+/// (a block that does not hold the cluster, [`crate::modal::blocks`]):
+/// one `LDLᵀ` (reusing the buffers of `spare`) and the refinement of
+/// [`refined_solve`]. Returns the solution and the factorization, to be
+/// handed on as the next spare.
+pub(super) fn plain_solve<'p>(
+    pencil: &'p Pencil,
+    lambda_bar: f64,
+    b: &Mat<f64>,
+    spare: Option<Factor<'p>>,
+) -> Result<(Mat<f64>, Factor<'p>)> {
+    let mut factor = pencil.factor_ldlt(lambda_bar, &[], spare)?;
+    let is_r = vec![false; pencil.n()];
+    let x = refined_solve(pencil, &mut factor, lambda_bar, (&[], &is_r), b)?;
+    Ok((x, factor))
+}
+
 /// Everything about one cluster that does not depend on the variable.
 pub(super) struct ClusterSystem<'p> {
     pencil: &'p Pencil,

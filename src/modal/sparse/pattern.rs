@@ -9,6 +9,7 @@
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
 };
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMat, SymbolicSparseColMatRef};
 use faer::Side;
 
@@ -93,10 +94,14 @@ pub(super) struct Ordered {
 impl Ordered {
     /// AMD ordering of the pattern, the permuted lower pattern and the
     /// symbolic factorization of the permuted pattern.
+    /// `supernodal`: always the supernodal factorization (a block of the
+    /// pencil, [`crate::modal::blocks`]: measured faster there, for the
+    /// Nelson `LDLᵀ`s above all); else faer's choice by flop count.
     pub(super) fn build(
         n: usize,
         col_ptr: &[usize],
         row_idx: &[usize],
+        supernodal: bool,
     ) -> Result<(Self, SymbolicCholesky<usize>)> {
         let err = |e| Error::numerical("modal::Pencil", format!("symbolic factorization: {e:?}"));
         let sym = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx);
@@ -151,7 +156,14 @@ impl Ordered {
             fsym,
             Side::Upper,
             SymmetricOrdering::Identity,
-            CholeskySymbolicParams::default(),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: if supernodal {
+                    SupernodalThreshold::FORCE_SUPERNODAL
+                } else {
+                    SupernodalThreshold::AUTO
+                },
+                ..Default::default()
+            },
         )
         .map_err(err)?;
         Ok((o, symbolic))

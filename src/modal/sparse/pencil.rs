@@ -67,7 +67,7 @@ impl Pencil {
             k_max,
             ..
         } = pat;
-        let (ordered, symbolic) = Ordered::build(n, &col_ptr, &row_idx)?;
+        let (ordered, symbolic) = Ordered::build(n, &col_ptr, &row_idx, false)?;
         let input = InputMap::build(k, &col_ptr, &row_idx).unwrap_or_else(InputMap::empty);
         let mut pencil = Pencil {
             n,
@@ -195,7 +195,7 @@ impl Pencil {
             }
             col_ptr.push(row_idx.len());
         }
-        let (ordered, symbolic) = Ordered::build(nb, &col_ptr, &row_idx)?;
+        let (ordered, symbolic) = Ordered::build(nb, &col_ptr, &row_idx, true)?;
         let mut block = Pencil {
             n: nb,
             col_ptr,

@@ -18,7 +18,7 @@ fn fixed_chain_matches_closed_form() {
     let (n, k, m) = (200, 3.0e4, 0.7);
     let kk = assemble(n, &chain_springs(n, k, 0, true));
     let mass = vec![m; n];
-    let solver = ModalSolver::new(&kk, &mass).unwrap();
+    let mut solver = ModalSolver::new(&kk, &mass).unwrap();
     let modes = solver.solve(&ModalOptions::new(14)).unwrap();
     for (j, &lam) in modes.lambda.iter().enumerate() {
         let jj = (j + 1) as f64;
@@ -50,7 +50,7 @@ fn square_grid_repeated_eigenvalues_closed_form() {
     let n = nx * nx;
     let kk = assemble(n, &grid_springs(nx, nx, k));
     let mass = vec![1.0; n];
-    let solver = ModalSolver::new(&kk, &mass).unwrap();
+    let mut solver = ModalSolver::new(&kk, &mass).unwrap();
     let modes = solver.solve(&ModalOptions::new(12)).unwrap();
     let h = PI / (nx as f64 + 1.0);
     let mut exact = Vec::new();
@@ -129,7 +129,7 @@ fn irregular_grid_residuals_and_dense_reference() {
     let mass: Vec<f64> = (0..n)
         .map(|i| 1.0 + 0.3 * ((i as f64) * 1.37).cos())
         .collect();
-    let solver = ModalSolver::new(&kk, &mass).unwrap();
+    let mut solver = ModalSolver::new(&kk, &mass).unwrap();
     let modes = solver.solve(&ModalOptions::new(14)).unwrap();
     let (lref, _) = dense_eig(&kk, &mass);
     for j in 0..14 {
@@ -175,7 +175,7 @@ fn free_free_chain_with_negative_shift() {
     let (n, k, m) = (60, 10.0, 2.0);
     let kk = assemble(n, &chain_springs(n, k, 0, false));
     let mass = vec![m; n];
-    let solver = ModalSolver::new(&kk, &mass).unwrap();
+    let mut solver = ModalSolver::new(&kk, &mass).unwrap();
     // σ = 0 fails: K is singular (rigid-body mode).
     let mut opts = ModalOptions::new(6);
     assert!(solver.solve(&opts).is_err());
@@ -216,7 +216,7 @@ fn all_modes_of_a_tiny_problem() {
 fn too_many_modes_is_input_error() {
     let n = 8;
     let kk = assemble(n, &chain_springs(n, 1.0, 0, true));
-    let solver = ModalSolver::new(&kk, &vec![1.0; n]).unwrap();
+    let mut solver = ModalSolver::new(&kk, &vec![1.0; n]).unwrap();
     match solver.solve(&ModalOptions::new(9)) {
         Err(Error::Input { key, value, .. }) => {
             assert_eq!(key, "n_modes");
@@ -266,7 +266,7 @@ fn bad_mass_is_input_error() {
 fn factorization_failure_is_numerical_error_with_shift_and_pivot() {
     let n = 50;
     let kk = assemble(n, &chain_springs(n, 1.0, 0, true));
-    let solver = ModalSolver::new(&kk, &vec![1.0; n]).unwrap();
+    let mut solver = ModalSolver::new(&kk, &vec![1.0; n]).unwrap();
     let mut opts = ModalOptions::new(3);
     opts.shift = 0.5; // λ_1 = 2(1 − cos(π/51)) ≈ 3.8e-3 < 0.5
     match solver.solve(&opts) {

@@ -73,7 +73,9 @@ fn measured_noise_of_an_analytic_problem_is_rounding() {
     assert_eq!(noise["allowance"].as_f64(), Some(allowance));
 }
 
-/// `rtol = "auto"` on the coarse SAR problem with the scene at rtol 1e-4:
+/// `rtol = "auto"` on the coarse SAR problem with the scene at rtol 1e-3
+/// (1e-4 was refused before B4 and B12 were grounded, `scene::ground`;
+/// it now meets the target, 4.2e-8):
 /// the tolerance taken is the loosest tried whose noise meets a tenth of
 /// the feasibility tolerance, every looser one tried failed the test, and
 /// the evaluations then run at it.
@@ -83,23 +85,23 @@ fn auto_tolerance_is_the_loosest_that_meets_the_noise_target() {
     use plyscape::explore::problem::scene_problem::SceneProblem;
     use plyscape::optimize::Problem;
     let text =
-        crate::common::sar::replace(&coarse_sar(STUDY, 8, 4), "rtol = 1e-10", "rtol = 1e-4", 1);
+        crate::common::sar::replace(&coarse_sar(STUDY, 8, 4), "rtol = 1e-10", "rtol = 1e-3", 1);
     assert!(text.contains("rtol = \"auto\"") && text.contains("feasibility_tolerance = 1e-6"));
     let s = Study::parse("auto.toml", &text).unwrap();
     let p = SceneProblem::from_study(&s).unwrap();
     let choice = p.accuracy_choice().expect("auto chose");
     assert!(choice.met, "{}", choice.summary());
     assert_eq!(choice.target, 1e-7);
-    assert!(choice.rtol < 1e-4, "{}", choice.summary());
+    assert!(choice.rtol < 1e-3, "{}", choice.summary());
     assert_eq!(p.tolerance(), Some(choice.rtol));
     let (last, looser) = choice.tried.split_last().unwrap();
     assert!(quiet_enough(&last.1, choice.target));
     for (r, m) in looser {
         assert!(!quiet_enough(m, choice.target), "rtol {r} met it already");
     }
-    // atol at the scene's ratio: 1e-12 / 1e-4.
+    // atol at the scene's ratio: 1e-12 / 1e-3.
     let atol = p.tolerances().1;
-    assert!((atol - 1e-8 * choice.rtol).abs() <= 1e-12 * atol, "{atol}");
+    assert!((atol - 1e-9 * choice.rtol).abs() <= 1e-12 * atol, "{atol}");
 }
 
 /// The two words of the accuracy keys: anything else is refused with the

@@ -85,18 +85,18 @@ fn sar_from_55_minus_55_in_16_function_and_5_gradient_calls() {
 /// The study's whole first run, as `plyscape multistart` makes it: the
 /// noise measured at the start (ECNoise, the study's seed 4), MMFD with
 /// that allowance, and the end settled (certificate, polish if needed):
-/// certified converged within 16 f + 5 g in all (issue 38's target; 15 f +
-/// 6 g before the exit at the noise), by the test at the noise: the
-/// decrease the MMFD's curvature model sees left is within the allowance
-/// (3σ of the measured noise). Its f is within that allowance of the best
-/// design known at the same tolerance, 0.9089406489896893: start 3 of
-/// results/sar_optimize/runs.csv as committed before the test at the
-/// noise (commit 0c5fd26; `git show 0c5fd26:results/sar_optimize/runs.csv`),
-/// certified there with a Kuhn–Tucker residual of 4.8e-8 (the same run's
-/// start 0 then ended at 0.9089406489742763, residual 5.0e-6). About 4 s
-/// in release.
+/// certified converged within 15 f + 6 g in all. Issue 38's target was
+/// 16 f + 5 g, met with the scene as it was then by the exit at the noise
+/// (σ_f = 1.87e-8 at the start, MMFD stopped at x4 with 1.75e-8 of decrease
+/// left). Since B4 and B12, locked to the fixed satellite, are built fixed
+/// (`scene::ground`), the start's noise is 2.2e-9: the exit at the noise
+/// no longer fires at x4, and MMFD takes one more step, to a Kuhn–Tucker
+/// residual of 5.0e-6 (21 calls either way). Its f is within the noise
+/// allowance of the study's start 3, which reaches the same optimum from
+/// elsewhere: 0.9089405754985072 (residual 1.2e-4; results/sar_optimize/
+/// runs.csv as committed with the grounding). About 4 s in release.
 #[test]
-fn sar_first_run_is_certified_at_the_noise_in_16_f_and_5_g() {
+fn sar_first_run_is_certified_in_15_f_and_6_g() {
     use plyscape::explore::local::settle::{settle, EndPolicy};
     use plyscape::optimize::kkt::{EndClass, KktTolerances};
     use plyscape::optimize::noise::{estimate, NoiseOptions};
@@ -123,13 +123,11 @@ fn sar_first_run_is_certified_at_the_noise_in_16_f_and_5_g() {
     let (o, c) = (&s.outcome, s.certificate.as_ref().unwrap());
     println!("SAR run 0: {o:?}\n{c:?}\n{}", s.note());
     assert_eq!(c.class, EndClass::Converged, "{c:?}");
-    assert!(o.function_calls <= 16 && o.gradient_calls <= 5, "{o:?}");
-    let best = 0.9089406489896893;
-    assert!((o.f - best).abs() <= noise * best.max(1.0), "{o:?}");
-    assert!(
-        c.at_noise.is_some() && c.decrease_left.unwrap() <= noise,
-        "{c:?}"
-    );
+    assert!(o.function_calls <= 15 && o.gradient_calls <= 6, "{o:?}");
+    let start3 = 0.9089405754985072;
+    assert!((o.f - start3).abs() <= noise * start3.max(1.0), "{o:?}");
+    assert!(c.kt_residual.unwrap() <= 1e-5, "{c:?}");
+    assert!(c.decrease_left.unwrap() <= noise, "{c:?}");
 }
 
 /// The restoration on a violation with many local minima
