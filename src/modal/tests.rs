@@ -52,14 +52,17 @@ fn alpha(e: usize, c: usize) -> f64 {
     0.6 * ((e as f64) * 0.83 + 2.0 * c as f64).cos()
 }
 
-/// The block path and the full path solve the same systems (each
-/// derivative is exact on its block: the pencil is block diagonal), so
-/// they agree to the solves' accuracy; modes of both chains occur.
-#[test]
-fn blocks_give_the_full_pencils_derivatives() {
+/// Two interleaved chains (`K` uncoupled) with the design derivative `K'`
+/// coupling their first DOFs by `couple`: the eigenvector derivatives of
+/// the 10 lowest modes on the full pencil and block by block, with the
+/// block holding each mode. Asserts that the blocks are the chains, that
+/// modes of both occur, and that the two paths agree to the solves'
+/// accuracy (1e-9 of the largest entry); returns the block path's
+/// derivatives, the holding blocks and that largest entry.
+fn block_and_full_derivatives(couple: f64) -> (Mat<f64>, Vec<usize>, f64) {
     let (m, p) = (30, 0.3);
     let k = chains(m, 0.0, |e, c| stiffness(e, c) * (1.0 + alpha(e, c) * p));
-    let dk = chains(m, 0.0, |e, c| stiffness(e, c) * alpha(e, c));
+    let dk = chains(m, couple, |e, c| stiffness(e, c) * alpha(e, c));
     let mass: Vec<f64> = (0..2 * m)
         .map(|i| 1.0 + 0.3 * ((i as f64) * 0.7).sin())
         .collect();
@@ -71,7 +74,7 @@ fn blocks_give_the_full_pencils_derivatives() {
     Blocks::refresh(&mut blocks, &pencil).unwrap();
     let mut b = blocks.expect("two chains: two blocks");
     b.couple(&[&dk]);
-    assert!(!b.coupled(0, 1));
+    assert_eq!(b.coupled(0, 1), couple != 0.0);
     assert_eq!(b.parts.len(), 2);
     for (c, part) in b.parts.iter().enumerate() {
         assert!(part.dofs.iter().all(|d| d % 2 == c));
@@ -104,11 +107,40 @@ fn blocks_give_the_full_pencils_derivatives() {
         for i in 0..2 * m {
             let d = (xf[(i, j)] - xs[(i, j)]).abs();
             assert!(d <= 1e-9 * scale, "mode {j} dof {i}: {d:e} of {scale:e}");
-            if i % 2 != held[j] {
-                assert_eq!(xs[(i, j)], 0.0);
-            }
         }
     }
+    (xs.clone(), held, scale)
+}
+
+/// The block path and the full path solve the same systems (each
+/// derivative is exact on its block: the pencil is block diagonal), so
+/// they agree to the solves' accuracy, and each derivative is zero off
+/// its mode's block.
+#[test]
+fn blocks_give_the_full_pencils_derivatives() {
+    let (xs, held, _) = block_and_full_derivatives(0.0);
+    for (j, &h) in held.iter().enumerate() {
+        for i in (0..xs.nrows()).filter(|i| i % 2 != h) {
+            assert_eq!(xs[(i, j)], 0.0);
+        }
+    }
+}
+
+/// A K' that couples the blocks of a block-diagonal K (one ply of a
+/// symmetric stack: membrane–bending coupling in K' only): each mode's
+/// derivative is solved by Nelson's method on its block and by a plain
+/// solve on the other, and agrees with the full pencil's, including the
+/// part on the other block, which is not zero.
+#[test]
+fn coupled_derivatives_on_blocks_match_the_full_pencil() {
+    let (xs, held, scale) = block_and_full_derivatives(40.0);
+    let mut off_block = 0.0f64;
+    for (j, &h) in held.iter().enumerate() {
+        for i in (0..xs.nrows()).filter(|i| i % 2 != h) {
+            off_block = off_block.max(xs[(i, j)].abs());
+        }
+    }
+    assert!(off_block > 1e-3 * scale, "{off_block:e} of {scale:e}");
 }
 
 /// A non-zero coupling in K joins the blocks, one in a K' couples them;
@@ -138,60 +170,6 @@ fn coupling_joins_blocks_and_mixed_vectors_have_no_block() {
     let pencil = Pencil::new(&k1, &mass).unwrap();
     Blocks::refresh(&mut blocks, &pencil).unwrap();
     assert!(blocks.is_none(), "K couples the chains");
-}
-
-/// A K' that couples the blocks of a block-diagonal K (one ply of a
-/// symmetric stack: membrane–bending coupling in K' only): each mode's
-/// derivative is solved by Nelson's method on its block and by a plain
-/// solve on the other, and agrees with the full pencil's, including the
-/// part on the other block, which is not zero.
-#[test]
-fn coupled_derivatives_on_blocks_match_the_full_pencil() {
-    let (m, p) = (30, 0.3);
-    let k = chains(m, 0.0, |e, c| stiffness(e, c) * (1.0 + alpha(e, c) * p));
-    let dk = chains(m, 40.0, |e, c| stiffness(e, c) * alpha(e, c));
-    let mass: Vec<f64> = (0..2 * m)
-        .map(|i| 1.0 + 0.3 * ((i as f64) * 0.7).sin())
-        .collect();
-    let mut opts = ModalOptions::new(10);
-    opts.tol = 1e-12;
-    let modes = ModalSolver::new(&k, &mass).unwrap().solve(&opts).unwrap();
-    let pencil = Pencil::new(&k, &mass).unwrap();
-    let mut blocks = None;
-    Blocks::refresh(&mut blocks, &pencil).unwrap();
-    let mut b = blocks.expect("K splits");
-    b.couple(&[&dk]);
-    assert!(b.coupled(0, 1));
-    let var = [DesignDerivative {
-        dk: &dk,
-        d2k: None,
-        mass: None,
-    }];
-    let o = DerivativeOptions::default();
-    let full = compute(&pencil, None, &modes, &var, &o).unwrap();
-    let split = compute(&pencil, Some(&b), &modes, &var, &o).unwrap();
-    let (xf, xs) = (
-        full[0].dmodes.as_ref().unwrap(),
-        split[0].dmodes.as_ref().unwrap(),
-    );
-    let scale = (0..10)
-        .flat_map(|j| (0..2 * m).map(move |i| (i, j)))
-        .fold(0.0f64, |a, (i, j)| a.max(xf[(i, j)].abs()));
-    let mut off_block = 0.0f64;
-    for j in 0..10 {
-        let held = b
-            .holding(modes.modes.as_ref().subcols(j, 1), &mass)
-            .unwrap();
-        assert!((full[0].dlambda[j] - split[0].dlambda[j]).abs() <= 1e-12 * scale.max(1.0));
-        for i in 0..2 * m {
-            let d = (xf[(i, j)] - xs[(i, j)]).abs();
-            assert!(d <= 1e-9 * scale, "mode {j} dof {i}: {d:e} of {scale:e}");
-            if i % 2 != held {
-                off_block = off_block.max(xs[(i, j)].abs());
-            }
-        }
-    }
-    assert!(off_block > 1e-3 * scale, "{off_block:e} of {scale:e}");
 }
 
 /// A stiffness with another stored pattern but the same partition (an
