@@ -70,6 +70,11 @@
 //!                      level = 1.2; direction = "up"          # crossing (time in s)
 //!                      mode = 1                               # frequency of of = ["B3"] (Hz)
 //! ```
+//! A rigid body locked (`type = "locked"`) to a fixed body or to the
+//! ground, directly or through other such bodies, is built as a fixed body
+//! without its lock, unless the study reads it or its lock (`ground`
+//! module): it never moves, so integrating it would only cost time.
+//!
 //! Rigid bodies start with their axes along the global axes, so `inertia`
 //! is both the global and the body-frame tensor at `t = 0`. A flexible
 //! body's frame is its basis frame (the beam's root, the panel's centre),
