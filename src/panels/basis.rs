@@ -217,6 +217,46 @@ impl BasisBuilder {
         mesh_joint_nodes(&self.analysis.panel.mesh, &self.points)
     }
 
+    /// The basis of a body at rest (the scene's `ground` module): the
+    /// panel's nodes and lumped masses for `laminate`, no modes, and,
+    /// when the builder computes derivatives, one empty derivative per
+    /// design variable (their names resolve the study's sensitivity
+    /// lanes, which are then zero). No eigen-analysis is done.
+    pub fn rest_basis(&mut self, laminate: &Laminate) -> Result<ModalBasis> {
+        let frame = self.analysis.rigid_frame(laminate)?;
+        let derivatives = match self.update {
+            Some(_) => (self.analysis.variable_names().into_iter())
+                .map(|name| BasisDerivative::modal(name, Vec::new(), Vec::new()))
+                .collect(),
+            None => Vec::new(),
+        };
+        Ok(ModalBasis {
+            nodes: self.nodes(),
+            node_mass: frame.mass().to_vec(),
+            node_inertia: frame.inertia().to_vec(),
+            n_modes: 0,
+            shapes: Vec::new(),
+            eigenvalues: Vec::new(),
+            derivatives,
+            rigid: RigidScreen {
+                content: Vec::new(),
+                dropped: Vec::new(),
+                limit: 1.0,
+                split: None,
+            },
+            geometric: None,
+        })
+    }
+
+    /// The mesh nodes in the panel frame (m, `z = 0`).
+    fn nodes(&self) -> Vec<Vector3<f64>> {
+        let nodes = &self.analysis.panel.mesh.nodes;
+        nodes
+            .iter()
+            .map(|p| Vector3::new(p[0], p[1], 0.0))
+            .collect()
+    }
+
     /// The basis of the panel with lay-up `laminate` (same ply count as the
     /// panel's, angles in rad) and its `n_modes` lowest elastic modes.
     /// Errors: `n_modes` = 0 or more than the free DOFs → [`Error::Input`];
@@ -322,16 +362,8 @@ impl BasisBuilder {
             }
             derivatives.push(bd);
         }
-        let nodes = self
-            .analysis
-            .panel
-            .mesh
-            .nodes
-            .iter()
-            .map(|p| Vector3::new(p[0], p[1], 0.0))
-            .collect();
         Ok(ModalBasis {
-            nodes,
+            nodes: self.nodes(),
             node_mass: lumped.mass,
             node_inertia: lumped.inertia,
             n_modes: n,
@@ -513,19 +545,41 @@ pub fn basis_for_study_thickness(
     if n_modes == 0 {
         return Err(Error::input("n_modes", 0, "at least 1 mode"));
     }
-    let panels = crate::fe::panels_from_study(study)?;
-    let Some(i) = panels.iter().position(|p| p.name == name) else {
-        return Err(unknown_panel(study, name, &panels));
-    };
-    let panel = &panels[i];
-    let basis = || {
+    with_study_panel(study, name, |panel| {
         let mut builder = BasisBuilder::new(panel, derivatives)?;
         builder.set_thickness(thickness)?;
         builder.set_geometric(geometric.is_some());
         builder.set_joint_points(geometric.unwrap_or(&[]));
         builder.basis(&panel.laminate, n_modes)
+    })
+}
+
+/// The basis of a body at rest built from the study's panel `name`
+/// ([`BasisBuilder::rest_basis`]: nodes and masses, no modes; errors as
+/// [`basis_for_study`]).
+pub fn rest_basis_for_study(
+    study: &Study,
+    name: &str,
+    derivatives: Option<ModeUpdate>,
+) -> Result<ModalBasis> {
+    with_study_panel(study, name, |panel| {
+        BasisBuilder::new(panel, derivatives)?.rest_basis(&panel.laminate)
+    })
+}
+
+/// `make` for the study's panel `name`, its errors located in the
+/// panel's entry; an unknown name is [`unknown_panel`].
+fn with_study_panel(
+    study: &Study,
+    name: &str,
+    make: impl FnOnce(&Panel) -> Result<ModalBasis>,
+) -> Result<ModalBasis> {
+    let panels = crate::fe::panels_from_study(study)?;
+    let Some(i) = panels.iter().position(|p| p.name == name) else {
+        return Err(unknown_panel(study, name, &panels));
     };
-    basis()
+    let panel = &panels[i];
+    make(panel)
         .map_err(|e| in_panel(e, &panel.name))
         .map_err(|e| e.in_file(&study.path, &format!("panels[{i}]")))
 }

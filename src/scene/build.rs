@@ -172,7 +172,7 @@ impl SceneSpec {
                             self.has(Effect::GeometricStiffening),
                         ),
                         &joints,
-                        panels,
+                        (panels, ground[k]),
                     )?
                 }
                 _ => {

@@ -37,7 +37,7 @@ use std::time::Instant;
 /// the wall time spent in them and in the whole build.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct BuildProfile {
-    /// Panel modal bases computed.
+    /// Panel modal bases computed (a body at rest takes none).
     pub bases: usize,
     /// Of those, bases with mode derivatives (dΛ/dθ, dX/dθ).
     pub derivative_bases: usize,
@@ -60,6 +60,10 @@ pub fn load_scene(study: &Study) -> Result<Scene> {
     let mut spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
     spec.prune_derivatives();
     let panels = |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: Stiffening| {
+        if modes == 0 {
+            // A body at rest (`ground` module).
+            return crate::panels::basis::rest_basis_for_study(study, name, update);
+        }
         let thickness = spec.thickness_variables(name);
         crate::panels::basis_for_study_thickness(
             study,
@@ -233,8 +237,10 @@ impl ScenePlan {
                     None => {
                         let basis =
                             self.basis(name, modes, (update, geometric), (laminates, &thickness));
-                        p.bases += 1;
-                        p.derivative_bases += usize::from(update.is_some());
+                        // A body at rest takes no eigen-analysis (modes = 0).
+                        let computed = usize::from(modes > 0);
+                        p.bases += computed;
+                        p.derivative_bases += computed * usize::from(update.is_some());
                         if let (Some(k), Ok(b)) = (key, &basis) {
                             shared.borrow_mut().keep(k, b);
                         }
@@ -282,9 +288,6 @@ impl ScenePlan {
         (update, geometric): (Option<ModeUpdate>, Stiffening),
         (laminates, thickness): (&[Laminate], &[String]),
     ) -> Result<ModalBasis> {
-        if modes == 0 {
-            return Err(Error::input("n_modes", 0, "at least 1 mode"));
-        }
         let Some(i) = self.panels.iter().position(|p| p.name == name) else {
             return Err(crate::panels::unknown_panel(
                 &self.study,
@@ -311,6 +314,7 @@ impl ScenePlan {
         prepared.builder.set_geometric(geometric.is_some());
         prepared.builder.set_joint_points(geometric.unwrap_or(&[]));
         let basis = match prepared.builder.set_thickness(thickness) {
+            Ok(()) if modes == 0 => prepared.builder.rest_basis(&laminates[i]),
             Ok(()) => prepared.builder.basis(&laminates[i], modes),
             Err(e) => Err(e),
         }

@@ -73,7 +73,11 @@
 //! A rigid body locked (`type = "locked"`) to a fixed body or to the
 //! ground, directly or through other such bodies, is built as a fixed body
 //! without its lock, unless the study reads it or its lock (`ground`
-//! module): it never moves, so integrating it would only cost time.
+//! module): it never moves, so integrating it would only cost time. So is
+//! a group of bodies joined to each other and to fixed bodies that starts
+//! at rest with no force, drive or gravity acting on it (a flexible one
+//! without modes, and no eigen-analysis), unless the study reads more of
+//! it than its energies, positions, masses and ply-angle sensitivities.
 //!
 //! Rigid bodies start with their axes along the global axes, so `inertia`
 //! is both the global and the body-frame tensor at `t = 0`. A flexible

@@ -18,6 +18,8 @@ use nalgebra::{Matrix3, Vector3};
 /// stiffness of the inertial load cases when `geometric` is given (the
 /// scene's `geometric_stiffening`) and the point-force cases at the
 /// panel-frame joint points it lists; errors name the study's keys.
+/// `modes = 0` asks for the basis of a body at rest (the `ground`
+/// module): nodes and lumped masses, no eigen-analysis.
 pub type PanelBases<'a> =
     &'a dyn Fn(&str, usize, Option<ModeUpdate>, Stiffening) -> Result<ModalBasis>;
 
@@ -340,7 +342,7 @@ pub(super) fn flexible_body(
     f: &FlexSpec,
     (damping, geometric): (bool, bool),
     joints: &[Vector3<f64>],
-    panels: PanelBases,
+    (panels, rest): (PanelBases, bool),
 ) -> Result<Body> {
     let fk = format!("{key}.flexible");
     if f.modes == 0 {
@@ -398,20 +400,26 @@ pub(super) fn flexible_body(
                     "a rigid-body content share in (0, 1] (1 keeps every mode)",
                 ));
             }
-            panels(
-                panel,
-                f.modes,
-                f.derivatives,
-                geometric.then_some(&local[..]),
-            )
-            .map_err(|e| match e {
-                // The mode count is this body's key, not the panel's.
-                Error::Input { key, expected, .. } if key.ends_with("n_modes") => {
-                    Error::input(format!("{fk}.modes"), f.modes, expected)
-                }
-                e => e,
-            })?
-            .screened(limit)?
+            // A body at rest (`ground` module) takes a basis without
+            // modes: its nodes and masses, no eigen-analysis.
+            let (modes, geometric) = if rest {
+                (0, false)
+            } else {
+                (f.modes, geometric)
+            };
+            let basis = panels(panel, modes, f.derivatives, geometric.then_some(&local[..]))
+                .map_err(|e| match e {
+                    // The mode count is this body's key, not the panel's.
+                    Error::Input { key, expected, .. } if key.ends_with("n_modes") => {
+                        Error::input(format!("{fk}.modes"), f.modes, expected)
+                    }
+                    e => e,
+                })?;
+            if rest {
+                basis
+            } else {
+                basis.screened(limit)?
+            }
         }
     };
     basis.validate(&fk)?;

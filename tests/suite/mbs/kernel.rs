@@ -103,12 +103,12 @@ fn mass_and_state_directions_match_central_differences() {
 
 #[test]
 fn perturbed_positions_are_projected_and_reported() {
-    // Move panel B2 by 1 mm and rotate B8 slightly: the projection restores
+    // Move panel B3 by 1 mm and rotate B8 slightly: the projection restores
     // the joints and reports the correction (mass-weighted minimum norm).
     let sys = sar_system();
     let mut y = sys.initial_state();
-    let s2 = sys.slot[sys.model.body("B2").unwrap()].unwrap();
-    y[sys.pos_off(s2)] += 1e-3;
+    let s3 = sys.slot[sys.model.body("B3").unwrap()].unwrap();
+    y[sys.pos_off(s3)] += 1e-3;
     let s8 = sys.slot[sys.model.body("B8").unwrap()].unwrap();
     y[sys.pos_off(s8) + 4] += 1e-3;
     let p = sys.project(0.0, &mut y).unwrap();

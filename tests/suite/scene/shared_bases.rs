@@ -18,12 +18,31 @@ const P2: &str =
     "[[0.153, -0.55], [0.153, 0.55], [0.853, 0.0], [-0.697, -0.55], [-0.697, 0.0], [-0.697, 0.55]]";
 const P3: &str = "[[0.797, 0.45], [-0.797, 0.45], [0.797, -0.45], [-0.797, -0.45]]";
 
+/// The coarse study with a constant load of 0.5 N along z on panel 2:
+/// without a force panel 2 stays at rest in this scene and is built fixed
+/// without modes (`scene::ground`), so nothing would be shared.
+fn coarse() -> String {
+    let t = replace(
+        &coarse_sar(STUDY, 8, 4),
+        "effects = [\"actuators\", \"damping\"",
+        "effects = [\"actuators\", \"loads\", \"damping\"",
+        1,
+    );
+    replace(
+        &t,
+        "\n[scene.integrator]",
+        "\n[[scene.forces]]\ntype = \"load\"\nbody = \"B2\"\nframe = \"global\"\n\
+         force = [0.0, 0.0, 0.5]\n\n[scene.integrator]",
+        1,
+    )
+}
+
 /// The coarse study with both panels' attachment points the union of the
 /// shipped two sets (panel 2: its own first; panel 3: its own first).
 fn same_mesh() -> String {
     let union = |a: &str, b: &str| format!("{}, {}", &a[..a.len() - 1], &b[1..]);
     let t = replace(
-        &coarse_sar(STUDY, 8, 4),
+        &coarse(),
         &format!("attachment_points = {P2}"),
         &format!("attachment_points = {}", union(P2, P3)),
         1,
@@ -130,7 +149,7 @@ fn a_different_angle_mode_count_or_mesh_is_not_shared() {
     );
     assert_eq!(counts(&build(&self::plan(&five), None, true).1), [2, 2, 0]);
     // The shipped attachment points: two meshes.
-    let shipped = self::plan(&coarse_sar(STUDY, 8, 4));
+    let shipped = self::plan(&coarse());
     assert_eq!(counts(&build(&shipped, None, false).1), [2, 0, 0]);
 }
 

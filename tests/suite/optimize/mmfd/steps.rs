@@ -85,18 +85,21 @@ fn sar_from_55_minus_55_in_16_function_and_5_gradient_calls() {
 /// The study's whole first run, as `plyscape multistart` makes it: the
 /// noise measured at the start (ECNoise, the study's seed 4), MMFD with
 /// that allowance, and the end settled (certificate, polish if needed):
-/// certified converged within 15 f + 6 g in all. Issue 38's target was
-/// 16 f + 5 g, met with the scene as it was then by the exit at the noise
-/// (σ_f = 1.87e-8 at the start, MMFD stopped at x4 with 1.75e-8 of decrease
-/// left). Since B4 and B12, locked to the fixed satellite, are built fixed
-/// (`scene::ground`), the start's noise is 2.2e-9: the exit at the noise
-/// no longer fires at x4, and MMFD takes one more step, to a Kuhn–Tucker
-/// residual of 5.0e-6 (21 calls either way). Its f is within the noise
-/// allowance of the study's start 3, which reaches the same optimum from
-/// elsewhere: 0.9089405754985072 (residual 1.2e-4; results/sar_optimize/
-/// runs.csv as committed with the grounding). About 4 s in release.
+/// certified converged within 13 f + 5 g in all. Issue 38's target was
+/// 16 f + 5 g. History: with the scene of issue 38 MMFD stopped at the
+/// noise at x4 (σ_f = 1.87e-8 at the start); once B4 and B12, locked to
+/// the fixed satellite, were built fixed the noise was 2.2e-9 and MMFD
+/// took one more step, to a Kuhn–Tucker residual of 5.0e-6 (15 f + 6 g).
+/// Since panel 2's group, which stays at rest, is built fixed too
+/// (`scene::ground`), the start's noise is 9.1e-9 and MMFD stops at the
+/// noise at x4 again: 1.72e-8 of decrease left against an allowance of
+/// 2.74e-8 (Kuhn–Tucker residual 1.4e-3, which the exit at the noise does
+/// not need). Its f is within the noise allowance of the study's start
+/// 3, which reaches the same optimum from elsewhere: 0.9089401593497987
+/// (residual 1.2e-4; results/sar_optimize/runs.csv as committed with
+/// the bodies at rest). About 2 s in release.
 #[test]
-fn sar_first_run_is_certified_in_15_f_and_6_g() {
+fn sar_first_run_is_certified_in_13_f_and_5_g() {
     use plyscape::explore::local::settle::{settle, EndPolicy};
     use plyscape::optimize::kkt::{EndClass, KktTolerances};
     use plyscape::optimize::noise::{estimate, NoiseOptions};
@@ -123,10 +126,9 @@ fn sar_first_run_is_certified_in_15_f_and_6_g() {
     let (o, c) = (&s.outcome, s.certificate.as_ref().unwrap());
     println!("SAR run 0: {o:?}\n{c:?}\n{}", s.note());
     assert_eq!(c.class, EndClass::Converged, "{c:?}");
-    assert!(o.function_calls <= 15 && o.gradient_calls <= 6, "{o:?}");
-    let start3 = 0.9089405754985072;
+    assert!(o.function_calls <= 13 && o.gradient_calls <= 5, "{o:?}");
+    let start3 = 0.9089401593497987;
     assert!((o.f - start3).abs() <= noise * start3.max(1.0), "{o:?}");
-    assert!(c.kt_residual.unwrap() <= 1e-5, "{c:?}");
     assert!(c.decrease_left.unwrap() <= noise, "{c:?}");
 }
 
