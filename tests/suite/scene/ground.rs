@@ -171,6 +171,14 @@ fn a_group_at_rest_is_built_fixed_and_the_rest_moves_alike() {
         assert_eq!(ra[2], 0.0);
         assert!(rb[2].abs() < 1e-20, "t = {t}: U = {:e}", rb[2]);
     }
+    // A sensitivity to the strut's mass leaves the group fixed: the
+    // derivatives of the bob's angle and of the beam's strain energy are
+    // exactly 0 (the mass of a body at rest moves nothing).
+    let sens = idle.replace("[scene]\n", "[scene]\nsensitivities = [\"strut.mass\"]\n");
+    assert_eq!(fixed_bodies(&sens), ["idle", "strut"]);
+    let s = run(&sens);
+    assert!(!s.sens_rows.is_empty() && s.sens_headers.len() > 1);
+    assert!(s.sens_rows.iter().all(|r| r[1..].iter().all(|&v| v == 0.0)));
     // Anything that could move the group keeps it built: a load on the
     // strut, an initial velocity, gravity, a reading of its modes.
     let load = idle_group(
