@@ -344,7 +344,7 @@ impl PanelAnalysis {
 
     /// The design variables' names: a `theta_<plies>` per ply group, then,
     /// with derivatives, a `thickness_<plies>` per thickness group.
-    pub(super) fn variable_names(&self) -> Vec<String> {
+    fn variable_names(&self) -> Vec<String> {
         let mut variables: Vec<String> = self
             .panel
             .design
@@ -360,10 +360,7 @@ impl PanelAnalysis {
 
     /// The panel's rigid frame for `laminate`, reused while the laminate's
     /// mass and rotary inertia per area stay the same.
-    pub(super) fn rigid_frame(
-        &mut self,
-        laminate: &crate::laminate::Laminate,
-    ) -> Result<RigidFrame> {
+    fn rigid_frame(&mut self, laminate: &crate::laminate::Laminate) -> Result<RigidFrame> {
         let key = [laminate.mass_per_area(), laminate.rotary_inertia_per_area()];
         Ok(match &self.frame {
             Some((k, f)) if *k == key => f.clone(),

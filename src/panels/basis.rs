@@ -135,7 +135,7 @@
 //! `dλ` are the eigenvalues of `X_CᵀK'X_C` (the one-sided derivatives of
 //! the sorted eigenvalues).
 
-use super::analysis::{in_panel, PanelAnalysis};
+use super::analysis::{group_name, in_panel, PanelAnalysis};
 use super::rigid::RigidFrame;
 use crate::error::{Error, Result};
 use crate::fe::{Panel, NODE_DOF};
@@ -215,46 +215,6 @@ impl BasisBuilder {
     /// The distinct mesh nodes at the joint points ([`mesh_joint_nodes`]).
     fn joint_nodes(&self) -> Vec<usize> {
         mesh_joint_nodes(&self.analysis.panel.mesh, &self.points)
-    }
-
-    /// The basis of a body at rest (the scene's `ground` module): the
-    /// panel's nodes and lumped masses for `laminate`, no modes, and,
-    /// when the builder computes derivatives, one empty derivative per
-    /// design variable (their names resolve the study's sensitivity
-    /// lanes, which are then zero). No eigen-analysis is done.
-    pub fn rest_basis(&mut self, laminate: &Laminate) -> Result<ModalBasis> {
-        let frame = self.analysis.rigid_frame(laminate)?;
-        let derivatives = match self.update {
-            Some(_) => (self.analysis.variable_names().into_iter())
-                .map(|name| BasisDerivative::modal(name, Vec::new(), Vec::new()))
-                .collect(),
-            None => Vec::new(),
-        };
-        Ok(ModalBasis {
-            nodes: self.nodes(),
-            node_mass: frame.mass().to_vec(),
-            node_inertia: frame.inertia().to_vec(),
-            n_modes: 0,
-            shapes: Vec::new(),
-            eigenvalues: Vec::new(),
-            derivatives,
-            rigid: RigidScreen {
-                content: Vec::new(),
-                dropped: Vec::new(),
-                limit: 1.0,
-                split: None,
-            },
-            geometric: None,
-        })
-    }
-
-    /// The mesh nodes in the panel frame (m, `z = 0`).
-    fn nodes(&self) -> Vec<Vector3<f64>> {
-        let nodes = &self.analysis.panel.mesh.nodes;
-        nodes
-            .iter()
-            .map(|p| Vector3::new(p[0], p[1], 0.0))
-            .collect()
     }
 
     /// The basis of the panel with lay-up `laminate` (same ply count as the
@@ -363,7 +323,7 @@ impl BasisBuilder {
             derivatives.push(bd);
         }
         Ok(ModalBasis {
-            nodes: self.nodes(),
+            nodes: panel_nodes(&self.analysis.panel),
             node_mass: lumped.mass,
             node_inertia: lumped.inertia,
             n_modes: n,
@@ -401,6 +361,59 @@ impl BasisBuilder {
         }
         Ok(NodeMasses { mass, inertia })
     }
+}
+
+/// The basis of a body at rest built from `panel` (the scene's `ground`
+/// module): the panel's nodes and HRZ lumped masses for `laminate`, no
+/// modes, and, when `derivatives` is given, one empty derivative per
+/// design variable, the ply-angle groups' and then the thickness
+/// variables `thickness` (names as [`BasisBuilder::set_thickness`]): their
+/// names resolve the study's sensitivity lanes, whose values are then
+/// zero. Neither `K` nor `M` is assembled and no eigen-analysis is done.
+/// Errors: a bad thickness name (key `thickness`), the rigid frame's.
+pub fn rest_basis(
+    panel: &Panel,
+    laminate: &Laminate,
+    (derivatives, thickness): (Option<ModeUpdate>, &[String]),
+) -> Result<ModalBasis> {
+    let frame = RigidFrame::of_panel(panel, laminate)?;
+    let n = panel.laminate.plies().len();
+    let thickness = thickness
+        .iter()
+        .map(|name| Ok(group_name("thickness", &thickness_group(name, n)?)))
+        .collect::<Result<Vec<_>>>()?;
+    let names = (panel.design.groups().iter())
+        .map(|g| group_name("theta", g))
+        .chain(thickness);
+    let derivatives = match derivatives {
+        Some(_) => names
+            .map(|name| BasisDerivative::modal(name, Vec::new(), Vec::new()))
+            .collect(),
+        None => Vec::new(),
+    };
+    Ok(ModalBasis {
+        nodes: panel_nodes(panel),
+        node_mass: frame.mass().to_vec(),
+        node_inertia: frame.inertia().to_vec(),
+        n_modes: 0,
+        shapes: Vec::new(),
+        eigenvalues: Vec::new(),
+        derivatives,
+        rigid: RigidScreen {
+            content: Vec::new(),
+            dropped: Vec::new(),
+            limit: 1.0,
+            split: None,
+        },
+        geometric: None,
+    })
+}
+
+/// The mesh nodes of `panel` in its frame (m, `z = 0`).
+fn panel_nodes(panel: &Panel) -> Vec<Vector3<f64>> {
+    (panel.mesh.nodes.iter())
+        .map(|p| Vector3::new(p[0], p[1], 0.0))
+        .collect()
 }
 
 /// The distinct nodes of `mesh` at the panel-frame points `points`, in
@@ -555,15 +568,15 @@ pub fn basis_for_study_thickness(
 }
 
 /// The basis of a body at rest built from the study's panel `name`
-/// ([`BasisBuilder::rest_basis`]: nodes and masses, no modes; errors as
+/// ([`rest_basis`]: nodes and masses, no modes; errors as
 /// [`basis_for_study`]).
 pub fn rest_basis_for_study(
     study: &Study,
     name: &str,
-    derivatives: Option<ModeUpdate>,
+    variables: (Option<ModeUpdate>, &[String]),
 ) -> Result<ModalBasis> {
     with_study_panel(study, name, |panel| {
-        BasisBuilder::new(panel, derivatives)?.rest_basis(&panel.laminate)
+        rest_basis(panel, &panel.laminate, variables)
     })
 }
 

@@ -66,14 +66,12 @@ impl SceneSpec {
     pub(super) fn grounded(&self) -> (Vec<bool>, Vec<bool>) {
         let (mut skip, mut ground) = self.locked_to_ground();
         let rest = self.at_rest(&skip, &ground);
-        for (k, j) in self.joints.iter().enumerate() {
-            let on = |name: &str| self.bodies.iter().position(|b| b.name == name);
-            if [&j.body_i, &j.body_j]
-                .iter()
-                .any(|b| on(b).is_some_and(|b| rest[b]))
-            {
-                skip[k] = true;
-            }
+        let resting: HashSet<&str> = (self.bodies.iter().zip(&rest))
+            .filter(|&(_, &r)| r)
+            .map(|(b, _)| b.name.as_str())
+            .collect();
+        for (s, j) in skip.iter_mut().zip(&self.joints) {
+            *s |= resting.contains(j.body_i.as_str()) || resting.contains(j.body_j.as_str());
         }
         for (g, r) in ground.iter_mut().zip(&rest) {
             *g |= r;
@@ -137,16 +135,9 @@ impl SceneSpec {
     /// sensitivities (each term of a tied lane), the joints of forces and
     /// the bodies of loads (or of their markers).
     fn names_read(&self) -> HashSet<&str> {
-        fn head(s: &str) -> impl Iterator<Item = &str> {
-            s.split('+')
-                .map(|t| t.trim().split('.').next().unwrap_or(""))
-        }
-        let mut read = HashSet::new();
-        let outputs = self.outputs.quantities.iter().chain(&self.outputs.plot);
-        let responses = self.responses.iter().flat_map(|r| r.of.iter());
-        for s in outputs.chain(responses).chain(&self.sensitivities) {
-            read.extend(head(s));
-        }
+        let mut read: HashSet<&str> = (self.reads())
+            .map(|t| t.split('.').next().unwrap_or(""))
+            .collect();
         for f in &self.forces {
             let (joint, body) = match f {
                 ForceSpec::Actuator { joint, .. } => (Some(joint), None),
@@ -176,7 +167,6 @@ impl SceneSpec {
         if self.has(Effect::Gravity) || index.is_empty() {
             return vec![false; n];
         }
-        let live = |k: usize| !skip[k];
         let body_of = |name: &str| index.get(name).copied();
         // Groups: union-find over the moving bodies joined by joints.
         let mut root: Vec<usize> = (0..n).collect();
@@ -187,7 +177,7 @@ impl SceneSpec {
             }
             k
         }
-        for (_, j) in self.joints.iter().enumerate().filter(|&(k, _)| live(k)) {
+        for (j, _) in self.joints.iter().zip(skip).filter(|&(_, &s)| !s) {
             if let (Some(a), Some(b)) = (body_of(&j.body_i), body_of(&j.body_j)) {
                 let (ra, rb) = (find(&mut root, a), find(&mut root, b));
                 root[ra] = rb;
@@ -251,10 +241,7 @@ impl SceneSpec {
                 }
             }
         }
-        let outputs = self.outputs.quantities.iter().chain(&self.outputs.plot);
-        let responses = self.responses.iter().flat_map(|r| r.of.iter());
-        let reads = outputs.chain(responses).chain(&self.sensitivities);
-        for part in reads.flat_map(|s| s.split('+')).map(str::trim) {
+        for part in self.reads() {
             let (head, kind) = part.split_once('.').unwrap_or((part, ""));
             if self.bodies.iter().any(|b| b.name == head) {
                 if !read_at_rest(kind) {
@@ -265,5 +252,15 @@ impl SceneSpec {
             }
         }
         out
+    }
+
+    /// Every name the study reads: each output, the plot, each response's
+    /// outputs and each sensitivity, a tied lane term by term, trimmed.
+    fn reads(&self) -> impl Iterator<Item = &str> {
+        let outputs = self.outputs.quantities.iter().chain(&self.outputs.plot);
+        let responses = self.responses.iter().flat_map(|r| r.of.iter());
+        (outputs.chain(responses).chain(&self.sensitivities))
+            .flat_map(|s| s.split('+'))
+            .map(str::trim)
     }
 }

@@ -60,11 +60,12 @@ pub fn load_scene(study: &Study) -> Result<Scene> {
     let mut spec: SceneSpec = study.require_section("scene", "the multibody scene")?;
     spec.prune_derivatives();
     let panels = |name: &str, modes: usize, update: Option<ModeUpdate>, geometric: Stiffening| {
+        let thickness = spec.thickness_variables(name);
         if modes == 0 {
             // A body at rest (`ground` module).
-            return crate::panels::basis::rest_basis_for_study(study, name, update);
+            let variables = (update, &thickness[..]);
+            return crate::panels::basis::rest_basis_for_study(study, name, variables);
         }
-        let thickness = spec.thickness_variables(name);
         crate::panels::basis_for_study_thickness(
             study,
             name,
@@ -280,7 +281,9 @@ impl ScenePlan {
     }
 
     /// The basis of panel `name` with lay-up `laminates[i]`, from a pooled
-    /// builder; with its geometric stiffness when `geometric`.
+    /// builder; with its geometric stiffness when `geometric`. `modes = 0`:
+    /// the basis of a body at rest, without a builder
+    /// ([`crate::panels::basis::rest_basis`]).
     fn basis(
         &self,
         name: &str,
@@ -298,6 +301,11 @@ impl ScenePlan {
         let located = |e: Error| {
             crate::panels::in_panel(e, name).in_file(&self.study.path, &format!("panels[{i}]"))
         };
+        if modes == 0 {
+            let variables = (update, thickness);
+            return crate::panels::basis::rest_basis(&self.panels[i], &laminates[i], variables)
+                .map_err(located);
+        }
         let taken = {
             let mut pool = self.pool.lock().unwrap_or_else(|p| p.into_inner());
             let k = pool.iter().position(|p| p.panel == i && p.update == update);
@@ -314,7 +322,6 @@ impl ScenePlan {
         prepared.builder.set_geometric(geometric.is_some());
         prepared.builder.set_joint_points(geometric.unwrap_or(&[]));
         let basis = match prepared.builder.set_thickness(thickness) {
-            Ok(()) if modes == 0 => prepared.builder.rest_basis(&laminates[i]),
             Ok(()) => prepared.builder.basis(&laminates[i], modes),
             Err(e) => Err(e),
         }

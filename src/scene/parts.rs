@@ -407,19 +407,15 @@ pub(super) fn flexible_body(
             } else {
                 (f.modes, geometric)
             };
-            let basis = panels(panel, modes, f.derivatives, geometric.then_some(&local[..]))
+            panels(panel, modes, f.derivatives, geometric.then_some(&local[..]))
                 .map_err(|e| match e {
                     // The mode count is this body's key, not the panel's.
                     Error::Input { key, expected, .. } if key.ends_with("n_modes") => {
                         Error::input(format!("{fk}.modes"), f.modes, expected)
                     }
                     e => e,
-                })?;
-            if rest {
-                basis
-            } else {
-                basis.screened(limit)?
-            }
+                })?
+                .screened(limit)?
         }
     };
     basis.validate(&fk)?;

@@ -311,10 +311,11 @@ impl ModalBasis {
     /// modes keep their order, eigenvalues and derivative columns, and
     /// `rigid` lists the dropped ones (1-based computed-mode numbers,
     /// frequency \[Hz\], content). A basis without contents (closed-form
-    /// beams) is returned as is. Error ([`Error::Numerical`]) if no mode
-    /// would be left.
+    /// beams) or without modes (a body at rest, `scene::ground`) is
+    /// returned as is. Error ([`Error::Numerical`]) if no mode would be
+    /// left of some.
     pub fn screened(&self, limit: f64) -> Result<ModalBasis> {
-        if self.rigid.content.len() != self.n_modes {
+        if self.n_modes == 0 || self.rigid.content.len() != self.n_modes {
             return Ok(self.clone());
         }
         let keep: Vec<usize> = (0..self.n_modes)

@@ -74,7 +74,7 @@ use faer::sparse::SparseColMat;
 use faer::{Mat, MatRef};
 use nalgebra::{DMatrix, SymmetricEigen};
 
-use super::blocks::Blocks;
+use super::blocks::{Blocks, Part};
 use super::mass::subtract_mass_term;
 pub use super::mass::MassDerivative;
 use super::modes::{sign_normalize, Modes};
@@ -365,14 +365,16 @@ impl<'a> Restriction<'a> {
     ) -> (usize, Restriction<'a>) {
         let mass = pencil.mass();
         match blocks.and_then(|b| Some((b, b.holding(cluster_modes, mass)?))) {
-            Some((b, p)) => (
-                p + 1,
-                Restriction {
-                    pencil: &b.parts[p].pencil,
-                    dofs: Some(&b.parts[p].dofs),
-                },
-            ),
+            Some((b, p)) => (p + 1, Restriction::of_part(&b.parts[p])),
             None => (0, Restriction { pencil, dofs: None }),
+        }
+    }
+
+    /// The restriction to one block of the pencil.
+    fn of_part(part: &'a Part) -> Self {
+        Restriction {
+            pencil: &part.pencil,
+            dofs: Some(&part.dofs),
         }
     }
 
@@ -388,14 +390,25 @@ impl<'a> Restriction<'a> {
     fn scatter(&self, v: Mat<f64>, n: usize) -> Mat<f64> {
         match self.dofs {
             None => v,
-            Some(d) => {
+            Some(_) => {
                 let mut out = Mat::<f64>::zeros(n, v.ncols());
+                self.scatter_into(&v, &mut out);
+                out
+            }
+        }
+    }
+
+    /// Write `v` (on this pencil's DOFs) into the rows of `out` (all `n`
+    /// DOFs) that this pencil covers.
+    fn scatter_into(&self, v: &Mat<f64>, out: &mut Mat<f64>) {
+        match self.dofs {
+            None => out.copy_from(v),
+            Some(d) => {
                 for j in 0..v.ncols() {
                     for (i, &di) in d.iter().enumerate() {
                         out[(di, j)] = v[(i, j)];
                     }
                 }
-                out
             }
         }
     }
@@ -449,19 +462,15 @@ pub(crate) fn compute(
         let f = right_hand_sides(pencil.mass(), &setups, &adjacent, (first, r));
         let mut vsol = on.scatter(sys.solve(&on.gather(f.as_ref(), 0..f.ncols()))?, n);
         if let (Some(b), Some(p)) = (blocks, slot.checked_sub(1)) {
-            for (q, part) in b.parts.iter().enumerate() {
-                if q == p || !b.coupled(p, q) {
-                    continue;
-                }
-                let fq =
-                    Mat::<f64>::from_fn(part.dofs.len(), f.ncols(), |i, j| f[(part.dofs[i], j)]);
-                let (vq, factor) =
-                    system::plain_solve(&part.pencil, sys.lambda_bar, &fq, spares[q + 1].take())?;
-                for j in 0..f.ncols() {
-                    for (i, &d) in part.dofs.iter().enumerate() {
-                        vsol[(d, j)] = vq[(i, j)];
-                    }
-                }
+            // The blocks a K'ᵥ couples to the cluster's (module doc of
+            // `blocks`): a plain solve, λ̄ being no eigenvalue there.
+            let coupled = (b.parts.iter().enumerate()).filter(|&(q, _)| q != p && b.coupled(p, q));
+            for (q, part) in coupled {
+                let on_q = Restriction::of_part(part);
+                let fq = on_q.gather(f.as_ref(), 0..f.ncols());
+                let spare = spares[q + 1].take();
+                let (vq, factor) = system::plain_solve(on_q.pencil, sys.lambda_bar, &fq, spare)?;
+                on_q.scatter_into(&vq, &mut vsol);
                 spares[q + 1] = Some(factor);
             }
         }

@@ -196,3 +196,39 @@ fn a_group_at_rest_is_built_fixed_and_the_rest_moves_alike() {
         assert!(fixed_bodies(&text).is_empty(), "{text}");
     }
 }
+
+/// The coarse SAR problem (8 divisions, 4 modes) with a thickness lane on
+/// panel 2, which stays at rest: loading the study resolves the lane on
+/// the basis without modes (the names come from the study's thickness
+/// variables, not from an eigen-analysis), panel 2 is built fixed, and
+/// every derivative with respect to its thickness is exactly 0.
+#[test]
+fn a_panel_at_rest_resolves_its_thickness_lane() {
+    use crate::common::sar::{coarse_sar, replace};
+    let text = replace(
+        &coarse_sar(include_str!("../../../studies/sar_optimize.toml"), 8, 4),
+        "sensitivities = [\"B3.design.theta_1_4\", \"B3.design.theta_2_3\", \
+         \"B2.design.theta_1_4\", \"B2.design.theta_2_3\"]",
+        "sensitivities = [\"B3.design.theta_1_4\", \"B2.design.thickness_1_4\"]",
+        1,
+    );
+    let study = Study::parse("sar_optimize.toml", &text).unwrap();
+    let scene = plyscape::scene::load_scene(&study).unwrap();
+    let m = &scene.model;
+    let b2 = &m.bodies[m.body("B2").unwrap()];
+    assert!(b2.fixed);
+    let names: Vec<&str> = (b2.flex.as_ref().unwrap().basis.derivatives.iter())
+        .map(|d| d.name.as_str())
+        .collect();
+    assert_eq!(names, ["theta_1_4", "theta_2_3", "thickness_1_4"]);
+    let (_, sim) = simulate(&scene).unwrap();
+    let lane: Vec<usize> = (sim.sens_headers.iter().enumerate())
+        .filter(|(_, h)| h.contains("/d(B2.design.thickness_1_4)"))
+        .map(|(c, _)| c)
+        .collect();
+    assert!(!lane.is_empty(), "{:?}", sim.sens_headers);
+    assert!(sim
+        .sens_rows
+        .iter()
+        .all(|r| lane.iter().all(|&c| r[c] == 0.0)));
+}
