@@ -130,6 +130,9 @@ fn sar_first_run_is_certified_in_13_f_and_5_g() {
     let start3 = 0.9089401593497987;
     assert!((o.f - start3).abs() <= noise * start3.max(1.0), "{o:?}");
     assert!(c.decrease_left.unwrap() <= noise, "{c:?}");
+    // The end at the noise is a near-stationary point: Kuhn–Tucker
+    // residual measured 1.4e-3 (5.0e-6 when the run took one more step).
+    assert!(c.kt_residual.unwrap() <= 2e-3, "{c:?}");
 }
 
 /// The restoration on a violation with many local minima
